@@ -1,0 +1,112 @@
+# Finds sadsplat's dependencies and defines imported targets for them.
+#
+# PCL is found by hand, not through Debian's PCLConfig.cmake: that file drags in VTK and MPI
+# even for PCL's non-I/O libraries, and the GPU machine has neither. Only the libraries
+# sadsplat uses are looked up: common, kdtree, search, octree, filters, sample_consensus
+# (+ FLANN) always, io (+ io_ply) when SADSPLAT_WITH_VTK is on.
+
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(Boost REQUIRED)
+find_package(Threads REQUIRED)
+
+# --- LibTorch -------------------------------------------------------------------------------
+find_package(Torch REQUIRED)
+# TORCH_LIBRARIES carries the whole of libtorch; modules link it PRIVATE unless a header needs it.
+add_library(sadsplat_torch INTERFACE)
+target_link_libraries(sadsplat_torch INTERFACE ${TORCH_LIBRARIES})
+target_include_directories(sadsplat_torch SYSTEM INTERFACE ${TORCH_INCLUDE_DIRS})
+add_library(sadsplat::torch ALIAS sadsplat_torch)
+
+# --- PCL (by hand) --------------------------------------------------------------------------
+set(_pcl_hints)
+if(SADSPLAT_PCL_ROOT)
+  list(APPEND _pcl_hints ${SADSPLAT_PCL_ROOT}/usr ${SADSPLAT_PCL_ROOT})
+endif()
+find_path(SADSPLAT_PCL_INCLUDE_DIR pcl/point_types.h
+          HINTS ${_pcl_hints} PATH_SUFFIXES include/pcl-1.13 include/pcl-1.14 include/pcl-1.12
+          REQUIRED)
+find_path(SADSPLAT_FLANN_INCLUDE_DIR flann/flann.hpp HINTS ${_pcl_hints} PATH_SUFFIXES include
+          REQUIRED)
+find_path(SADSPLAT_LZ4_INCLUDE_DIR lz4.h HINTS ${_pcl_hints} PATH_SUFFIXES include REQUIRED)
+
+add_library(sadsplat_pcl INTERFACE)
+target_include_directories(sadsplat_pcl SYSTEM INTERFACE
+  ${SADSPLAT_PCL_INCLUDE_DIR} ${SADSPLAT_FLANN_INCLUDE_DIR} ${SADSPLAT_LZ4_INCLUDE_DIR})
+target_link_libraries(sadsplat_pcl INTERFACE Eigen3::Eigen Boost::headers)
+foreach(_lib common kdtree search octree filters sample_consensus)
+  find_library(SADSPLAT_PCL_${_lib}_LIBRARY NAMES pcl_${_lib}
+               HINTS ${_pcl_hints} PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
+  target_link_libraries(sadsplat_pcl INTERFACE ${SADSPLAT_PCL_${_lib}_LIBRARY})
+endforeach()
+find_library(SADSPLAT_FLANN_LIBRARY NAMES flann_cpp HINTS ${_pcl_hints}
+             PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
+# FLANN's headers call LZ4 (index serialisation), so code instantiating KdTreeFLANN needs it.
+find_library(SADSPLAT_LZ4_LIBRARY NAMES lz4 HINTS ${_pcl_hints}
+             PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
+target_link_libraries(sadsplat_pcl INTERFACE ${SADSPLAT_FLANN_LIBRARY} ${SADSPLAT_LZ4_LIBRARY})
+add_library(sadsplat::pcl ALIAS sadsplat_pcl)
+
+set(SADSPLAT_HAVE_PCL_IO OFF)
+if(SADSPLAT_WITH_VTK)
+  find_library(SADSPLAT_PCL_io_LIBRARY NAMES pcl_io HINTS ${_pcl_hints}
+               PATH_SUFFIXES lib/x86_64-linux-gnu lib)
+  find_library(SADSPLAT_PCL_io_ply_LIBRARY NAMES pcl_io_ply HINTS ${_pcl_hints}
+               PATH_SUFFIXES lib/x86_64-linux-gnu lib)
+  if(SADSPLAT_PCL_io_LIBRARY AND SADSPLAT_PCL_io_ply_LIBRARY)
+    add_library(sadsplat_pcl_io INTERFACE)
+    target_link_libraries(sadsplat_pcl_io INTERFACE sadsplat::pcl ${SADSPLAT_PCL_io_LIBRARY}
+                                                    ${SADSPLAT_PCL_io_ply_LIBRARY})
+    add_library(sadsplat::pcl_io ALIAS sadsplat_pcl_io)
+    set(SADSPLAT_HAVE_PCL_IO ON)
+  else()
+    message(FATAL_ERROR "SADSPLAT_WITH_VTK=ON but pcl_io was not found "
+                        "(install libpcl-dev, or configure with -DSADSPLAT_WITH_VTK=OFF)")
+  endif()
+endif()
+
+# --- OpenCV ---------------------------------------------------------------------------------
+set(SADSPLAT_HAVE_OPENCV OFF)
+if(SADSPLAT_WITH_OPENCV)
+  find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs calib3d)
+  set(SADSPLAT_HAVE_OPENCV ON)
+endif()
+
+# --- header-only helpers: JSON and CLI ------------------------------------------------------
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+
+# --- CUDA -----------------------------------------------------------------------------------
+set(SADSPLAT_HAVE_CUDA OFF)
+if(SADSPLAT_WITH_CUDA STREQUAL "AUTO")
+  include(CheckLanguage)
+  check_language(CUDA)
+  if(CMAKE_CUDA_COMPILER)
+    set(SADSPLAT_HAVE_CUDA ON)
+  endif()
+elseif(SADSPLAT_WITH_CUDA)
+  set(SADSPLAT_HAVE_CUDA ON)
+endif()
+if(SADSPLAT_HAVE_CUDA)
+  if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+    set(CMAKE_CUDA_ARCHITECTURES 90)
+  endif()
+  enable_language(CUDA)
+  set(CMAKE_CUDA_STANDARD 17)
+  set(CMAKE_CUDA_STANDARD_REQUIRED ON)
+endif()
+
+# --- GoogleTest -----------------------------------------------------------------------------
+if(SADSPLAT_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+  include(GoogleTest)
+endif()
+
+# Compile definitions every sadsplat target sees, so headers can say what the build has.
+add_library(sadsplat_build_flags INTERFACE)
+target_compile_definitions(sadsplat_build_flags INTERFACE
+  SADSPLAT_HAVE_OPENCV=$<BOOL:${SADSPLAT_HAVE_OPENCV}>
+  SADSPLAT_HAVE_PCL_IO=$<BOOL:${SADSPLAT_HAVE_PCL_IO}>
+  SADSPLAT_HAVE_CUDA=$<BOOL:${SADSPLAT_HAVE_CUDA}>)
+target_compile_options(sadsplat_build_flags INTERFACE
+  $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wno-unused-parameter>)
+add_library(sadsplat::build_flags ALIAS sadsplat_build_flags)

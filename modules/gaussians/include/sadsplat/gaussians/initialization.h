@@ -1,0 +1,38 @@
+#pragma once
+/// \file initialization.h
+/// \brief Initial Gaussians from a scene's sparse points (3D Gaussian Splatting's initialisation).
+
+#include <pcl/point_cloud.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "sadsplat/common/gaussian_point.h"
+#include "sadsplat/io/scene.h"
+
+namespace sadsplat {
+namespace gaussians {
+
+/// \brief Parameters of the initialisation; defaults are those of the 3DGS reference trainer.
+struct InitOptions {
+  float initial_opacity = 0.1f;   ///< opacity (not logit) of every Gaussian
+  int scale_neighbours = 3;       ///< scale = mean distance to this many nearest neighbours
+  float min_scale = 1e-7f;        ///< floor for the distance (duplicate points)
+  float feature_stddev = 1e-2f;   ///< semantic features ~ N(0, stddev), seeded
+  std::uint64_t seed = 42;
+};
+
+/// \brief One isotropic Gaussian per sparse point: centre = point, SH DC from its colour,
+/// log-scale = log(mean distance to the k nearest neighbours, through pcl::KdTreeFLANN),
+/// identity rotation, opacity logit of `initial_opacity`, small random features, unlabelled.
+/// \throws sadsplat::Error if the scene has fewer than scale_neighbours + 1 points
+pcl::PointCloud<GaussianPoint> initialCloud(const std::vector<io::ScenePoint>& points,
+                                            const InitOptions& options = {});
+
+/// \brief SH DC coefficient that renders `rgb` (0..1) at degree 0: (rgb - 0.5) / C0.
+float rgbToShDc(float rgb);
+/// \brief Inverse of rgbToShDc.
+float shDcToRgb(float dc);
+
+}  // namespace gaussians
+}  // namespace sadsplat

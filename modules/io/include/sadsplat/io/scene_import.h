@@ -1,0 +1,35 @@
+#pragma once
+/// \file scene_import.h
+/// \brief Importing a scene directory (images/, labels/, sparse/0/, classes.json, split.json).
+/// Needs OpenCV (SADSPLAT_WITH_OPENCV); without it importScene throws a clear error.
+
+#include <string>
+
+#include "sadsplat/io/scene.h"
+
+namespace sadsplat {
+namespace io {
+
+/// \brief How images are resized on import.
+struct ImportOptions {
+  /// Scale applied to every image (the paper trains at half resolution: 0.5). In (0, 1].
+  double scale = 1.0;
+  /// If > 0, images wider than this are further scaled down to this width.
+  int max_width = 0;
+};
+
+/// \brief Whether this build can import scene directories (it has OpenCV).
+bool haveSceneImport();
+
+/// \brief Imports a scene directory.
+///
+/// Images are decoded, undistorted to a pinhole camera (SIMPLE_RADIAL, RADIAL, OPENCV), and
+/// resized; label maps (labels/<image stem>.png: 8-bit class ids with 255 = ignore, or colour
+/// PNGs mapped through the class colours with black = ignore unless a class is black) are
+/// warped the same way with nearest-neighbour sampling. split.json is optional: without it every
+/// view trains and every view with a label map is labelled.
+/// \throws sadsplat::Error naming the file, the field and the expectation
+Scene importScene(const std::string& dir, const ImportOptions& options = {});
+
+}  // namespace io
+}  // namespace sadsplat

@@ -1,0 +1,58 @@
+#include "sadsplat/io/atomic_file.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <sys/stat.h>
+
+#include "sadsplat/common/error.h"
+
+namespace sadsplat {
+namespace io {
+
+void writeViaTemporaryPath(const std::string& path,
+                           const std::function<void(const std::string& tmp_path)>& write) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  try {
+    write(tmp);
+    struct stat st {};
+    if (::stat(tmp.c_str(), &st) != 0) {
+      throw Error(path, "write", "the file to be written", "the writer produced nothing");
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+      throw Error(path, "rename from " + tmp, "success", std::strerror(errno));
+    }
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+}
+
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write) {
+  writeViaTemporaryPath(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      throw Error(path, "open for writing", "a writable location", std::strerror(errno));
+    }
+    write(out);
+    out.flush();
+    if (!out) throw Error(path, "write", "all bytes written", "a stream error (disk full?)");
+  });
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "file", "an existing, readable file", "cannot open it");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw Error(path, "file", "a readable file", "a read error");
+  return buffer.str();
+}
+
+}  // namespace io
+}  // namespace sadsplat

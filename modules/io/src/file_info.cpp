@@ -1,0 +1,120 @@
+#include "sadsplat/io/file_info.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/pcd.h"
+#include "sadsplat/io/scene_cache.h"
+#include "sadsplat/io/scene_import.h"
+
+namespace sadsplat {
+namespace io {
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+template <typename Range, typename GetXyz>
+void describeBounds(std::ostream& out, const Range& points, GetXyz xyz) {
+  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                 std::numeric_limits<float>::max()};
+  float hi[3] = {-lo[0], -lo[1], -lo[2]};
+  bool any = false;
+  for (const auto& p : points) {
+    const auto v = xyz(p);
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], v[k]);
+      hi[k] = std::max(hi[k], v[k]);
+    }
+    any = true;
+  }
+  if (!any) {
+    out << "bounding box: (empty)\n";
+    return;
+  }
+  out << std::setprecision(4) << "bounding box: [" << lo[0] << ", " << lo[1] << ", " << lo[2]
+      << "] .. [" << hi[0] << ", " << hi[1] << ", " << hi[2] << "]\n";
+}
+
+void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& cloud) {
+  out << "gaussians: " << cloud.size() << "\n";
+  describeBounds(out, cloud, [](const GaussianPoint& p) { return std::array<float, 3>{p.x, p.y, p.z}; });
+  std::size_t labelled = 0;
+  std::uint32_t max_label = 0;
+  for (const auto& p : cloud) {
+    if (p.label != kUnlabelled) {
+      ++labelled;
+      max_label = std::max(max_label, p.label);
+    }
+  }
+  out << "labelled gaussians: " << labelled;
+  if (labelled) out << " (class ids up to " << max_label << ")";
+  out << "\n";
+}
+
+void describeScene(std::ostream& out, const Scene& scene) {
+  std::size_t train = 0, test = 0, labelled = 0;
+  for (const auto& v : scene.views) {
+    train += v.train;
+    test += v.test;
+    labelled += v.labelled;
+  }
+  out << "views: " << scene.views.size() << " (train " << train << ", test " << test
+      << ", labelled " << labelled << ")\n";
+  if (!scene.views.empty()) {
+    out << "image size: " << scene.views[0].camera.width << "x" << scene.views[0].camera.height
+        << "\n";
+  }
+  out << "sparse points: " << scene.points.size() << "\n";
+  describeBounds(out, scene.points, [](const ScenePoint& p) { return p.xyz; });
+  out << "classes: " << scene.classes.size() << "\n";
+  for (std::size_t i = 0; i < scene.classes.size(); ++i) {
+    const auto& c = scene.classes[i];
+    out << "  " << i << " " << c.name << " rgb(" << int(c.color[0]) << "," << int(c.color[1])
+        << "," << int(c.color[2]) << ") \"" << c.prompt << "\"\n";
+  }
+}
+
+}  // namespace
+
+std::string describeFile(const std::string& path) {
+  std::ostringstream out;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw Error(path, "file", "an existing file or directory", "missing");
+  if (S_ISDIR(st.st_mode)) {
+    out << path << ": scene directory\n";
+    describeScene(out, importScene(path));
+  } else if (isSceneCache(path)) {
+    out << path << ": scene cache (version " << kSceneCacheVersion << ")\n";
+    describeScene(out, readSceneCache(path));
+  } else if (endsWith(path, ".ply")) {
+    PlyFileInfo info;
+    const auto cloud = readGaussianPly(path, &info);
+    out << path << ": 3DGS PLY (" << info.format << ")\n"
+        << "SH degree: " << info.sh_degree << "\n"
+        << "semantic properties: " << (info.has_semantic ? "yes" : "no")
+        << " (feature dim " << info.feature_dim << ")\n";
+    if (!info.ignored_properties.empty()) {
+      out << "ignored properties:";
+      for (const auto& n : info.ignored_properties) out << " " << n;
+      out << "\n";
+    }
+    describeGaussians(out, cloud);
+  } else if (endsWith(path, ".pcd")) {
+    out << path << ": PCD of GaussianPoint\n";
+    describeGaussians(out, loadGaussianPcd(path));
+  } else {
+    throw Error(path, "file type", "a .ply, a .pcd, a scene cache or a scene directory");
+  }
+  return out.str();
+}
+
+}  // namespace io
+}  // namespace sadsplat

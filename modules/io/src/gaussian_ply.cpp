@@ -1,0 +1,457 @@
+#include "sadsplat/io/gaussian_ply.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <sstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+
+namespace sadsplat {
+namespace io {
+namespace {
+
+enum class PlyType { kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kFloat32, kFloat64 };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::kFloat32;
+  bool is_list = false;
+  PlyType count_type = PlyType::kUInt8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+
+struct PlyHeader {
+  PlyFormat format = PlyFormat::kBinaryLittleEndian;
+  std::string format_name;
+  std::vector<PlyElement> elements;
+  std::size_t data_offset = 0;
+};
+
+bool parseType(const std::string& s, PlyType* type) {
+  static const std::pair<const char*, PlyType> kNames[] = {
+      {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUInt8},
+      {"uint8", PlyType::kUInt8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUInt16}, {"uint16", PlyType::kUInt16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},   {"uint", PlyType::kUInt32},     {"uint32", PlyType::kUInt32},
+      {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"float64", PlyType::kFloat64}};
+  for (const auto& [name, t] : kNames) {
+    if (s == name) {
+      *type = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::size_t typeSize(PlyType t) {
+  switch (t) {
+    case PlyType::kInt8:
+    case PlyType::kUInt8:
+      return 1;
+    case PlyType::kInt16:
+    case PlyType::kUInt16:
+      return 2;
+    case PlyType::kInt32:
+    case PlyType::kUInt32:
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
+  }
+  return 0;
+}
+
+PlyHeader parseHeader(const std::string& path, const std::string& bytes) {
+  if (bytes.compare(0, 4, "ply\n") != 0 && bytes.compare(0, 5, "ply\r\n") != 0) {
+    throw Error(path, "magic", "a PLY file starting with \"ply\"");
+  }
+  PlyHeader header;
+  std::size_t pos = 0;
+  bool have_format = false;
+  int line_no = 0;
+  while (true) {
+    const std::size_t eol = bytes.find('\n', pos);
+    if (eol == std::string::npos) throw Error(path, "header", "an \"end_header\" line", "EOF");
+    std::string line = bytes.substr(pos, eol - pos);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    pos = eol + 1;
+    ++line_no;
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    const std::string where = "header line " + std::to_string(line_no);
+    if (keyword == "ply" || keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
+      continue;
+    }
+    if (keyword == "end_header") break;
+    if (keyword == "format") {
+      std::string name, version;
+      words >> name >> version;
+      if (name == "ascii") {
+        header.format = PlyFormat::kAscii;
+      } else if (name == "binary_little_endian") {
+        header.format = PlyFormat::kBinaryLittleEndian;
+      } else if (name == "binary_big_endian") {
+        header.format = PlyFormat::kBinaryBigEndian;
+      } else {
+        throw Error(path, where + " (format)",
+                    "ascii, binary_little_endian or binary_big_endian", name);
+      }
+      header.format_name = name;
+      have_format = true;
+    } else if (keyword == "element") {
+      PlyElement element;
+      long long count = -1;
+      words >> element.name >> count;
+      if (element.name.empty() || count < 0 || words.fail()) {
+        throw Error(path, where + " (element)", "\"element <name> <count>\"", line);
+      }
+      element.count = static_cast<std::size_t>(count);
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) {
+        throw Error(path, where + " (property)", "a property after an element line", line);
+      }
+      PlyProperty property;
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type >> property.name;
+        property.is_list = true;
+        if (!parseType(count_type, &property.count_type) || !parseType(item_type, &property.type)) {
+          throw Error(path, where + " (property list)", "known PLY scalar types", line);
+        }
+      } else {
+        words >> property.name;
+        if (!parseType(type, &property.type)) {
+          throw Error(path, where + " (property " + property.name + ")",
+                      "a PLY scalar type (char uchar short ushort int uint float double)", type);
+        }
+      }
+      if (property.name.empty()) throw Error(path, where, "a property name", line);
+      header.elements.back().properties.push_back(property);
+    } else {
+      throw Error(path, where, "a PLY header keyword", keyword);
+    }
+  }
+  if (!have_format) throw Error(path, "header", "a \"format\" line");
+  header.data_offset = pos;
+  return header;
+}
+
+// Where a PLY vertex property goes in a GaussianPoint.
+struct Target {
+  enum Kind { kSkip, kFloat, kLabel } kind = kSkip;
+  std::size_t float_offset = 0;  // byte offset of the float in GaussianPoint
+};
+
+#define SADSPLAT_FIELD_OFFSET(field) offsetof(GaussianPoint, field)
+
+// Matches "<prefix><index>" and returns the index, or -1.
+int indexedName(const std::string& name, const std::string& prefix) {
+  if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return -1;
+  int index = 0;
+  for (std::size_t i = prefix.size(); i < name.size(); ++i) {
+    if (name[i] < '0' || name[i] > '9' || index > 100000) return -1;
+    index = index * 10 + (name[i] - '0');
+  }
+  return index;
+}
+
+class ValueDecoder {
+ public:
+  ValueDecoder(const std::string& path, const std::string& bytes, std::size_t pos,
+               PlyFormat format)
+      : path_(path), bytes_(bytes), pos_(pos), format_(format) {}
+
+  double next(PlyType type, const std::string& what) {
+    if (format_ == PlyFormat::kAscii) return nextAscii(what);
+    const std::size_t size = typeSize(type);
+    if (pos_ + size > bytes_.size()) {
+      throw Error(path_, what, "more data (file is truncated)", "end of file");
+    }
+    unsigned char raw[8];
+    std::memcpy(raw, bytes_.data() + pos_, size);
+    pos_ += size;
+    if (format_ == PlyFormat::kBinaryBigEndian) {
+      for (std::size_t i = 0; i < size / 2; ++i) std::swap(raw[i], raw[size - 1 - i]);
+    }
+    switch (type) {
+      case PlyType::kInt8: return static_cast<double>(static_cast<std::int8_t>(raw[0]));
+      case PlyType::kUInt8: return static_cast<double>(raw[0]);
+      case PlyType::kInt16: return load<std::int16_t>(raw);
+      case PlyType::kUInt16: return load<std::uint16_t>(raw);
+      case PlyType::kInt32: return load<std::int32_t>(raw);
+      case PlyType::kUInt32: return load<std::uint32_t>(raw);
+      case PlyType::kFloat32: return load<float>(raw);
+      case PlyType::kFloat64: return load<double>(raw);
+    }
+    return 0.0;
+  }
+
+  // Skips to the next line in ascii files (one element item per line).
+  void endItem() {
+    if (format_ != PlyFormat::kAscii) return;
+    while (pos_ < bytes_.size() && bytes_[pos_] != '\n') ++pos_;
+    if (pos_ < bytes_.size()) ++pos_;
+  }
+
+ private:
+  template <typename T>
+  static double load(const unsigned char* raw) {
+    T v;
+    std::memcpy(&v, raw, sizeof(T));
+    return static_cast<double>(v);
+  }
+
+  double nextAscii(const std::string& what) {
+    while (pos_ < bytes_.size() && (bytes_[pos_] == ' ' || bytes_[pos_] == '\t')) ++pos_;
+    if (pos_ >= bytes_.size() || bytes_[pos_] == '\n' || bytes_[pos_] == '\r') {
+      throw Error(path_, what, "a number (line is short or file is truncated)", "end of line");
+    }
+    const char* begin = bytes_.data() + pos_;
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    if (end == begin) {
+      throw Error(path_, what, "a number", std::string(begin, std::min<std::size_t>(16, bytes_.size() - pos_)));
+    }
+    pos_ += static_cast<std::size_t>(end - begin);
+    return v;
+  }
+
+  const std::string& path_;
+  const std::string& bytes_;
+  std::size_t pos_;
+  PlyFormat format_;
+};
+
+void skipElement(ValueDecoder& decoder, const PlyElement& element) {
+  for (std::size_t i = 0; i < element.count; ++i) {
+    for (const PlyProperty& p : element.properties) {
+      const std::string what = "element " + element.name + " item " + std::to_string(i);
+      if (p.is_list) {
+        const double n = decoder.next(p.count_type, what);
+        for (long long k = 0; k < static_cast<long long>(n); ++k) decoder.next(p.type, what);
+      } else {
+        decoder.next(p.type, what);
+      }
+    }
+    decoder.endItem();
+  }
+}
+
+}  // namespace
+
+pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileInfo* info) {
+  const std::string bytes = readWholeFile(path);
+  const PlyHeader header = parseHeader(path, bytes);
+
+  std::size_t vertex_index = header.elements.size();
+  for (std::size_t i = 0; i < header.elements.size(); ++i) {
+    if (header.elements[i].name == "vertex") vertex_index = i;
+  }
+  if (vertex_index == header.elements.size()) {
+    throw Error(path, "header", "an \"element vertex\" line");
+  }
+  const PlyElement& vertex = header.elements[vertex_index];
+
+  PlyFileInfo found;
+  found.format = header.format_name;
+  found.num_vertices = vertex.count;
+
+  // Map each vertex property to its place in GaussianPoint.
+  std::vector<Target> targets(vertex.properties.size());
+  int rest_count = 0;
+  std::vector<bool> seen_required(14, false);  // x y z f_dc0..2 opacity scale0..2 rot0..3
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    const PlyProperty& p = vertex.properties[i];
+    if (p.is_list) {
+      throw Error(path, "vertex property " + p.name, "a scalar property", "a list");
+    }
+    Target& t = targets[i];
+    t.kind = Target::kFloat;
+    const std::string& n = p.name;
+    int k = -1;
+    if (n == "x") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(x);
+      seen_required[0] = true;
+    } else if (n == "y") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(y);
+      seen_required[1] = true;
+    } else if (n == "z") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(z);
+      seen_required[2] = true;
+    } else if (n == "nx" || n == "ny" || n == "nz") {
+      t.float_offset = n == "nx"   ? SADSPLAT_FIELD_OFFSET(nx)
+                       : n == "ny" ? SADSPLAT_FIELD_OFFSET(ny)
+                                   : SADSPLAT_FIELD_OFFSET(nz);
+      found.has_normals = true;
+    } else if ((k = indexedName(n, "f_dc_")) >= 0 && k < 3) {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(f_dc) + sizeof(float) * k;
+      seen_required[3 + k] = true;
+    } else if ((k = indexedName(n, "f_rest_")) >= 0) {
+      t.kind = Target::kSkip;  // placed once the SH degree is known
+      rest_count = std::max(rest_count, k + 1);
+    } else if (n == "opacity") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(opacity);
+      seen_required[6] = true;
+    } else if ((k = indexedName(n, "scale_")) >= 0 && k < 3) {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(scale) + sizeof(float) * k;
+      seen_required[7 + k] = true;
+    } else if ((k = indexedName(n, "rot_")) >= 0 && k < 4) {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(rot) + sizeof(float) * k;
+      seen_required[10 + k] = true;
+    } else if ((k = indexedName(n, "feature_")) >= 0) {
+      if (k >= kFeatureDim) {
+        throw Error(path, "vertex property " + n,
+                    "at most " + std::to_string(kFeatureDim) + " feature_* properties");
+      }
+      t.float_offset = SADSPLAT_FIELD_OFFSET(feature) + sizeof(float) * k;
+      found.feature_dim = std::max(found.feature_dim, k + 1);
+      found.has_semantic = true;
+    } else if (n == "log_alpha") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(log_alpha);
+      found.has_semantic = true;
+    } else if (n == "confidence") {
+      t.float_offset = SADSPLAT_FIELD_OFFSET(confidence);
+      found.has_semantic = true;
+    } else if (n == "label") {
+      t.kind = Target::kLabel;
+      found.has_semantic = true;
+    } else {
+      t.kind = Target::kSkip;
+      found.ignored_properties.push_back(n);
+    }
+  }
+  static const char* kRequiredNames[14] = {"x",     "y",       "z",       "f_dc_0", "f_dc_1",
+                                           "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+                                           "rot_0", "rot_1",   "rot_2",   "rot_3"};
+  for (int r = 0; r < 14; ++r) {
+    if (!seen_required[r]) {
+      throw Error(path, std::string("vertex property ") + kRequiredNames[r],
+                  "present (a 3D Gaussian Splatting PLY has x y z f_dc_0..2 opacity scale_0..2 "
+                  "rot_0..3)",
+                  "missing");
+    }
+  }
+  // Rest coefficients: 3 channels x ((d+1)^2 - 1), channel-major.
+  int rest_per_channel = rest_count / 3;
+  found.sh_degree = -1;
+  for (int d = 0; d <= kMaxShDegree; ++d) {
+    if (rest_count == 3 * (shCoefficientsForDegree(d) - 1)) found.sh_degree = d;
+  }
+  if (found.sh_degree < 0) {
+    throw Error(path, "vertex properties f_rest_*", "0, 9, 24 or 45 of them (SH degree 0..3)",
+                std::to_string(rest_count));
+  }
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    const int k = indexedName(vertex.properties[i].name, "f_rest_");
+    if (k < 0) continue;
+    const int channel = k / rest_per_channel;
+    const int coeff = k % rest_per_channel;
+    targets[i].kind = Target::kFloat;
+    targets[i].float_offset =
+        SADSPLAT_FIELD_OFFSET(f_rest) + sizeof(float) * (channel * kShRestPerChannel + coeff);
+  }
+
+  ValueDecoder decoder(path, bytes, header.data_offset, header.format);
+  for (std::size_t e = 0; e < vertex_index; ++e) skipElement(decoder, header.elements[e]);
+
+  pcl::PointCloud<GaussianPoint> cloud;
+  cloud.resize(vertex.count);
+  for (std::size_t v = 0; v < vertex.count; ++v) {
+    GaussianPoint& point = cloud[v];
+    auto* base = reinterpret_cast<unsigned char*>(&point);
+    for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+      const PlyProperty& p = vertex.properties[i];
+      const double value = decoder.next(p.type, "vertex " + std::to_string(v) + " property " + p.name);
+      const Target& t = targets[i];
+      if (t.kind == Target::kSkip) continue;
+      if (!std::isfinite(value)) {
+        throw Error(path, "vertex " + std::to_string(v) + " property " + p.name,
+                    "a finite number", std::to_string(value));
+      }
+      if (t.kind == Target::kLabel) {
+        if (value < 0 || value > static_cast<double>(kUnlabelled) || value != std::floor(value)) {
+          throw Error(path, "vertex " + std::to_string(v) + " property label",
+                      "an unsigned integer class id", std::to_string(value));
+        }
+        point.label = static_cast<std::uint32_t>(value);
+      } else {
+        const float f = static_cast<float>(value);
+        std::memcpy(base + t.float_offset, &f, sizeof(float));
+      }
+    }
+    decoder.endItem();
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  if (info != nullptr) *info = found;
+  return cloud;
+}
+
+void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
+                      const PlyWriteOptions& options) {
+  if (options.sh_degree < 0 || options.sh_degree > kMaxShDegree) {
+    throw Error(path, "sh_degree option", "0..3", std::to_string(options.sh_degree));
+  }
+  const int rest = shCoefficientsForDegree(options.sh_degree) - 1;
+
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\ncomment written by sadsplat\n"
+         << "element vertex " << cloud.size() << "\n";
+  for (const char* n : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"}) {
+    header << "property float " << n << "\n";
+  }
+  for (int k = 0; k < 3 * rest; ++k) header << "property float f_rest_" << k << "\n";
+  header << "property float opacity\n";
+  for (int k = 0; k < 3; ++k) header << "property float scale_" << k << "\n";
+  for (int k = 0; k < 4; ++k) header << "property float rot_" << k << "\n";
+  if (options.semantic) {
+    for (int k = 0; k < kFeatureDim; ++k) header << "property float feature_" << k << "\n";
+    header << "property float log_alpha\nproperty float confidence\nproperty uint label\n";
+  }
+  header << "end_header\n";
+  const std::string header_text = header.str();
+
+  // One record per vertex, all fields 4 bytes, little endian (the host order on x86-64/ARM).
+  const std::size_t floats_per_record =
+      9 + 3 * rest + 1 + 3 + 4 + (options.semantic ? kFeatureDim + 3 : 0);
+  std::vector<float> record(floats_per_record);
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(header_text.data(), static_cast<std::streamsize>(header_text.size()));
+    for (const GaussianPoint& p : cloud) {
+      float* r = record.data();
+      for (float v : {p.x, p.y, p.z, p.nx, p.ny, p.nz, p.f_dc[0], p.f_dc[1], p.f_dc[2]}) *r++ = v;
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < rest; ++k) *r++ = p.f_rest[c * kShRestPerChannel + k];
+      }
+      *r++ = p.opacity;
+      for (float v : p.scale) *r++ = v;
+      for (float v : p.rot) *r++ = v;
+      if (options.semantic) {
+        for (float v : p.feature) *r++ = v;
+        *r++ = p.log_alpha;
+        *r++ = p.confidence;
+        std::memcpy(r++, &p.label, sizeof(float));
+      }
+      out.write(reinterpret_cast<const char*>(record.data()),
+                static_cast<std::streamsize>(record.size() * sizeof(float)));
+    }
+  });
+}
+
+}  // namespace io
+}  // namespace sadsplat

@@ -1,0 +1,288 @@
+#include "sadsplat/io/scene_cache.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+
+namespace sadsplat {
+namespace io {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'A', 'D', 'S', 'C', 'E', 'N', 'E'};
+constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8;
+
+// Little-endian writer into a byte string (x86-64 and ARM hosts are little endian).
+class ByteWriter {
+ public:
+  template <typename T>
+  void put(const T& v) {
+    bytes_.append(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
+  void putString(const std::string& s) {
+    put<std::uint32_t>(static_cast<std::uint32_t>(s.size()));
+    bytes_.append(s);
+  }
+  void putBytes(const std::vector<std::uint8_t>& v) {
+    bytes_.append(reinterpret_cast<const char*>(v.data()), v.size());
+  }
+  // Chunk: 4-byte tag, u64 size, content.
+  void putChunk(const char tag[4], const ByteWriter& content) {
+    bytes_.append(tag, 4);
+    put<std::uint64_t>(content.bytes_.size());
+    bytes_.append(content.bytes_);
+  }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+class ByteReader {
+ public:
+  ByteReader(const std::string& path, const char* data, std::size_t size, std::string context)
+      : path_(path), data_(data), size_(size), context_(std::move(context)) {}
+
+  template <typename T>
+  T get(const char* field) {
+    need(sizeof(T), field);
+    T v;
+    std::memcpy(&v, data_ + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return v;
+  }
+  double getFinite(const char* field) {
+    const double v = get<double>(field);
+    if (!std::isfinite(v)) throw Error(path_, context_ + " " + field, "a finite number", std::to_string(v));
+    return v;
+  }
+  std::string getString(const char* field) {
+    const auto n = get<std::uint32_t>(field);
+    need(n, field);
+    std::string s(data_ + pos_, n);
+    pos_ += n;
+    return s;
+  }
+  std::vector<std::uint8_t> getBytes(std::size_t n, const char* field) {
+    need(n, field);
+    std::vector<std::uint8_t> v(reinterpret_cast<const std::uint8_t*>(data_ + pos_),
+                                reinterpret_cast<const std::uint8_t*>(data_ + pos_ + n));
+    pos_ += n;
+    return v;
+  }
+  ByteReader subReader(std::size_t n, const std::string& context) {
+    need(n, "chunk");
+    ByteReader sub(path_, data_ + pos_, n, context);
+    pos_ += n;
+    return sub;
+  }
+  bool atEnd() const { return pos_ == size_; }
+  std::size_t remaining() const { return size_ - pos_; }
+  const std::string& context() const { return context_; }
+
+ private:
+  void need(std::size_t n, const char* field) const {
+    if (n > size_ - pos_) {
+      throw Error(path_, context_ + " " + field, "more data (file is truncated or corrupt)",
+                  std::to_string(size_ - pos_) + " bytes left");
+    }
+  }
+  const std::string& path_;
+  const char* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+  std::string context_;
+};
+
+Image8 readImage(ByteReader& r, int w, int h, int channels, const char* field) {
+  Image8 image;
+  image.width = w;
+  image.height = h;
+  image.channels = channels;
+  image.pixels = r.getBytes(static_cast<std::size_t>(w) * h * channels, field);
+  return image;
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(const void* data, std::size_t size) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  std::uint64_t hash = 1469598103934665603ull;
+  for (std::size_t i = 0; i < size; ++i) {
+    hash ^= p[i];
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+void writeSceneCache(const std::string& path, const Scene& scene) {
+  ByteWriter payload;
+  {
+    ByteWriter c;
+    c.putString(scene.source);
+    payload.putChunk("SRCE", c);
+  }
+  {
+    ByteWriter c;
+    c.put<std::uint32_t>(static_cast<std::uint32_t>(scene.classes.size()));
+    for (const auto& cls : scene.classes) {
+      c.putString(cls.name);
+      for (auto v : cls.color) c.put<std::uint8_t>(v);
+      c.putString(cls.prompt);
+    }
+    payload.putChunk("CLAS", c);
+  }
+  for (const View& v : scene.views) {
+    const auto pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
+    if (v.rgb.pixels.size() != pixels * 3 || v.mask.pixels.size() != pixels ||
+        (!v.labels.empty() && v.labels.pixels.size() != pixels)) {
+      throw Error(path, "view " + v.name, "images of the camera's size " +
+                  std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height));
+    }
+    ByteWriter c;
+    c.putString(v.name);
+    c.put<std::uint32_t>(v.camera.width);
+    c.put<std::uint32_t>(v.camera.height);
+    for (double x : {v.camera.fx, v.camera.fy, v.camera.cx, v.camera.cy}) c.put<double>(x);
+    for (double q : v.camera.qvec) c.put<double>(q);
+    for (double t : v.camera.tvec) c.put<double>(t);
+    const std::uint8_t roles = (v.train ? 1 : 0) | (v.test ? 2 : 0) | (v.labelled ? 4 : 0);
+    c.put<std::uint8_t>(roles);
+    c.put<std::uint8_t>(v.labels.empty() ? 0 : 1);
+    c.putBytes(v.rgb.pixels);
+    c.putBytes(v.mask.pixels);
+    if (!v.labels.empty()) c.putBytes(v.labels.pixels);
+    payload.putChunk("VIEW", c);
+  }
+  {
+    ByteWriter c;
+    c.put<std::uint64_t>(scene.points.size());
+    for (const auto& p : scene.points) {
+      for (float x : p.xyz) c.put<float>(x);
+      for (auto v : p.rgb) c.put<std::uint8_t>(v);
+    }
+    payload.putChunk("PNTS", c);
+  }
+  const std::string& body = payload.bytes();
+  ByteWriter header;
+  for (char ch : kMagic) header.put<char>(ch);
+  header.put<std::uint32_t>(kSceneCacheVersion);
+  header.put<std::uint32_t>(0);  // flags, reserved
+  header.put<std::uint64_t>(body.size());
+  header.put<std::uint64_t>(fnv1a64(body.data(), body.size()));
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(header.bytes().data(), static_cast<std::streamsize>(header.bytes().size()));
+    out.write(body.data(), static_cast<std::streamsize>(body.size()));
+  });
+}
+
+bool isSceneCache(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, 8) && std::memcmp(magic, kMagic, 8) == 0;
+}
+
+Scene readSceneCache(const std::string& path) {
+  const std::string bytes = readWholeFile(path);
+  ByteReader head(path, bytes.data(), bytes.size(), "header");
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
+    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"");
+  }
+  head.getBytes(8, "magic");
+  const auto version = head.get<std::uint32_t>("version");
+  if (version != kSceneCacheVersion) {
+    throw Error(path, "version", std::to_string(kSceneCacheVersion) + " (re-import the scene)",
+                std::to_string(version));
+  }
+  head.get<std::uint32_t>("flags");
+  const auto payload_size = head.get<std::uint64_t>("payload size");
+  const auto checksum = head.get<std::uint64_t>("checksum");
+  if (payload_size != bytes.size() - kHeaderSize) {
+    throw Error(path, "payload size", std::to_string(payload_size) + " bytes after the header",
+                std::to_string(bytes.size() - kHeaderSize) + " (file truncated or padded)");
+  }
+  const char* body = bytes.data() + kHeaderSize;
+  if (fnv1a64(body, payload_size) != checksum) {
+    throw Error(path, "checksum", "the FNV-1a hash stored in the header", "a mismatch (corrupt)");
+  }
+
+  Scene scene;
+  ByteReader r(path, body, payload_size, "payload");
+  bool have_classes = false;
+  while (!r.atEnd()) {
+    const auto tag_bytes = r.getBytes(4, "chunk tag");
+    const std::string tag(tag_bytes.begin(), tag_bytes.end());
+    const auto size = r.get<std::uint64_t>("chunk size");
+    ByteReader c = r.subReader(size, "chunk " + tag);
+    if (tag == "SRCE") {
+      scene.source = c.getString("source");
+    } else if (tag == "CLAS") {
+      const auto n = c.get<std::uint32_t>("class count");
+      for (std::uint32_t i = 0; i < n; ++i) {
+        ClassInfo cls;
+        cls.name = c.getString("class name");
+        for (auto& v : cls.color) v = c.get<std::uint8_t>("class colour");
+        cls.prompt = c.getString("class prompt");
+        scene.classes.push_back(cls);
+      }
+      have_classes = true;
+    } else if (tag == "VIEW") {
+      View v;
+      v.name = c.getString("view name");
+      v.camera.width = static_cast<int>(c.get<std::uint32_t>("width"));
+      v.camera.height = static_cast<int>(c.get<std::uint32_t>("height"));
+      v.camera.fx = c.getFinite("fx");
+      v.camera.fy = c.getFinite("fy");
+      v.camera.cx = c.getFinite("cx");
+      v.camera.cy = c.getFinite("cy");
+      for (double& q : v.camera.qvec) q = c.getFinite("qvec");
+      for (double& t : v.camera.tvec) t = c.getFinite("tvec");
+      const auto roles = c.get<std::uint8_t>("roles");
+      v.train = roles & 1;
+      v.test = roles & 2;
+      v.labelled = roles & 4;
+      const bool has_labels = c.get<std::uint8_t>("has labels") != 0;
+      const int w = v.camera.width, h = v.camera.height;
+      if (w <= 0 || h <= 0 || v.camera.fx <= 0 || v.camera.fy <= 0) {
+        throw Error(path, "view " + v.name + " camera", "positive size and focal lengths");
+      }
+      v.rgb = readImage(c, w, h, 3, "rgb");
+      v.mask = readImage(c, w, h, 1, "mask");
+      if (has_labels) {
+        v.labels = readImage(c, w, h, 1, "labels");
+        if (!have_classes) throw Error(path, "chunk order", "CLAS before VIEW");
+        for (std::size_t i = 0; i < v.labels.pixels.size(); ++i) {
+          const auto l = v.labels.pixels[i];
+          if (l != kIgnoreLabel && l >= scene.classes.size()) {
+            throw Error(path, "view " + v.name + " label pixel " + std::to_string(i),
+                        "a class id below " + std::to_string(scene.classes.size()) + " or 255",
+                        std::to_string(l));
+          }
+        }
+      }
+      scene.views.push_back(std::move(v));
+    } else if (tag == "PNTS") {
+      const auto n = c.get<std::uint64_t>("point count");
+      if (n > c.remaining() / 15) {
+        throw Error(path, "chunk PNTS point count", "a count that fits the chunk",
+                    std::to_string(n));
+      }
+      scene.points.resize(n);
+      for (auto& p : scene.points) {
+        for (float& x : p.xyz) {
+          x = c.get<float>("point xyz");
+          if (!std::isfinite(x)) throw Error(path, "point xyz", "finite coordinates");
+        }
+        for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
+      }
+    }
+    // Unknown chunks are skipped: later versions may add chunks readers can ignore.
+  }
+  if (!have_classes) throw Error(path, "chunk CLAS", "present", "missing");
+  return scene;
+}
+
+}  // namespace io
+}  // namespace sadsplat

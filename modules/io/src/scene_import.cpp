@@ -1,0 +1,268 @@
+#include "sadsplat/io/scene_import.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/colmap.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#endif
+
+namespace sadsplat {
+namespace io {
+
+bool haveSceneImport() { return SADSPLAT_HAVE_OPENCV != 0; }
+
+#if !SADSPLAT_HAVE_OPENCV
+Scene importScene(const std::string& dir, const ImportOptions&) {
+  throw Error(dir, "scene import", "a sadsplat build with OpenCV (SADSPLAT_WITH_OPENCV=ON)",
+              "a build without it; import the scene elsewhere and use its scene cache");
+}
+#else
+namespace {
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::string stem(const std::string& name) {
+  const auto slash = name.find_last_of('/');
+  const std::string base = slash == std::string::npos ? name : name.substr(slash + 1);
+  const auto dot = base.find_last_of('.');
+  const std::string dir = slash == std::string::npos ? "" : name.substr(0, slash + 1);
+  return dir + (dot == std::string::npos ? base : base.substr(0, dot));
+}
+
+Image8 toImage8(const cv::Mat& mat) {
+  Image8 image;
+  image.width = mat.cols;
+  image.height = mat.rows;
+  image.channels = mat.channels();
+  const cv::Mat contiguous = mat.isContinuous() ? mat : mat.clone();
+  image.pixels.assign(contiguous.data, contiguous.data + contiguous.total() * contiguous.elemSize());
+  return image;
+}
+
+// Camera matrix and distortion in OpenCV's convention (pixel centres at integers, hence -0.5).
+void opencvIntrinsics(const ColmapCamera& c, cv::Mat* K, cv::Mat* dist, PinholeCamera* pinhole) {
+  const auto& p = c.params;
+  double fx = p[0], fy = p[0], cx = p[1], cy = p[2];
+  std::vector<double> d(4, 0.0);
+  switch (c.model) {
+    case CameraModel::kSimplePinhole: break;
+    case CameraModel::kPinhole: fy = p[1]; cx = p[2]; cy = p[3]; break;
+    case CameraModel::kSimpleRadial: d[0] = p[3]; break;
+    case CameraModel::kRadial: d[0] = p[3]; d[1] = p[4]; break;
+    case CameraModel::kOpenCV:
+      fy = p[1]; cx = p[2]; cy = p[3];
+      d = {p[4], p[5], p[6], p[7]};
+      break;
+  }
+  *K = (cv::Mat_<double>(3, 3) << fx, 0, cx - 0.5, 0, fy, cy - 0.5, 0, 0, 1);
+  *dist = cv::Mat(d, true).reshape(1, 1);
+  pinhole->fx = fx;
+  pinhole->fy = fy;
+  pinhole->cx = cx;
+  pinhole->cy = cy;
+}
+
+bool isDistorted(const ColmapCamera& c) {
+  return c.model == CameraModel::kSimpleRadial || c.model == CameraModel::kRadial ||
+         c.model == CameraModel::kOpenCV;
+}
+
+cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
+  cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw Error(path, "image data", "a readable PNG label map", "cannot decode");
+  if (raw.depth() != CV_8U) {
+    throw Error(path, "pixel depth", "8-bit label map", "depth code " + std::to_string(raw.depth()));
+  }
+  cv::Mat labels(raw.rows, raw.cols, CV_8UC1);
+  if (raw.channels() == 1) {
+    labels = raw;
+    for (int y = 0; y < labels.rows; ++y) {
+      const auto* row = labels.ptr<std::uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) {
+        if (row[x] != kIgnoreLabel && row[x] >= classes.size()) {
+          throw Error(path, "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")",
+                      "a class id below " + std::to_string(classes.size()) + " or 255 (ignore)",
+                      std::to_string(row[x]));
+        }
+      }
+    }
+    return labels;
+  }
+  if (raw.channels() != 3 && raw.channels() != 4) {
+    throw Error(path, "channels", "1 (class ids) or 3 (class colours)",
+                std::to_string(raw.channels()));
+  }
+  std::map<std::uint32_t, std::uint8_t> palette;
+  auto key = [](int r, int g, int b) { return std::uint32_t(r) << 16 | std::uint32_t(g) << 8 | b; };
+  palette[key(0, 0, 0)] = kIgnoreLabel;
+  for (std::size_t i = 0; i < classes.size(); ++i) {
+    palette[key(classes[i].color[0], classes[i].color[1], classes[i].color[2])] =
+        static_cast<std::uint8_t>(i);
+  }
+  for (int y = 0; y < raw.rows; ++y) {
+    for (int x = 0; x < raw.cols; ++x) {
+      const std::uint8_t* px = raw.ptr<std::uint8_t>(y) + x * raw.channels();  // BGR(A)
+      const auto it = palette.find(key(px[2], px[1], px[0]));
+      if (it == palette.end()) {
+        throw Error(path, "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")",
+                    "a colour from classes.json or black (ignore)",
+                    "(" + std::to_string(px[2]) + ", " + std::to_string(px[1]) + ", " +
+                        std::to_string(px[0]) + ")");
+      }
+      labels.at<std::uint8_t>(y, x) = it->second;
+    }
+  }
+  return labels;
+}
+
+}  // namespace
+
+Scene importScene(const std::string& dir, const ImportOptions& options) {
+  if (!(options.scale > 0.0 && options.scale <= 1.0)) {
+    throw Error("<import options>", "scale", "a value in (0, 1]", std::to_string(options.scale));
+  }
+  if (!exists(dir)) throw Error(dir, "scene directory", "an existing directory", "missing");
+  Scene scene;
+  scene.source = dir;
+  scene.classes = readClassesJson(dir + "/classes.json");
+  const ColmapModel model = readColmapModel(dir + "/sparse/0");
+  std::map<std::uint32_t, const ColmapCamera*> cameras;
+  for (const auto& c : model.cameras) cameras[c.id] = &c;
+
+  SplitInfo split;
+  const bool have_split = exists(dir + "/split.json");
+  if (have_split) split = readSplitJson(dir + "/split.json");
+  const std::set<std::string> train(split.train.begin(), split.train.end());
+  const std::set<std::string> test(split.test.begin(), split.test.end());
+  const std::set<std::string> labelled(split.labelled.begin(), split.labelled.end());
+  std::set<std::string> image_names;
+  for (const auto& im : model.images) image_names.insert(im.name);
+  for (const auto* list : {&split.train, &split.test}) {
+    for (const auto& name : *list) {
+      if (!image_names.count(name)) {
+        throw Error(dir + "/split.json", "image " + name, "a name from sparse/0/images", "unknown");
+      }
+    }
+  }
+
+  std::vector<const ColmapImage*> images;
+  for (const auto& im : model.images) images.push_back(&im);
+  std::sort(images.begin(), images.end(),
+            [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+
+  for (const ColmapImage* im : images) {
+    const ColmapCamera& cam = *cameras.at(im->camera_id);
+    const std::string image_path = dir + "/images/" + im->name;
+    cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
+    if (bgr.empty()) {
+      throw Error(image_path, "image data", "a readable image named in sparse/0/images",
+                  exists(image_path) ? "cannot decode" : "missing");
+    }
+    if (bgr.cols != static_cast<int>(cam.width) || bgr.rows != static_cast<int>(cam.height)) {
+      throw Error(image_path, "size",
+                  std::to_string(cam.width) + "x" + std::to_string(cam.height) + " (camera " +
+                      std::to_string(cam.id) + ")",
+                  std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows));
+    }
+    View view;
+    view.name = im->name;
+    view.camera.qvec = im->qvec;
+    view.camera.tvec = im->tvec;
+    view.train = have_split ? train.count(im->name) > 0 : true;
+    view.test = have_split && test.count(im->name) > 0;
+
+    cv::Mat labels;
+    const std::string label_path = dir + "/labels/" + stem(im->name) + ".png";
+    if (exists(label_path)) {
+      labels = readLabelMap(label_path, scene.classes);
+      if (labels.size() != bgr.size()) {
+        throw Error(label_path, "size",
+                    std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) + " (its image)",
+                    std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
+      }
+    }
+    view.labelled = have_split ? labelled.count(im->name) > 0 : (!labels.empty() && view.train);
+    if (view.labelled && labels.empty()) {
+      throw Error(label_path, "file", "a label map for labelled view " + im->name, "missing");
+    }
+
+    cv::Mat mask(bgr.size(), CV_8UC1, cv::Scalar(255));
+    cv::Mat K, dist;
+    opencvIntrinsics(cam, &K, &dist, &view.camera);
+    if (isDistorted(cam)) {
+      cv::Mat map1, map2;
+      cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, bgr.size(), CV_32FC1, map1, map2);
+      cv::Mat undistorted;
+      cv::remap(bgr, undistorted, map1, map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+      bgr = undistorted;
+      cv::Mat warped_mask;
+      cv::remap(mask, warped_mask, map1, map2, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                cv::Scalar(0));
+      mask = warped_mask;
+      if (!labels.empty()) {
+        cv::Mat warped;
+        cv::remap(labels, warped, map1, map2, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                  cv::Scalar(kIgnoreLabel));
+        labels = warped;
+      }
+    }
+
+    double scale = options.scale;
+    if (options.max_width > 0 && bgr.cols * scale > options.max_width) {
+      scale = static_cast<double>(options.max_width) / bgr.cols;
+    }
+    const int w = std::max(1, static_cast<int>(std::lround(bgr.cols * scale)));
+    const int h = std::max(1, static_cast<int>(std::lround(bgr.rows * scale)));
+    if (w != bgr.cols || h != bgr.rows) {
+      const double sx = static_cast<double>(w) / bgr.cols;
+      const double sy = static_cast<double>(h) / bgr.rows;
+      cv::Mat resized;
+      cv::resize(bgr, resized, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+      bgr = resized;
+      cv::resize(mask, resized, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
+      mask = resized.clone();
+      if (!labels.empty()) {
+        cv::resize(labels, resized, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
+        labels = resized.clone();
+      }
+      view.camera.fx *= sx;
+      view.camera.cx *= sx;
+      view.camera.fy *= sy;
+      view.camera.cy *= sy;
+    }
+    view.camera.width = w;
+    view.camera.height = h;
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    view.rgb = toImage8(rgb);
+    view.mask = toImage8(mask);
+    if (!labels.empty()) view.labels = toImage8(labels);
+    scene.views.push_back(std::move(view));
+  }
+
+  scene.points.reserve(model.points.size());
+  for (const auto& p : model.points) {
+    ScenePoint sp;
+    for (int k = 0; k < 3; ++k) sp.xyz[k] = static_cast<float>(p.xyz[k]);
+    sp.rgb = p.rgb;
+    scene.points.push_back(sp);
+  }
+  return scene;
+}
+#endif
+
+}  // namespace io
+}  // namespace sadsplat

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs the Debian bookworm packages sadsplat needs, only those that are missing (idempotent).
+# Run as root on a fresh Debian bookworm machine.
+set -euo pipefail
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libpcl-dev libflann-dev libeigen3-dev libvtk9-dev mpi-default-dev
+  libtorch-dev libopencv-dev libgtest-dev libcli11-dev nlohmann-json3-dev
+  python3 python3-open3d
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+  echo "setup: all packages present"
+fi
