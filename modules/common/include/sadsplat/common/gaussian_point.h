@@ -24,6 +24,10 @@
 /// the way PCL itself does for its own types; include their ordinary PCL headers and link
 /// sadsplat::common: pcl::KdTreeFLANN, pcl::search::KdTree, pcl::VoxelGrid, pcl::ExtractIndices,
 /// pcl::RandomSample, pcl::CropBox.
+///
+/// Note on pcl::VoxelGrid: PCL's centroid accumulator knows only its standard fields, so a
+/// voxel's output point has the averaged centre and GaussianPoint's default values in every
+/// other field. Use it for spatial subsampling of centres, not for merging Gaussians.
 
 #include <cstdint>
 #include <limits>

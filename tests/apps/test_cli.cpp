@@ -1,0 +1,68 @@
+// The CLI: subcommands listed, info summaries, clear errors with non-zero exits, demo.
+#include <gtest/gtest.h>
+
+#include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/scene_import.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+const std::string kCli = SADSPLAT_CLI;
+const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+
+TEST(Cli, HelpListsTheSubcommands) {
+  std::string out;
+  EXPECT_EQ(test::runCommand(kCli + " --help", &out), 0);
+  for (const char* sub : {"info", "import", "convert", "extract", "demo"}) {
+    EXPECT_NE(out.find(sub), std::string::npos) << sub;
+  }
+}
+
+TEST(Cli, InfoSummarisesAPly) {
+  test::TempDir dir;
+  io::writeGaussianPly(dir.file("m.ply"), test::randomGaussians(12, 51));
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("m.ply"), &out), 0) << out;
+  EXPECT_NE(out.find("gaussians: 12"), std::string::npos) << out;
+  EXPECT_NE(out.find("SH degree: 3"), std::string::npos) << out;
+  EXPECT_NE(out.find("bounding box"), std::string::npos) << out;
+}
+
+TEST(Cli, BadInputGivesOneMessageAndNonZeroExit) {
+  test::TempDir dir;
+  test::writeFile(dir.file("bad.ply"), "not a ply");
+  std::string out;
+  EXPECT_EQ(test::runCommand(kCli + " info " + dir.file("bad.ply"), &out), 1);
+  EXPECT_NE(out.find("bad.ply: magic: expected"), std::string::npos) << out;
+  EXPECT_NE(test::runCommand(kCli + " frobnicate", &out), 0);
+}
+
+TEST(Cli, ImportInfoExtractAndDemoWorkOnTheFixture) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  test::TempDir dir;
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " import " + kScene + " --scale 0.5 --out " +
+                             dir.file("s.cache"), &out), 0) << out;
+  ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("s.cache"), &out), 0) << out;
+  EXPECT_NE(out.find("views: 8 (train 6, test 2, labelled 2)"), std::string::npos) << out;
+  EXPECT_NE(out.find("image size: 32x24"), std::string::npos) << out;
+  EXPECT_NE(out.find("2 building"), std::string::npos) << out;
+
+  auto cloud = test::randomGaussians(40, 52, 3);
+  io::writeGaussianPly(dir.file("m.ply"), cloud);
+  ASSERT_EQ(test::runCommand(kCli + " extract " + dir.file("m.ply") + " --class building --classes " +
+                             dir.file("s.cache") + " --out " + dir.file("b.ply"), &out), 0) << out;
+  std::size_t buildings = 0;
+  for (const auto& p : cloud) buildings += p.label == 2;
+  EXPECT_EQ(io::readGaussianPly(dir.file("b.ply")).size(), buildings);
+  EXPECT_EQ(test::runCommand(kCli + " extract " + dir.file("m.ply") + " --class water --classes " +
+                             dir.file("s.cache") + " --out " + dir.file("w.ply"), &out), 1);
+  EXPECT_NE(out.find("one of: road, grass, building"), std::string::npos) << out;
+
+  ASSERT_EQ(test::runCommand(kCli + " demo --out " + dir.file("demo"), &out), 0) << out;
+  EXPECT_NE(out.find("round trips exact: yes"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace sadsplat

@@ -1,0 +1,246 @@
+// The 3DGS PLY codec: exact round trips, the standard layout, files of other tools, errors, and
+// the readers of PCL and Open3D.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/gaussian_ply.h"
+#include "test_support/test_support.h"
+
+#if SADSPLAT_HAVE_PCL_IO
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/ply_io.h>
+#endif
+
+namespace sadsplat {
+namespace {
+
+using io::PlyFileInfo;
+using io::readGaussianPly;
+using io::writeGaussianPly;
+
+std::string headerOf(const std::string& path) {
+  const std::string bytes = test::readFile(path);
+  return bytes.substr(0, bytes.find("end_header\n") + 11);
+}
+
+// Expects readGaussianPly(path) to throw an Error whose message contains `needle`.
+void expectReadError(const std::string& path, const std::string& needle) {
+  try {
+    readGaussianPly(path);
+    FAIL() << "expected an error containing: " << needle;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(GaussianPly, RoundTripIsBitExact) {
+  test::TempDir dir;
+  const auto cloud = test::randomGaussians(257, 11);
+  writeGaussianPly(dir.file("a.ply"), cloud);
+  PlyFileInfo info;
+  const auto back = readGaussianPly(dir.file("a.ply"), &info);
+  ASSERT_EQ(back.size(), cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_TRUE(bitwiseEqual(back[i], cloud[i])) << "point " << i;
+  }
+  EXPECT_EQ(info.sh_degree, 3);
+  EXPECT_TRUE(info.has_semantic);
+  EXPECT_EQ(info.feature_dim, 32);
+  EXPECT_TRUE(info.ignored_properties.empty());
+}
+
+TEST(GaussianPly, WritesTheStandardLayoutThenSemanticProperties) {
+  test::TempDir dir;
+  writeGaussianPly(dir.file("a.ply"), test::randomGaussians(3, 1));
+  std::string want = "ply\nformat binary_little_endian 1.0\ncomment written by sadsplat\n"
+                     "element vertex 3\n";
+  for (const char* n : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"}) {
+    want += std::string("property float ") + n + "\n";
+  }
+  for (int k = 0; k < 45; ++k) want += "property float f_rest_" + std::to_string(k) + "\n";
+  want += "property float opacity\n";
+  for (int k = 0; k < 3; ++k) want += "property float scale_" + std::to_string(k) + "\n";
+  for (int k = 0; k < 4; ++k) want += "property float rot_" + std::to_string(k) + "\n";
+  for (int k = 0; k < 32; ++k) want += "property float feature_" + std::to_string(k) + "\n";
+  want += "property float log_alpha\nproperty float confidence\nproperty uint label\nend_header\n";
+  EXPECT_EQ(headerOf(dir.file("a.ply")), want);
+  // 62 standard floats + 34 semantic floats + 1 uint per vertex.
+  EXPECT_EQ(test::readFile(dir.file("a.ply")).size(), want.size() + 3 * 97 * 4);
+}
+
+TEST(GaussianPly, LowerShDegreeWritesFewerCoefficientsChannelMajor) {
+  test::TempDir dir;
+  auto cloud = test::randomGaussians(5, 2);
+  io::PlyWriteOptions options;
+  options.sh_degree = 1;
+  options.semantic = false;
+  writeGaussianPly(dir.file("d1.ply"), cloud, options);
+  PlyFileInfo info;
+  const auto back = readGaussianPly(dir.file("d1.ply"), &info);
+  EXPECT_EQ(info.sh_degree, 1);
+  EXPECT_FALSE(info.has_semantic);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < 15; ++k) {
+        const float want = k < 3 ? cloud[i].f_rest[c * 15 + k] : 0.f;
+        EXPECT_EQ(back[i].f_rest[c * 15 + k], want) << "point " << i << " c " << c << " k " << k;
+      }
+    }
+    EXPECT_EQ(back[i].feature[0], 0.f);
+    EXPECT_EQ(back[i].label, kUnlabelled);
+    EXPECT_EQ(back[i].opacity, cloud[i].opacity);
+  }
+}
+
+TEST(GaussianPly, ReadsAsciiFilesOfOtherToolsWithoutNormalsAndWithExtras) {
+  test::TempDir dir;
+  // Degree 1 (9 rest coefficients), no normals, extra properties of other types, CRLF lines.
+  std::string text =
+      "ply\r\nformat ascii 1.0\r\ncomment made by another trainer\r\nelement vertex 2\r\n"
+      "property float x\r\nproperty float y\r\nproperty float z\r\n"
+      "property float f_dc_0\r\nproperty float f_dc_1\r\nproperty float f_dc_2\r\n";
+  for (int k = 0; k < 9; ++k) text += "property float f_rest_" + std::to_string(k) + "\r\n";
+  text +=
+      "property float opacity\r\nproperty double scale_0\r\nproperty float scale_1\r\n"
+      "property float scale_2\r\nproperty float rot_0\r\nproperty float rot_1\r\n"
+      "property float rot_2\r\nproperty float rot_3\r\nproperty uchar red\r\n"
+      "element face 0\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
+      "1 2 3 0.1 0.2 0.3 10 11 12 20 21 22 30 31 32 -2 -1.5 -1.25 -1 1 0 0 0 255\r\n"
+      "4 5 6 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0.5 0.5 0.5 0.5 7\r\n";
+  test::writeFile(dir.file("other.ply"), text);
+  PlyFileInfo info;
+  const auto cloud = readGaussianPly(dir.file("other.ply"), &info);
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(info.format, "ascii");
+  EXPECT_EQ(info.sh_degree, 1);
+  EXPECT_FALSE(info.has_normals);
+  EXPECT_EQ(info.ignored_properties, std::vector<std::string>{"red"});
+  EXPECT_EQ(cloud[0].z, 3.f);
+  EXPECT_EQ(cloud[0].f_dc[2], 0.3f);
+  EXPECT_EQ(cloud[0].f_rest[0 * 15 + 0], 10.f);  // R, coefficient 1
+  EXPECT_EQ(cloud[0].f_rest[1 * 15 + 1], 21.f);  // G, coefficient 2
+  EXPECT_EQ(cloud[0].f_rest[2 * 15 + 2], 32.f);  // B, coefficient 3
+  EXPECT_EQ(cloud[0].f_rest[2 * 15 + 3], 0.f);
+  EXPECT_EQ(cloud[0].opacity, -2.f);
+  EXPECT_EQ(cloud[0].scale[0], -1.5f);
+  EXPECT_EQ(cloud[1].rot[3], 0.5f);
+  EXPECT_EQ(cloud[1].nx, 0.f);
+  EXPECT_EQ(cloud[1].label, kUnlabelled);
+}
+
+TEST(GaussianPly, ReadsBigEndianAndSkipsElementsBeforeTheVertices) {
+  test::TempDir dir;
+  std::string bytes =
+      "ply\nformat binary_big_endian 1.0\nelement meta 1\nproperty list uchar short ids\n"
+      "element vertex 1\n";
+  const char* names[] = {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0",
+                         "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"};
+  for (const char* n : names) bytes += std::string("property float ") + n + "\n";
+  bytes += "end_header\n";
+  bytes += std::string("\x02\x00\x01\x00\x02", 5);  // meta: list of two shorts
+  for (int i = 0; i < 14; ++i) {
+    const float v = 0.5f * static_cast<float>(i);
+    std::uint32_t u;
+    std::memcpy(&u, &v, 4);
+    for (int b = 3; b >= 0; --b) bytes.push_back(static_cast<char>((u >> (8 * b)) & 0xff));
+  }
+  test::writeFile(dir.file("be.ply"), bytes);
+  const auto cloud = readGaussianPly(dir.file("be.ply"));
+  ASSERT_EQ(cloud.size(), 1u);
+  EXPECT_EQ(cloud[0].y, 0.5f);
+  EXPECT_EQ(cloud[0].rot[3], 6.5f);
+}
+
+TEST(GaussianPly, ErrorsNameTheFileAndTheProblem) {
+  test::TempDir dir;
+  expectReadError(dir.file("missing.ply"), "existing, readable file");
+
+  test::writeFile(dir.file("magic.ply"), "PLY?\n");
+  expectReadError(dir.file("magic.ply"), "magic");
+
+  test::writeFile(dir.file("noscale.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                  "property float z\nend_header\n1 2 3\n");
+  expectReadError(dir.file("noscale.ply"), "vertex property f_dc_0");
+
+  writeGaussianPly(dir.file("full.ply"), test::randomGaussians(4, 5));
+  const std::string full = test::readFile(dir.file("full.ply"));
+  test::writeFile(dir.file("truncated.ply"), full.substr(0, full.size() - 10));
+  expectReadError(dir.file("truncated.ply"), "truncated");
+
+  auto cloud = test::randomGaussians(2, 6);
+  cloud[1].scale[1] = std::numeric_limits<float>::quiet_NaN();
+  writeGaussianPly(dir.file("nan.ply"), cloud);
+  expectReadError(dir.file("nan.ply"), "vertex 1 property scale_1: expected a finite number");
+
+  std::string odd = "ply\nformat ascii 1.0\nelement vertex 0\n";
+  for (const char* n : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0",
+                        "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3", "f_rest_0"}) {
+    odd += std::string("property float ") + n + "\n";
+  }
+  test::writeFile(dir.file("rest.ply"), odd + "end_header\n");
+  expectReadError(dir.file("rest.ply"), "0, 9, 24 or 45");
+
+  test::writeFile(dir.file("type.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 0\nproperty float128 x\nend_header\n");
+  expectReadError(dir.file("type.ply"), "PLY scalar type");
+}
+
+TEST(GaussianPly, FailedWriteLeavesNoFileBehind) {
+  EXPECT_THROW(writeGaussianPly("/nonexistent-dir/a.ply", test::randomGaussians(1, 1)), Error);
+}
+
+#if SADSPLAT_HAVE_PCL_IO
+TEST(GaussianPly, PclPlyReaderAcceptsOurFiles) {
+  test::TempDir dir;
+  const auto cloud = test::randomGaussians(10, 8);
+  writeGaussianPly(dir.file("a.ply"), cloud);
+  pcl::PCLPointCloud2 blob;
+  pcl::PLYReader reader;
+  ASSERT_EQ(reader.read(dir.file("a.ply"), blob), 0);
+  EXPECT_EQ(blob.width * blob.height, 10u);
+  ASSERT_EQ(blob.fields.size(), 97u);
+  EXPECT_EQ(blob.fields[6].name, "f_dc_0");
+  EXPECT_EQ(blob.fields.back().name, "label");
+  float opacity = 0.f;
+  for (const auto& f : blob.fields) {
+    if (f.name == "opacity") std::memcpy(&opacity, &blob.data[3 * blob.point_step + f.offset], 4);
+  }
+  EXPECT_EQ(opacity, cloud[3].opacity);
+}
+#endif
+
+TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
+  std::string probe;
+  if (test::runCommand("/usr/bin/python3 -c 'import open3d'", &probe) != 0) {
+    GTEST_SKIP() << "Debian's python3-open3d is not installed (scripts/setup_debian.sh installs it)";
+  }
+  test::TempDir dir;
+  auto cloud = test::randomGaussians(6, 9);
+  writeGaussianPly(dir.file("a.ply"), cloud);
+  const std::string script =
+      "import open3d as o3d, sys\n"
+      "pc = o3d.t.io.read_point_cloud(sys.argv[1])\n"
+      "print(len(pc.point.positions), float(pc.point.opacity[2][0].item()), "
+      "float(pc.point.feature_31[4][0].item()), float(pc.point.f_rest_44[0][0].item()))\n";
+  test::writeFile(dir.file("probe.py"), script);
+  std::string out;
+  ASSERT_EQ(test::runCommand("/usr/bin/python3 " + dir.file("probe.py") + " " + dir.file("a.ply"), &out), 0)
+      << out;
+  std::istringstream in(out.substr(out.find_last_of('\n', out.size() - 2) + 1));
+  std::size_t n = 0;
+  float opacity = 0, feature = 0, rest = 0;
+  in >> n >> opacity >> feature >> rest;
+  EXPECT_EQ(n, 6u) << out;
+  EXPECT_FLOAT_EQ(opacity, cloud[2].opacity);
+  EXPECT_FLOAT_EQ(feature, cloud[4].feature[31]);
+  EXPECT_FLOAT_EQ(rest, cloud[0].f_rest[44]);
+}
+
+}  // namespace
+}  // namespace sadsplat

@@ -1,0 +1,142 @@
+// The scene cache: exact round trip and every kind of damaged file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/scene_cache.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+io::Scene syntheticScene() {
+  io::Scene scene;
+  scene.source = "synthetic";
+  scene.classes = {{"road", {1, 2, 3}, "a road"}, {"roof", {4, 5, 6}, "a roof"}};
+  for (int i = 0; i < 3; ++i) {
+    io::View v;
+    v.name = "v" + std::to_string(i) + ".png";
+    v.camera.width = 5 + i;
+    v.camera.height = 4;
+    v.camera.fx = 10.5 + i;
+    v.camera.fy = 11.25;
+    v.camera.cx = 2.5;
+    v.camera.cy = 2.0;
+    v.camera.qvec = {0.5, 0.5, -0.5, 0.5};
+    v.camera.tvec = {1e-3, -2.0, 3.0 + i};
+    const auto n = static_cast<std::size_t>(v.camera.width * v.camera.height);
+    v.rgb = {v.camera.width, 4, 3, std::vector<std::uint8_t>(n * 3)};
+    for (std::size_t k = 0; k < n * 3; ++k) v.rgb.pixels[k] = static_cast<std::uint8_t>(k * 7 + i);
+    v.mask = {v.camera.width, 4, 1, std::vector<std::uint8_t>(n, 255)};
+    if (i != 1) {
+      v.labels = {v.camera.width, 4, 1, std::vector<std::uint8_t>(n)};
+      for (std::size_t k = 0; k < n; ++k) v.labels.pixels[k] = k % 3 == 2 ? 255 : k % 2;
+    }
+    v.train = i != 2;
+    v.test = i == 2;
+    v.labelled = i == 0;
+    scene.views.push_back(v);
+  }
+  scene.points = {{{1.f, 2.f, 3.f}, {9, 8, 7}}, {{-1.f, 0.5f, 1e-8f}, {0, 255, 1}}};
+  return scene;
+}
+
+void expectCacheError(const std::string& path, const std::string& needle) {
+  try {
+    io::readSceneCache(path);
+    FAIL() << "expected an error containing " << needle;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+// Rewrites the header checksum so that only the deliberate damage is detected.
+void fixChecksum(std::string& bytes) {
+  const std::uint64_t sum = io::fnv1a64(bytes.data() + 32, bytes.size() - 32);
+  std::memcpy(&bytes[24], &sum, 8);
+}
+
+TEST(SceneCache, RoundTripIsExact) {
+  test::TempDir dir;
+  const io::Scene scene = syntheticScene();
+  io::writeSceneCache(dir.file("s.cache"), scene);
+  EXPECT_TRUE(io::isSceneCache(dir.file("s.cache")));
+  const io::Scene back = io::readSceneCache(dir.file("s.cache"));
+  EXPECT_EQ(back.source, "synthetic");
+  ASSERT_EQ(back.classes.size(), 2u);
+  EXPECT_EQ(back.classes[1].name, "roof");
+  EXPECT_EQ(back.classes[1].color, scene.classes[1].color);
+  EXPECT_EQ(back.classes[1].prompt, "a roof");
+  ASSERT_EQ(back.views.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto &a = scene.views[i], &b = back.views[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.camera.width, b.camera.width);
+    EXPECT_EQ(a.camera.fx, b.camera.fx);
+    EXPECT_EQ(a.camera.cy, b.camera.cy);
+    EXPECT_EQ(a.camera.qvec, b.camera.qvec);
+    EXPECT_EQ(a.camera.tvec, b.camera.tvec);
+    EXPECT_EQ(a.rgb.pixels, b.rgb.pixels);
+    EXPECT_EQ(a.mask.pixels, b.mask.pixels);
+    EXPECT_EQ(a.labels.pixels, b.labels.pixels);
+    EXPECT_EQ(a.train, b.train);
+    EXPECT_EQ(a.test, b.test);
+    EXPECT_EQ(a.labelled, b.labelled);
+  }
+  ASSERT_EQ(back.points.size(), 2u);
+  EXPECT_EQ(back.points[1].xyz, scene.points[1].xyz);
+  EXPECT_EQ(back.points[1].rgb, scene.points[1].rgb);
+}
+
+TEST(SceneCache, DamagedFilesAreRejectedWithTheReason) {
+  test::TempDir dir;
+  expectCacheError(dir.file("none.cache"), "existing, readable file");
+  io::writeSceneCache(dir.file("s.cache"), syntheticScene());
+  const std::string good = test::readFile(dir.file("s.cache"));
+
+  std::string bytes = good;
+  bytes[0] = 'X';
+  test::writeFile(dir.file("magic.cache"), bytes);
+  expectCacheError(dir.file("magic.cache"), "magic");
+
+  bytes = good;
+  bytes[8] = 99;  // version
+  test::writeFile(dir.file("version.cache"), bytes);
+  expectCacheError(dir.file("version.cache"), "version: expected 1");
+
+  test::writeFile(dir.file("short.cache"), good.substr(0, good.size() - 7));
+  expectCacheError(dir.file("short.cache"), "truncated");
+
+  bytes = good;
+  bytes[bytes.size() - 20] ^= 0x40;
+  test::writeFile(dir.file("flip.cache"), bytes);
+  expectCacheError(dir.file("flip.cache"), "checksum");
+}
+
+TEST(SceneCache, ChecksSemanticValidityOfWellFormedFiles) {
+  test::TempDir dir;
+  io::Scene scene = syntheticScene();
+  scene.views[2].camera.fx = std::nan("");
+  io::writeSceneCache(dir.file("nan.cache"), scene);
+  expectCacheError(dir.file("nan.cache"), "fx: expected a finite number");
+
+  scene = syntheticScene();
+  scene.views[0].labels.pixels[3] = 7;  // only 2 classes
+  io::writeSceneCache(dir.file("label.cache"), scene);
+  expectCacheError(dir.file("label.cache"), "class id below 2");
+
+  // A damaged chunk size inside a payload whose checksum is (re)valid.
+  io::writeSceneCache(dir.file("s.cache"), syntheticScene());
+  std::string bytes = test::readFile(dir.file("s.cache"));
+  const std::uint64_t huge = 1ull << 40;
+  std::memcpy(&bytes[32 + 4], &huge, 8);  // size of the first chunk
+  fixChecksum(bytes);
+  test::writeFile(dir.file("chunk.cache"), bytes);
+  expectCacheError(dir.file("chunk.cache"), "truncated or corrupt");
+}
+
+}  // namespace
+}  // namespace sadsplat

@@ -1,0 +1,163 @@
+// Scene directory import: roles, resizing, undistortion, label maps and every input error.
+#include <gtest/gtest.h>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/colmap.h"
+#include "sadsplat/io/scene_import.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+
+class SceneImport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  }
+  // A writable copy of the fixture scene.
+  std::string copy() { return test::copyTree(kScene, tmp_.file("scene")); }
+
+  void expectError(const std::string& dir, const std::string& file_suffix,
+                   const std::string& needle, const io::ImportOptions& options = {}) {
+    try {
+      io::importScene(dir, options);
+      FAIL() << "expected an error containing " << needle;
+    } catch (const Error& e) {
+      EXPECT_NE(e.file().find(file_suffix), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  }
+
+  test::TempDir tmp_;
+};
+
+TEST_F(SceneImport, ReadsTheFixtureWithRolesLabelsAndPoints) {
+  const io::Scene scene = io::importScene(kScene);
+  ASSERT_EQ(scene.views.size(), 8u);
+  ASSERT_EQ(scene.classes.size(), 3u);
+  EXPECT_EQ(scene.classes[2].name, "building");
+  EXPECT_EQ(scene.points.size(), 400u);
+  const io::View& v0 = scene.views[0];
+  EXPECT_EQ(v0.name, "view_000.png");
+  EXPECT_TRUE(v0.train && v0.labelled && !v0.test);
+  EXPECT_TRUE(scene.views[2].test && !scene.views[2].train);
+  EXPECT_TRUE(scene.views[1].labels.empty());
+  ASSERT_EQ(v0.labels.pixels.size(), 64u * 48u);
+  EXPECT_EQ(v0.camera.width, 64);
+  EXPECT_DOUBLE_EQ(v0.camera.fx, 52.0);
+  // The fixture's corners are sky (ignore) in view 0; its centre sees the ground.
+  EXPECT_EQ(v0.labels.at(0, 0), io::kIgnoreLabel);
+  EXPECT_NE(v0.labels.at(32, 30), io::kIgnoreLabel);
+  EXPECT_EQ(v0.mask.at(0, 0), 255);
+  EXPECT_EQ(v0.rgb.channels, 3);
+}
+
+TEST_F(SceneImport, ResizingScalesImagesAndIntrinsics) {
+  io::ImportOptions options;
+  options.scale = 0.5;
+  const io::Scene scene = io::importScene(kScene, options);
+  const auto& cam = scene.views[0].camera;
+  EXPECT_EQ(cam.width, 32);
+  EXPECT_EQ(cam.height, 24);
+  EXPECT_DOUBLE_EQ(cam.fx, 26.0);
+  EXPECT_DOUBLE_EQ(cam.cx, 16.0);
+  EXPECT_EQ(scene.views[0].labels.pixels.size(), 32u * 24u);
+  options.scale = 1.5;
+  expectError(kScene, "<import options>", "(0, 1]", options);
+}
+
+TEST_F(SceneImport, UndistortsRadialCamerasAndMasksInvalidPixels) {
+  const std::string dir = copy();
+  auto model = io::readColmapModel(dir + "/sparse/0");
+  model.cameras[0].model = io::CameraModel::kOpenCV;
+  model.cameras[0].params = {52, 52, 32, 24, 0.0, 0.0, 0.0, 0.0};
+  io::writeColmapText(dir + "/sparse/0", model);
+  const io::Scene zero = io::importScene(dir);
+  const io::Scene plain = io::importScene(kScene);
+  // Zero distortion: identical pixels and labels.
+  EXPECT_EQ(zero.views[0].rgb.pixels, plain.views[0].rgb.pixels);
+  EXPECT_EQ(zero.views[0].labels.pixels, plain.views[0].labels.pixels);
+
+  model.cameras[0].model = io::CameraModel::kSimpleRadial;
+  model.cameras[0].params = {52, 32, 24, 0.4};  // pincushion: the corners fall outside
+  io::writeColmapText(dir + "/sparse/0", model);
+  const io::Scene warped = io::importScene(dir);
+  const auto& v = warped.views[0];
+  EXPECT_EQ(v.mask.at(0, 0), 0);
+  EXPECT_EQ(v.labels.at(0, 0), io::kIgnoreLabel);
+  EXPECT_EQ(v.mask.at(32, 24), 255);
+  EXPECT_EQ(v.rgb.at(32, 24, 1), plain.views[0].rgb.at(32, 24, 1));
+  EXPECT_DOUBLE_EQ(v.camera.fx, 52.0);
+}
+
+TEST_F(SceneImport, MapsColourLabelMapsThroughThePalette) {
+  const std::string dir = copy();
+  // A colour label map: building colour everywhere, black (ignore) in the first row.
+  std::string out;
+  const std::string py =
+      "import zlib, struct, sys\n"
+      "w, h = 64, 48\n"
+      "rows = b''.join(b'\\x00' + (bytes([0,0,0]) * w if y == 0 else bytes([220,20,60]) * w) for y in range(h))\n"
+      "c = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d))\n"
+      "open(sys.argv[1], 'wb').write(b'\\x89PNG\\r\\n\\x1a\\n' + c(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0)) + c(b'IDAT', zlib.compress(rows)) + c(b'IEND', b''))\n";
+  test::writeFile(tmp_.file("png.py"), py);
+  ASSERT_EQ(test::runCommand("/usr/bin/python3 " + tmp_.file("png.py") + " " + dir +
+                             "/labels/view_000.png", &out), 0) << out;
+  const io::Scene scene = io::importScene(dir);
+  EXPECT_EQ(scene.views[0].labels.at(5, 0), io::kIgnoreLabel);
+  EXPECT_EQ(scene.views[0].labels.at(5, 1), 2);
+}
+
+TEST_F(SceneImport, BadInputsNameTheFileAndTheField) {
+  expectError(tmp_.file("nowhere"), "nowhere", "existing directory");
+  {
+    const std::string dir = copy();
+    test::writeFile(dir + "/classes.json", "{\"classes\": [{\"name\": \"a\", \"color\": [1, 2]}]}");
+    expectError(dir, "classes.json", "classes[0].color");
+    test::writeFile(dir + "/classes.json", "{\"classes\": [");
+    expectError(dir, "classes.json", "JSON syntax");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+  {
+    const std::string dir = copy();
+    // A label id outside the 3-class list: make the classes list shorter.
+    test::writeFile(dir + "/classes.json",
+                    "{\"classes\": [{\"name\": \"road\", \"color\": [128, 64, 128]}]}");
+    expectError(dir, "labels/view_000.png", "class id below 1");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+  {
+    const std::string dir = copy();
+    auto model = io::readColmapModel(dir + "/sparse/0");
+    model.cameras[0].width = 80;
+    io::writeColmapText(dir + "/sparse/0", model);
+    expectError(dir, "images/view_000.png", "size: expected 80x48");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+  {
+    const std::string dir = copy();
+    test::runCommand("rm '" + dir + "/images/view_004.png'");
+    expectError(dir, "images/view_004.png", "missing");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+  {
+    const std::string dir = copy();
+    test::runCommand("rm '" + dir + "/labels/view_003.png'");
+    expectError(dir, "labels/view_003.png", "label map for labelled view");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+  {
+    const std::string dir = copy();
+    test::writeFile(dir + "/split.json", "{\"train\": [\"view_000.png\"], \"test\": [\"nope.png\"]}");
+    expectError(dir, "split.json", "nope.png");
+    test::writeFile(dir + "/split.json",
+                    "{\"train\": [\"view_000.png\"], \"test\": [], \"labelled\": [\"view_001.png\"]}");
+    expectError(dir, "split.json", "also in \"train\"");
+    test::runCommand("rm -rf '" + dir + "'");
+  }
+}
+
+}  // namespace
+}  // namespace sadsplat
