@@ -1,0 +1,404 @@
+#pragma once
+/// \file raster_math.h
+/// \brief The math of Gaussian splatting, written once for the CPU and the CUDA rasterizer:
+/// quaternion to rotation, EWA projection of the 3D covariance with the low-pass dilation,
+/// conic and screen radius, per-pixel alpha, and the backward pass of each.
+///
+/// Conventions: world-to-camera (R, t) as in COLMAP; camera x right, y down, z forward; pixel
+/// (i, j) has its centre at (i + 0.5, j + 0.5); the conic (a, b, c) is the inverse 2D covariance
+/// [[a, b], [b, c]] and a Gaussian's power at offset d = mean2d - pixel is
+/// -0.5 (a dx^2 + c dy^2) - b dx dy.
+/// Functions are templated on the scalar so the CPU reference can run in double for gradient
+/// checks; the CUDA backend uses float.
+
+#include <cmath>
+
+#if defined(__CUDACC__)
+#define SADSPLAT_HD __host__ __device__ __forceinline__
+#else
+#define SADSPLAT_HD inline
+#endif
+
+namespace sadsplat {
+namespace gaussians {
+namespace raster {
+
+/// Tile edge in pixels (16 x 16 tiles, as in the reference rasterizer).
+constexpr int kTileSize = 16;
+/// Added to the 2D covariance's diagonal: the low-pass filter of EWA splatting (in pixels^2).
+constexpr double kDilation = 0.3;
+/// Contributions below this alpha are skipped.
+constexpr double kMinAlpha = 1.0 / 255.0;
+/// Per-Gaussian alpha is clamped to this (keeps 1 - alpha invertible in the backward pass).
+constexpr double kMaxAlpha = 0.99;
+/// A pixel stops once its transmittance would fall below this.
+constexpr double kMinTransmittance = 1e-4;
+/// The frustum clamp of the projection Jacobian: 1.3 x the half field of view.
+constexpr double kFrustumClamp = 1.3;
+
+template <typename T>
+SADSPLAT_HD T mexp(T x) {
+#if defined(__CUDA_ARCH__)
+  return exp(x);
+#else
+  return std::exp(x);
+#endif
+}
+
+template <typename T>
+SADSPLAT_HD T msqrt(T x) {
+#if defined(__CUDA_ARCH__)
+  return sqrt(x);
+#else
+  return std::sqrt(x);
+#endif
+}
+
+template <typename T>
+SADSPLAT_HD T mceil(T x) {
+#if defined(__CUDA_ARCH__)
+  return ceil(x);
+#else
+  return std::ceil(x);
+#endif
+}
+
+template <typename T>
+SADSPLAT_HD T floorOf(T x) {
+#if defined(__CUDA_ARCH__)
+  return floor(x);
+#else
+  return std::floor(x);
+#endif
+}
+
+template <typename T>
+SADSPLAT_HD bool mfinite(T x) {
+#if defined(__CUDA_ARCH__)
+  return isfinite(x);
+#else
+  return std::isfinite(x);
+#endif
+}
+
+template <typename T>
+SADSPLAT_HD T mmin(T a, T b) {
+  return a < b ? a : b;
+}
+template <typename T>
+SADSPLAT_HD T mmax(T a, T b) {
+  return a > b ? a : b;
+}
+
+/// A pinhole camera with its world-to-camera pose, in the scalar type of the computation.
+template <typename T>
+struct Camera {
+  T R[9];  ///< row-major world-to-camera rotation
+  T t[3];  ///< world-to-camera translation
+  T fx, fy, cx, cy;
+  int width, height;
+  T near_plane;
+};
+
+/// Rotation matrix (row-major) of the normalised quaternion q = (w, x, y, z).
+template <typename T>
+SADSPLAT_HD void quatToRotation(const T q[4], T R[9]) {
+  const T n = msqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const T w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  R[0] = T(1) - T(2) * (y * y + z * z);
+  R[1] = T(2) * (x * y - w * z);
+  R[2] = T(2) * (x * z + w * y);
+  R[3] = T(2) * (x * y + w * z);
+  R[4] = T(1) - T(2) * (x * x + z * z);
+  R[5] = T(2) * (y * z - w * x);
+  R[6] = T(2) * (x * z - w * y);
+  R[7] = T(2) * (y * z + w * x);
+  R[8] = T(1) - T(2) * (x * x + y * y);
+}
+
+/// Gradient of a loss with respect to the raw quaternion, given its gradient G with respect to
+/// quatToRotation(q) (row-major).
+template <typename T>
+SADSPLAT_HD void quatToRotationBackward(const T q[4], const T G[9], T dq[4]) {
+  const T n = msqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const T w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  T g[4];
+  g[0] = T(2) * (-z * G[1] + y * G[2] + z * G[3] - x * G[5] - y * G[6] + x * G[7]);
+  g[1] = T(2) * (y * G[1] + z * G[2] + y * G[3] - T(2) * x * G[4] - w * G[5] + z * G[6] +
+                 w * G[7] - T(2) * x * G[8]);
+  g[2] = T(2) * (-T(2) * y * G[0] + x * G[1] + w * G[2] + x * G[3] + z * G[5] - w * G[6] +
+                 z * G[7] - T(2) * y * G[8]);
+  g[3] = T(2) * (-T(2) * z * G[0] - w * G[1] + x * G[2] + w * G[3] - T(2) * z * G[4] +
+                 y * G[5] + x * G[6] + y * G[7]);
+  // Through the normalisation qn = q / |q|.
+  const T dot = w * g[0] + x * g[1] + y * g[2] + z * g[3];
+  dq[0] = (g[0] - w * dot) / n;
+  dq[1] = (g[1] - x * dot) / n;
+  dq[2] = (g[2] - y * dot) / n;
+  dq[3] = (g[3] - z * dot) / n;
+}
+
+/// Everything the forward projection computes for one Gaussian.
+template <typename T>
+struct Projected {
+  T mean2d[2];  ///< pixel coordinates of the centre
+  T conic[3];   ///< inverse 2D covariance (a, b, c)
+  T depth;      ///< camera-space z
+  int radius;   ///< 3-sigma screen radius in pixels; 0 = culled
+};
+
+/// Projects one Gaussian (EWA splatting with the low-pass dilation). Returns false (radius 0)
+/// when it is behind the near plane, degenerate (non-finite or non-positive 2D covariance) or
+/// entirely off-screen.
+template <typename T>
+SADSPLAT_HD bool projectGaussian(const T mean[3], const T quat[4], const T log_scale[3],
+                                 const Camera<T>& cam, Projected<T>* out) {
+  out->radius = 0;
+  const T* R = cam.R;
+  T p[3];
+  for (int i = 0; i < 3; ++i) {
+    p[i] = R[3 * i] * mean[0] + R[3 * i + 1] * mean[1] + R[3 * i + 2] * mean[2] + cam.t[i];
+  }
+  if (!(p[2] > cam.near_plane)) return false;
+
+  // 3D covariance: (Rq S)(Rq S)^T.
+  T Rq[9];
+  quatToRotation(quat, Rq);
+  T M[9];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) M[3 * i + j] = Rq[3 * i + j] * mexp(log_scale[j]);
+  }
+  T S[9];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
+    }
+  }
+  // Jacobian of the perspective projection at the (frustum-clamped) centre.
+  const T z = p[2];
+  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
+  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
+  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
+  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
+  const T tx = mmin(lim_x_pos, mmax(-lim_x_neg, p[0] / z)) * z;
+  const T ty = mmin(lim_y_pos, mmax(-lim_y_neg, p[1] / z)) * z;
+  const T J00 = cam.fx / z, J02 = -cam.fx * tx / (z * z);
+  const T J11 = cam.fy / z, J12 = -cam.fy * ty / (z * z);
+  // Tm = J R (2 x 3).
+  T Tm[6];
+  for (int j = 0; j < 3; ++j) {
+    Tm[j] = J00 * R[j] + J02 * R[6 + j];
+    Tm[3 + j] = J11 * R[3 + j] + J12 * R[6 + j];
+  }
+  // cov2 = Tm S Tm^T + dilation.
+  T TS[6];
+  for (int r = 0; r < 2; ++r) {
+    for (int j = 0; j < 3; ++j) {
+      TS[3 * r + j] = Tm[3 * r] * S[j] + Tm[3 * r + 1] * S[3 + j] + Tm[3 * r + 2] * S[6 + j];
+    }
+  }
+  const T a = TS[0] * Tm[0] + TS[1] * Tm[1] + TS[2] * Tm[2] + T(kDilation);
+  const T b = TS[0] * Tm[3] + TS[1] * Tm[4] + TS[2] * Tm[5];
+  const T c = TS[3] * Tm[3] + TS[4] * Tm[4] + TS[5] * Tm[5] + T(kDilation);
+  const T det = a * c - b * b;
+  if (!(det > T(0)) || !mfinite(det) || !mfinite(a) || !mfinite(c)) return false;
+  out->conic[0] = c / det;
+  out->conic[1] = -b / det;
+  out->conic[2] = a / det;
+  const T mid = T(0.5) * (a + c);
+  const T lambda = mid + msqrt(mmax(T(0.1), mid * mid - det));
+  const T radius = mceil(T(3) * msqrt(lambda));
+  out->mean2d[0] = cam.fx * p[0] / z + cam.cx;
+  out->mean2d[1] = cam.fy * p[1] / z + cam.cy;
+  out->depth = z;
+  if (!mfinite(out->mean2d[0]) || !mfinite(out->mean2d[1]) || !mfinite(radius)) return false;
+  // Off-screen: the 3-sigma box misses the image.
+  if (out->mean2d[0] + radius <= T(0) || out->mean2d[0] - radius >= T(cam.width) ||
+      out->mean2d[1] + radius <= T(0) || out->mean2d[1] - radius >= T(cam.height)) {
+    return false;
+  }
+  out->radius = static_cast<int>(radius);
+  return true;
+}
+
+/// Backward of projectGaussian for a Gaussian it kept: from the gradients of mean2d, conic and
+/// depth to those of the mean, the quaternion and the log-scales (added to the outputs).
+template <typename T>
+SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const T log_scale[3],
+                                         const Camera<T>& cam, const T g_mean2d[2],
+                                         const T g_conic[3], T g_depth, T g_mean[3],
+                                         T g_quat[4], T g_log_scale[3]) {
+  const T* R = cam.R;
+  T p[3];
+  for (int i = 0; i < 3; ++i) {
+    p[i] = R[3 * i] * mean[0] + R[3 * i + 1] * mean[1] + R[3 * i + 2] * mean[2] + cam.t[i];
+  }
+  T Rq[9], s[3], M[9], S[9];
+  quatToRotation(quat, Rq);
+  for (int j = 0; j < 3; ++j) s[j] = mexp(log_scale[j]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) M[3 * i + j] = Rq[3 * i + j] * s[j];
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
+    }
+  }
+  const T z = p[2];
+  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
+  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
+  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
+  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
+  const T rx = p[0] / z, ry = p[1] / z;
+  const bool clamp_x = rx > lim_x_pos || rx < -lim_x_neg;
+  const bool clamp_y = ry > lim_y_pos || ry < -lim_y_neg;
+  const T cx_ratio = mmin(lim_x_pos, mmax(-lim_x_neg, rx));
+  const T cy_ratio = mmin(lim_y_pos, mmax(-lim_y_neg, ry));
+  const T tx = cx_ratio * z, ty = cy_ratio * z;
+  const T J00 = cam.fx / z, J02 = -cam.fx * tx / (z * z);
+  const T J11 = cam.fy / z, J12 = -cam.fy * ty / (z * z);
+  T Tm[6];
+  for (int j = 0; j < 3; ++j) {
+    Tm[j] = J00 * R[j] + J02 * R[6 + j];
+    Tm[3 + j] = J11 * R[3 + j] + J12 * R[6 + j];
+  }
+  T TS[6];
+  for (int r = 0; r < 2; ++r) {
+    for (int j = 0; j < 3; ++j) {
+      TS[3 * r + j] = Tm[3 * r] * S[j] + Tm[3 * r + 1] * S[3 + j] + Tm[3 * r + 2] * S[6 + j];
+    }
+  }
+  const T a = TS[0] * Tm[0] + TS[1] * Tm[1] + TS[2] * Tm[2] + T(kDilation);
+  const T b = TS[0] * Tm[3] + TS[1] * Tm[4] + TS[2] * Tm[5];
+  const T c = TS[3] * Tm[3] + TS[4] * Tm[4] + TS[5] * Tm[5] + T(kDilation);
+  const T det = a * c - b * b;
+  const T Y[3] = {c / det, -b / det, a / det};  // conic (ya, yb, yc)
+
+  // Conic = X^-1: dL/dX = -Y Gm Y with Gm = [[ga, gb/2], [gb/2, gc]] (b is one variable).
+  const T ga = g_conic[0], gb = T(0.5) * g_conic[1], gc = g_conic[2];
+  // P = Gm Y
+  const T P00 = ga * Y[0] + gb * Y[1], P01 = ga * Y[1] + gb * Y[2];
+  const T P10 = gb * Y[0] + gc * Y[1], P11 = gb * Y[1] + gc * Y[2];
+  // G2 = -Y P (symmetric).
+  const T G00 = -(Y[0] * P00 + Y[1] * P10);
+  const T G01 = -(Y[0] * P01 + Y[1] * P11);
+  const T G11 = -(Y[1] * P01 + Y[2] * P11);
+  const T G2[4] = {G00, G01, G01, G11};
+
+  // dL/dS = Tm^T G2 Tm (3 x 3), dL/dTm = 2 G2 Tm S (2 x 3).
+  T G2T[6];  // G2 Tm
+  for (int j = 0; j < 3; ++j) {
+    G2T[j] = G2[0] * Tm[j] + G2[1] * Tm[3 + j];
+    G2T[3 + j] = G2[2] * Tm[j] + G2[3] * Tm[3 + j];
+  }
+  T gS[9];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) gS[3 * i + j] = Tm[i] * G2T[j] + Tm[3 + i] * G2T[3 + j];
+  }
+  T gTm[6];
+  for (int r = 0; r < 2; ++r) {
+    for (int j = 0; j < 3; ++j) {
+      gTm[3 * r + j] = T(2) * (G2T[3 * r] * S[j] + G2T[3 * r + 1] * S[3 + j] +
+                               G2T[3 * r + 2] * S[6 + j]);
+    }
+  }
+  // Tm = J R: dL/dJ = gTm R^T; only J00, J02, J11, J12 are variables.
+  const T gJ00 = gTm[0] * R[0] + gTm[1] * R[1] + gTm[2] * R[2];
+  const T gJ02 = gTm[0] * R[6] + gTm[1] * R[7] + gTm[2] * R[8];
+  const T gJ11 = gTm[3] * R[3] + gTm[4] * R[4] + gTm[5] * R[5];
+  const T gJ12 = gTm[3] * R[6] + gTm[4] * R[7] + gTm[5] * R[8];
+  // J as a function of (tx, ty, z); tx = clamp(x / z) z.
+  T gp[3] = {T(0), T(0), T(0)};
+  const T z2 = z * z, z3 = z2 * z;
+  gp[2] += -cam.fx / z2 * gJ00 + T(2) * cam.fx * tx / z3 * gJ02 - cam.fy / z2 * gJ11 +
+           T(2) * cam.fy * ty / z3 * gJ12;
+  const T g_tx = -cam.fx / z2 * gJ02;
+  const T g_ty = -cam.fy / z2 * gJ12;
+  if (clamp_x) {
+    gp[2] += g_tx * cx_ratio;  // tx = lim z
+  } else {
+    gp[0] += g_tx;
+  }
+  if (clamp_y) {
+    gp[2] += g_ty * cy_ratio;
+  } else {
+    gp[1] += g_ty;
+  }
+  // mean2d = f p / z + c; depth = z.
+  gp[0] += g_mean2d[0] * cam.fx / z;
+  gp[1] += g_mean2d[1] * cam.fy / z;
+  gp[2] += -g_mean2d[0] * cam.fx * p[0] / z2 - g_mean2d[1] * cam.fy * p[1] / z2 + g_depth;
+  for (int j = 0; j < 3; ++j) g_mean[j] += R[j] * gp[0] + R[3 + j] * gp[1] + R[6 + j] * gp[2];
+
+  // S = M M^T: dL/dM = 2 gS M (gS symmetric).
+  T gM[9];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      gM[3 * i + j] = T(2) * (gS[3 * i] * M[j] + gS[3 * i + 1] * M[3 + j] + gS[3 * i + 2] * M[6 + j]);
+    }
+  }
+  T gR[9];
+  for (int j = 0; j < 3; ++j) {
+    T gs = T(0);
+    for (int i = 0; i < 3; ++i) {
+      gs += gM[3 * i + j] * Rq[3 * i + j];
+      gR[3 * i + j] = gM[3 * i + j] * s[j];
+    }
+    g_log_scale[j] += gs * s[j];
+  }
+  T dq[4];
+  quatToRotationBackward(quat, gR, dq);
+  for (int k = 0; k < 4; ++k) g_quat[k] += dq[k];
+}
+
+/// Power of a Gaussian at offset (dx, dy) = mean2d - pixel centre.
+template <typename T>
+SADSPLAT_HD T gaussianPower(const T conic[3], T dx, T dy) {
+  return T(-0.5) * (conic[0] * dx * dx + conic[2] * dy * dy) - conic[1] * dx * dy;
+}
+
+/// Tiles touched by a Gaussian's 3-sigma box: [x0, x1) x [y0, y1), clamped to the grid.
+template <typename T>
+SADSPLAT_HD void tileRect(const T mean2d[2], int radius, int tiles_x, int tiles_y, int* x0, int* y0,
+                          int* x1, int* y1) {
+  const T size = T(kTileSize);
+  *x0 = mmax(0, static_cast<int>(floorOf((mean2d[0] - radius) / size)));
+  *y0 = mmax(0, static_cast<int>(floorOf((mean2d[1] - radius) / size)));
+  *x1 = mmin(tiles_x, static_cast<int>(floorOf((mean2d[0] + radius) / size)) + 1);
+  *y1 = mmin(tiles_y, static_cast<int>(floorOf((mean2d[1] + radius) / size)) + 1);
+}
+
+/// Alpha of a Gaussian at a pixel centre (px, py), or 0 when it is skipped (power > 0 or alpha
+/// below kMinAlpha). *G receives exp(power); *clamped whether alpha hit kMaxAlpha.
+template <typename T>
+SADSPLAT_HD T pixelAlpha(const T mean2d[2], const T conic[3], T opacity, T px, T py, T* G,
+                         bool* clamped) {
+  const T power = gaussianPower(conic, mean2d[0] - px, mean2d[1] - py);
+  if (power > T(0)) return T(0);
+  *G = mexp(power);
+  const T raw = opacity * *G;
+  *clamped = raw > T(kMaxAlpha);
+  const T alpha = *clamped ? T(kMaxAlpha) : raw;
+  return alpha < T(kMinAlpha) ? T(0) : alpha;
+}
+
+/// Backward of pixelAlpha for a contributing Gaussian: adds the gradients of mean2d, conic and
+/// opacity for a gradient g_alpha of its alpha.
+template <typename T>
+SADSPLAT_HD void pixelAlphaBackward(const T mean2d[2], const T conic[3], T opacity, T px, T py,
+                                   T G, bool clamped, T g_alpha, T g_mean2d[2], T g_conic[3],
+                                   T* g_opacity) {
+  if (clamped) return;  // alpha = kMaxAlpha does not depend on the Gaussian
+  *g_opacity += G * g_alpha;
+  const T g_power = opacity * G * g_alpha;
+  const T dx = mean2d[0] - px, dy = mean2d[1] - py;
+  g_mean2d[0] += -g_power * (conic[0] * dx + conic[1] * dy);
+  g_mean2d[1] += -g_power * (conic[2] * dy + conic[1] * dx);
+  g_conic[0] += T(-0.5) * dx * dx * g_power;
+  g_conic[1] += -dx * dy * g_power;
+  g_conic[2] += T(-0.5) * dy * dy * g_power;
+}
+
+}  // namespace raster
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,92 @@
+#pragma once
+// Internal interface between the autograd functions (rasterizer.cpp) and the two backends
+// (raster_cpu.cpp, raster_cuda.cu). Both backends implement the same five steps with the math
+// of raster_math.h; tensors are contiguous, on the backend's device.
+
+#include <ATen/ATen.h>
+
+#include <array>
+#include <tuple>
+
+namespace sadsplat {
+namespace gaussians {
+namespace raster {
+
+/// A camera as the backends take it (double so that it can be stored in autograd contexts).
+struct CameraParams {
+  std::array<double, 9> R{};  ///< row-major world-to-camera rotation
+  std::array<double, 3> t{};
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  int width = 0, height = 0;
+  double near_plane = 0.01;
+};
+
+struct ProjectionResult {
+  at::Tensor means2d;  ///< [N, 2]
+  at::Tensor conics;   ///< [N, 3]
+  at::Tensor depths;   ///< [N]
+  at::Tensor radii;    ///< [N] int32, 0 = culled
+};
+
+/// Per-tile lists of Gaussians sorted front to back: tile t uses
+/// gaussian_ids[tile_ranges[t, 0] : tile_ranges[t, 1]].
+struct Binning {
+  at::Tensor tile_ranges;   ///< [tiles_y * tiles_x, 2] int32
+  at::Tensor gaussian_ids;  ///< [M] int32
+};
+
+struct RasterResult {
+  at::Tensor image;  ///< [H, W, D] composited channels (no background)
+  at::Tensor alpha;  ///< [H, W] accumulated opacity, 1 - final transmittance
+  at::Tensor last;   ///< [H, W] int32: 1 + list position of the last contributor, 0 if none
+  Binning binning;
+};
+
+struct ProjectionGrads {
+  at::Tensor means, quats, log_scales;
+};
+
+struct RasterGrads {
+  at::Tensor means2d, conics, opacities, values;
+};
+
+ProjectionResult projectForwardCpu(const at::Tensor& means, const at::Tensor& quats,
+                                   const at::Tensor& log_scales, const CameraParams& cam);
+ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& quats,
+                                   const at::Tensor& log_scales, const at::Tensor& radii,
+                                   const CameraParams& cam, const at::Tensor& g_means2d,
+                                   const at::Tensor& g_conics, const at::Tensor& g_depths);
+RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
+                                 const at::Tensor& opacities, const at::Tensor& values,
+                                 const at::Tensor& radii, const at::Tensor& depths, int width,
+                                 int height);
+RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
+                                 const at::Tensor& opacities, const at::Tensor& values,
+                                 const RasterResult& forward, const at::Tensor& g_image,
+                                 const at::Tensor& g_alpha);
+
+#if SADSPLAT_HAVE_CUDA
+ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
+                                    const at::Tensor& log_scales, const CameraParams& cam);
+ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& quats,
+                                    const at::Tensor& log_scales, const at::Tensor& radii,
+                                    const CameraParams& cam, const at::Tensor& g_means2d,
+                                    const at::Tensor& g_conics, const at::Tensor& g_depths);
+RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
+                                  const at::Tensor& opacities, const at::Tensor& values,
+                                  const at::Tensor& radii, const at::Tensor& depths, int width,
+                                  int height);
+RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
+                                  const at::Tensor& opacities, const at::Tensor& values,
+                                  const RasterResult& forward, const at::Tensor& g_image,
+                                  const at::Tensor& g_alpha);
+#endif
+
+/// Number of tiles along x and y for an image.
+inline std::pair<int, int> tileGrid(int width, int height) {
+  return {(width + 15) / 16, (height + 15) / 16};
+}
+
+}  // namespace raster
+}  // namespace gaussians
+}  // namespace sadsplat

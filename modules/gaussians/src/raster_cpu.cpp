@@ -1,0 +1,289 @@
+// The CPU backend of the rasterizer: the reference for correctness. Multi-threaded over
+// Gaussians (projection) and tiles (rasterization) with at::parallel_for; templated on the
+// scalar type so gradient checks can run in double.
+#include <ATen/Parallel.h>
+
+#include <algorithm>
+#include <numeric>
+#include <vector>
+
+#include "raster_backend.h"
+#include "sadsplat/gaussians/raster_math.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace raster {
+namespace {
+
+template <typename T>
+Camera<T> toCamera(const CameraParams& p) {
+  Camera<T> c;
+  for (int i = 0; i < 9; ++i) c.R[i] = static_cast<T>(p.R[i]);
+  for (int i = 0; i < 3; ++i) c.t[i] = static_cast<T>(p.t[i]);
+  c.fx = static_cast<T>(p.fx);
+  c.fy = static_cast<T>(p.fy);
+  c.cx = static_cast<T>(p.cx);
+  c.cy = static_cast<T>(p.cy);
+  c.width = p.width;
+  c.height = p.height;
+  c.near_plane = static_cast<T>(p.near_plane);
+  return c;
+}
+
+// Grain sizes for at::parallel_for.
+constexpr int64_t kGaussianGrain = 2048;
+
+}  // namespace
+
+ProjectionResult projectForwardCpu(const at::Tensor& means, const at::Tensor& quats,
+                                   const at::Tensor& log_scales, const CameraParams& cam) {
+  const int64_t n = means.size(0);
+  ProjectionResult out;
+  out.means2d = at::zeros({n, 2}, means.options());
+  out.conics = at::zeros({n, 3}, means.options());
+  out.depths = at::zeros({n}, means.options());
+  out.radii = at::zeros({n}, means.options().dtype(at::kInt));
+  AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "projectForwardCpu", [&] {
+    const Camera<scalar_t> c = toCamera<scalar_t>(cam);
+    const scalar_t* m = means.data_ptr<scalar_t>();
+    const scalar_t* q = quats.data_ptr<scalar_t>();
+    const scalar_t* s = log_scales.data_ptr<scalar_t>();
+    scalar_t* m2 = out.means2d.data_ptr<scalar_t>();
+    scalar_t* co = out.conics.data_ptr<scalar_t>();
+    scalar_t* d = out.depths.data_ptr<scalar_t>();
+    int* r = out.radii.data_ptr<int>();
+    at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        Projected<scalar_t> p;
+        if (!projectGaussian(m + 3 * i, q + 4 * i, s + 3 * i, c, &p)) continue;
+        m2[2 * i] = p.mean2d[0];
+        m2[2 * i + 1] = p.mean2d[1];
+        for (int k = 0; k < 3; ++k) co[3 * i + k] = p.conic[k];
+        d[i] = p.depth;
+        r[i] = p.radius;
+      }
+    });
+  });
+  return out;
+}
+
+ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& quats,
+                                   const at::Tensor& log_scales, const at::Tensor& radii,
+                                   const CameraParams& cam, const at::Tensor& g_means2d,
+                                   const at::Tensor& g_conics, const at::Tensor& g_depths) {
+  const int64_t n = means.size(0);
+  ProjectionGrads g;
+  g.means = at::zeros_like(means);
+  g.quats = at::zeros_like(quats);
+  g.log_scales = at::zeros_like(log_scales);
+  AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "projectBackwardCpu", [&] {
+    const Camera<scalar_t> c = toCamera<scalar_t>(cam);
+    const scalar_t* m = means.data_ptr<scalar_t>();
+    const scalar_t* q = quats.data_ptr<scalar_t>();
+    const scalar_t* s = log_scales.data_ptr<scalar_t>();
+    const int* r = radii.data_ptr<int>();
+    const scalar_t* gm2 = g_means2d.data_ptr<scalar_t>();
+    const scalar_t* gco = g_conics.data_ptr<scalar_t>();
+    const scalar_t* gd = g_depths.data_ptr<scalar_t>();
+    scalar_t* gm = g.means.data_ptr<scalar_t>();
+    scalar_t* gq = g.quats.data_ptr<scalar_t>();
+    scalar_t* gs = g.log_scales.data_ptr<scalar_t>();
+    at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        if (r[i] <= 0) continue;
+        projectGaussianBackward(m + 3 * i, q + 4 * i, s + 3 * i, c, gm2 + 2 * i, gco + 3 * i,
+                                gd[i], gm + 3 * i, gq + 4 * i, gs + 3 * i);
+      }
+    });
+  });
+  return g;
+}
+
+namespace {
+
+// Per-tile lists sorted by (depth, id): the same order the CUDA backend's stable sort gives.
+template <typename T>
+Binning binGaussians(const T* means2d, const int* radii, const T* depths, int64_t n, int width,
+                     int height) {
+  const auto [tiles_x, tiles_y] = tileGrid(width, height);
+  const int num_tiles = tiles_x * tiles_y;
+  std::vector<std::vector<int>> lists(num_tiles);
+  for (int64_t i = 0; i < n; ++i) {
+    if (radii[i] <= 0) continue;
+    int x0, y0, x1, y1;
+    tileRect(means2d + 2 * i, radii[i], tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    for (int ty = y0; ty < y1; ++ty) {
+      for (int tx = x0; tx < x1; ++tx) lists[ty * tiles_x + tx].push_back(static_cast<int>(i));
+    }
+  }
+  Binning b;
+  b.tile_ranges = at::zeros({num_tiles, 2}, at::TensorOptions().dtype(at::kInt));
+  int* ranges = b.tile_ranges.data_ptr<int>();
+  int64_t total = 0;
+  for (int t = 0; t < num_tiles; ++t) total += static_cast<int64_t>(lists[t].size());
+  b.gaussian_ids = at::empty({total}, at::TensorOptions().dtype(at::kInt));
+  int* ids = b.gaussian_ids.data_ptr<int>();
+  at::parallel_for(0, num_tiles, 16, [&](int64_t begin, int64_t end) {
+    for (int64_t t = begin; t < end; ++t) {
+      auto& list = lists[t];
+      // Sorting by float depth, ties by id, matches the CUDA key (depth bits of a float).
+      std::stable_sort(list.begin(), list.end(), [&](int a, int c) {
+        return static_cast<float>(depths[a]) < static_cast<float>(depths[c]);
+      });
+    }
+  });
+  int offset = 0;
+  for (int t = 0; t < num_tiles; ++t) {
+    ranges[2 * t] = offset;
+    std::copy(lists[t].begin(), lists[t].end(), ids + offset);
+    offset += static_cast<int>(lists[t].size());
+    ranges[2 * t + 1] = offset;
+  }
+  return b;
+}
+
+}  // namespace
+
+RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
+                                 const at::Tensor& opacities, const at::Tensor& values,
+                                 const at::Tensor& radii, const at::Tensor& depths, int width,
+                                 int height) {
+  const int64_t n = means2d.size(0);
+  const int64_t D = values.size(1);
+  RasterResult out;
+  out.image = at::zeros({height, width, D}, values.options());
+  out.alpha = at::zeros({height, width}, values.options());
+  out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
+  AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeForwardCpu", [&] {
+    using T = scalar_t;
+    const T* m2 = means2d.data_ptr<T>();
+    const T* co = conics.data_ptr<T>();
+    const T* op = opacities.data_ptr<T>();
+    const T* val = values.data_ptr<T>();
+    out.binning = binGaussians(m2, radii.data_ptr<int>(), depths.data_ptr<T>(), n, width, height);
+    const int* ranges = out.binning.tile_ranges.data_ptr<int>();
+    const int* ids = out.binning.gaussian_ids.data_ptr<int>();
+    T* img = out.image.data_ptr<T>();
+    T* alpha_out = out.alpha.data_ptr<T>();
+    int* last_out = out.last.data_ptr<int>();
+    const int tiles_x = tileGrid(width, height).first;
+    const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
+    at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
+      std::vector<T> accum(static_cast<std::size_t>(D));
+      for (int64_t tile = begin; tile < end; ++tile) {
+        const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
+        const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
+        for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
+          for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
+            const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+            std::fill(accum.begin(), accum.end(), T(0));
+            T trans = T(1);
+            int last = 0;
+            for (int k = start; k < stop; ++k) {
+              const int g = ids[k];
+              T G;
+              bool clamped;
+              const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
+              if (alpha == T(0)) continue;
+              const T next = trans * (T(1) - alpha);
+              if (next < T(kMinTransmittance)) break;
+              const T w = alpha * trans;
+              for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * val[g * D + ch];
+              trans = next;
+              last = k - start + 1;
+            }
+            const int64_t pix = static_cast<int64_t>(py) * width + px;
+            for (int64_t ch = 0; ch < D; ++ch) img[pix * D + ch] = accum[ch];
+            alpha_out[pix] = T(1) - trans;
+            last_out[pix] = last;
+          }
+        }
+      }
+    });
+  });
+  return out;
+}
+
+RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
+                                 const at::Tensor& opacities, const at::Tensor& values,
+                                 const RasterResult& fwd, const at::Tensor& g_image,
+                                 const at::Tensor& g_alpha) {
+  const int64_t n = means2d.size(0);
+  const int64_t D = values.size(1);
+  const int height = static_cast<int>(fwd.alpha.size(0));
+  const int width = static_cast<int>(fwd.alpha.size(1));
+  // One gradient buffer per thread (tiles share Gaussians), summed at the end. Row layout:
+  // mean2d (2), conic (3), opacity (1), values (D).
+  const int64_t row = 6 + D;
+  const int threads = at::get_num_threads();
+  at::Tensor buffers = at::zeros({threads, n, row}, values.options());
+  AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeBackwardCpu", [&] {
+    using T = scalar_t;
+    const T* m2 = means2d.data_ptr<T>();
+    const T* co = conics.data_ptr<T>();
+    const T* op = opacities.data_ptr<T>();
+    const T* val = values.data_ptr<T>();
+    const T* gimg = g_image.data_ptr<T>();
+    const T* galpha = g_alpha.data_ptr<T>();
+    const T* alpha_fwd = fwd.alpha.data_ptr<T>();
+    const int* last_fwd = fwd.last.data_ptr<int>();
+    const int* ranges = fwd.binning.tile_ranges.data_ptr<int>();
+    const int* ids = fwd.binning.gaussian_ids.data_ptr<int>();
+    T* buf_base = buffers.data_ptr<T>();
+    const int tiles_x = tileGrid(width, height).first;
+    const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
+    at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
+      T* buf = buf_base + static_cast<int64_t>(at::get_thread_num()) * n * row;
+      std::vector<T> accum(static_cast<std::size_t>(D)), last_value(static_cast<std::size_t>(D));
+      for (int64_t tile = begin; tile < end; ++tile) {
+        const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
+        const int start = ranges[2 * tile];
+        for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
+          for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
+            const int64_t pix = static_cast<int64_t>(py) * width + px;
+            const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+            const T final_trans = T(1) - alpha_fwd[pix];
+            const T* gpix = gimg + pix * D;
+            T trans = final_trans;
+            std::fill(accum.begin(), accum.end(), T(0));
+            std::fill(last_value.begin(), last_value.end(), T(0));
+            T last_alpha = T(0);
+            for (int k = start + last_fwd[pix] - 1; k >= start; --k) {
+              const int g = ids[k];
+              T G;
+              bool clamped;
+              const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
+              if (alpha == T(0)) continue;
+              trans = trans / (T(1) - alpha);
+              const T w = alpha * trans;
+              T* gb = buf + static_cast<int64_t>(g) * row;
+              T g_a = T(0);
+              for (int64_t ch = 0; ch < D; ++ch) {
+                accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
+                last_value[ch] = val[g * D + ch];
+                g_a += (val[g * D + ch] - accum[ch]) * gpix[ch];
+                gb[6 + ch] += w * gpix[ch];
+              }
+              g_a *= trans;
+              g_a += galpha[pix] * final_trans / (T(1) - alpha);
+              last_alpha = alpha;
+              pixelAlphaBackward(m2 + 2 * g, co + 3 * g, op[g], fx, fy, G, clamped, g_a, gb,
+                                 gb + 2, gb + 5);
+            }
+          }
+        }
+      }
+    });
+  });
+  const at::Tensor total = buffers.sum(0);
+  RasterGrads g;
+  g.means2d = total.slice(1, 0, 2).contiguous();
+  g.conics = total.slice(1, 2, 5).contiguous();
+  g.opacities = total.select(1, 5).contiguous();
+  g.values = total.slice(1, 6, row).contiguous();
+  return g;
+}
+
+}  // namespace raster
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,327 @@
+// The rasterizer's autograd functions and the render() pipeline. The heavy lifting is in the
+// backends (raster_cpu.cpp, raster_cuda.cu); this file validates, dispatches and wires autograd.
+#include "sadsplat/gaussians/rasterizer.h"
+
+#include <torch/csrc/autograd/custom_function.h>
+
+#include <string>
+#include <vector>
+
+#include "raster_backend.h"
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/raster_math.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace {
+
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+using raster::CameraParams;
+
+raster::CameraParams toParams(const RasterCamera& c) {
+  CameraParams p;
+  const double q[4] = {c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  for (int i = 0; i < 9; ++i) p.R[i] = R[i];
+  for (int i = 0; i < 3; ++i) p.t[i] = c.tvec[i];
+  p.fx = c.fx;
+  p.fy = c.fy;
+  p.cx = c.cx;
+  p.cy = c.cy;
+  p.width = c.width;
+  p.height = c.height;
+  p.near_plane = c.near_plane;
+  return p;
+}
+
+std::vector<double> packCamera(const CameraParams& p) {
+  std::vector<double> v(p.R.begin(), p.R.end());
+  v.insert(v.end(), p.t.begin(), p.t.end());
+  v.insert(v.end(), {p.fx, p.fy, p.cx, p.cy, double(p.width), double(p.height), p.near_plane});
+  return v;
+}
+
+CameraParams unpackCamera(const std::vector<double>& v) {
+  CameraParams p;
+  for (int i = 0; i < 9; ++i) p.R[i] = v[i];
+  for (int i = 0; i < 3; ++i) p.t[i] = v[9 + i];
+  p.fx = v[12];
+  p.fy = v[13];
+  p.cx = v[14];
+  p.cy = v[15];
+  p.width = static_cast<int>(v[16]);
+  p.height = static_cast<int>(v[17]);
+  p.near_plane = v[18];
+  return p;
+}
+
+[[noreturn]] void noCuda() {
+  throw Error("<render>", "device", "CPU tensors (this sadsplat build has no CUDA backend)",
+              "CUDA tensors");
+}
+
+at::Tensor orZeros(const at::Tensor& grad, const at::Tensor& like) {
+  return grad.defined() ? grad.contiguous() : at::zeros_like(like);
+}
+
+struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& means,
+                               const at::Tensor& quats, const at::Tensor& log_scales,
+                               const std::vector<double>& camera) {
+    const CameraParams cam = unpackCamera(camera);
+    const at::Tensor m = means.contiguous(), q = quats.contiguous(), s = log_scales.contiguous();
+    raster::ProjectionResult r;
+    if (m.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      r = raster::projectForwardCuda(m, q, s, cam);
+#else
+      noCuda();
+#endif
+    } else {
+      r = raster::projectForwardCpu(m, q, s, cam);
+    }
+    ctx->save_for_backward({m, q, s, r.radii});
+    ctx->saved_data["camera"] = camera;
+    ctx->mark_non_differentiable({r.radii});
+    return {r.means2d, r.conics, r.depths, r.radii};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const at::Tensor &m = saved[0], &q = saved[1], &s = saved[2], &radii = saved[3];
+    const CameraParams cam = unpackCamera(ctx->saved_data["camera"].toDoubleVector());
+    const at::Tensor g_m2 = orZeros(grads[0], at::empty({m.size(0), 2}, m.options()));
+    const at::Tensor g_co = orZeros(grads[1], at::empty({m.size(0), 3}, m.options()));
+    const at::Tensor g_d = orZeros(grads[2], at::empty({m.size(0)}, m.options()));
+    raster::ProjectionGrads g;
+    if (m.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      g = raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d);
+#else
+      noCuda();
+#endif
+    } else {
+      g = raster::projectBackwardCpu(m, q, s, radii, cam, g_m2, g_co, g_d);
+    }
+    return {g.means, g.quats, g.log_scales, at::Tensor()};
+  }
+};
+
+struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& means2d,
+                               const at::Tensor& conics, const at::Tensor& opacities,
+                               const at::Tensor& values, const at::Tensor& radii,
+                               const at::Tensor& depths, int64_t width, int64_t height) {
+    const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
+                     op = opacities.contiguous(), val = values.contiguous();
+    raster::RasterResult r;
+    if (m2.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      r = raster::rasterizeForwardCuda(m2, co, op, val, radii.contiguous(), depths.contiguous(),
+                                       static_cast<int>(width), static_cast<int>(height));
+#else
+      noCuda();
+#endif
+    } else {
+      r = raster::rasterizeForwardCpu(m2, co, op, val, radii.contiguous(), depths.contiguous(),
+                                      static_cast<int>(width), static_cast<int>(height));
+    }
+    ctx->save_for_backward({m2, co, op, val});
+    ctx->saved_data["alpha"] = r.alpha;
+    ctx->saved_data["last"] = r.last;
+    ctx->saved_data["tile_ranges"] = r.binning.tile_ranges;
+    ctx->saved_data["gaussian_ids"] = r.binning.gaussian_ids;
+    return {r.image, r.alpha};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    raster::RasterResult fwd;
+    fwd.alpha = ctx->saved_data["alpha"].toTensor();
+    fwd.last = ctx->saved_data["last"].toTensor();
+    fwd.binning.tile_ranges = ctx->saved_data["tile_ranges"].toTensor();
+    fwd.binning.gaussian_ids = ctx->saved_data["gaussian_ids"].toTensor();
+    const at::Tensor& val = saved[3];
+    const at::Tensor g_img = orZeros(
+        grads[0], at::empty({fwd.alpha.size(0), fwd.alpha.size(1), val.size(1)}, val.options()));
+    const at::Tensor g_alpha = orZeros(grads[1], fwd.alpha);
+    raster::RasterGrads g;
+    if (val.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      g = raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
+#else
+      noCuda();
+#endif
+    } else {
+      g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
+    }
+    return {g.means2d, g.conics, g.opacities, g.values,
+            at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
+  }
+};
+
+void expectTensor(const at::Tensor& t, const char* name, int64_t n, std::vector<int64_t> tail,
+                  const at::Tensor& reference) {
+  std::string want = "[" + std::to_string(n);
+  for (auto d : tail) want += ", " + (d < 0 ? std::string("*") : std::to_string(d));
+  want += "] " + std::string(c10::toString(reference.scalar_type())) + " on " +
+          reference.device().str();
+  if (!t.defined()) throw Error("<render>", name, want, "undefined");
+  bool ok = t.dim() == 1 + static_cast<int64_t>(tail.size()) && t.size(0) == n &&
+            t.scalar_type() == reference.scalar_type() && t.device() == reference.device();
+  for (std::size_t i = 0; ok && i < tail.size(); ++i) {
+    ok = tail[i] < 0 || t.size(static_cast<int64_t>(i) + 1) == tail[i];
+  }
+  if (!ok) {
+    std::string got = "[";
+    for (int64_t i = 0; i < t.dim(); ++i) got += (i ? ", " : "") + std::to_string(t.size(i));
+    got += "] " + std::string(c10::toString(t.scalar_type())) + " on " + t.device().str();
+    throw Error("<render>", name, want, got);
+  }
+}
+
+void validateCamera(const RasterCamera& c) {
+  if (c.width <= 0 || c.height <= 0 || !(c.fx > 0) || !(c.fy > 0) || !(c.near_plane > 0)) {
+    throw Error("<render>", "camera",
+                "positive width, height, focal lengths and near plane",
+                std::to_string(c.width) + "x" + std::to_string(c.height) +
+                    " fx=" + std::to_string(c.fx) + " fy=" + std::to_string(c.fy));
+  }
+}
+
+}  // namespace
+
+RasterCamera RasterCamera::fromPinhole(const io::PinholeCamera& camera) {
+  RasterCamera c;
+  c.width = camera.width;
+  c.height = camera.height;
+  c.fx = camera.fx;
+  c.fy = camera.fy;
+  c.cx = camera.cx;
+  c.cy = camera.cy;
+  c.qvec = camera.qvec;
+  c.tvec = camera.tvec;
+  return c;
+}
+
+std::array<double, 3> RasterCamera::centre() const {
+  const double q[4] = {qvec[0], qvec[1], qvec[2], qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  std::array<double, 3> c{};
+  for (int j = 0; j < 3; ++j) c[j] = -(R[j] * tvec[0] + R[3 + j] * tvec[1] + R[6 + j] * tvec[2]);
+  return c;
+}
+
+at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
+                      const std::array<double, 3>& camera_centre, int degree) {
+  if (degree < 0 || degree > 3) {
+    throw Error("<render>", "sh_degree", "0..3", std::to_string(degree));
+  }
+  const at::Tensor centre =
+      at::tensor({camera_centre[0], camera_centre[1], camera_centre[2]}, means.options());
+  const at::Tensor dirs = means - centre;
+  const at::Tensor d = dirs / dirs.norm(2, 1, true).clamp_min(1e-12);
+  const at::Tensor x = d.select(1, 0).unsqueeze(1), y = d.select(1, 1).unsqueeze(1),
+                   z = d.select(1, 2).unsqueeze(1);
+  auto coeff = [&](int k) { return sh.select(1, k); };  // [N, 3]
+  at::Tensor result = 0.28209479177387814 * coeff(0);
+  if (degree > 0) {
+    constexpr double c1 = 0.4886025119029199;
+    result = result - c1 * y * coeff(1) + c1 * z * coeff(2) - c1 * x * coeff(3);
+    if (degree > 1) {
+      const at::Tensor xx = x * x, yy = y * y, zz = z * z, xy = x * y, yz = y * z, xz = x * z;
+      result = result + 1.0925484305920792 * xy * coeff(4) - 1.0925484305920792 * yz * coeff(5) +
+               0.31539156525252005 * (2.0 * zz - xx - yy) * coeff(6) -
+               1.0925484305920792 * xz * coeff(7) + 0.5462742152960396 * (xx - yy) * coeff(8);
+      if (degree > 2) {
+        result = result - 0.5900435899266435 * y * (3.0 * xx - yy) * coeff(9) +
+                 2.890611442640554 * xy * z * coeff(10) -
+                 0.4570457994644658 * y * (4.0 * zz - xx - yy) * coeff(11) +
+                 0.3731763325901154 * z * (2.0 * zz - 3.0 * xx - 3.0 * yy) * coeff(12) -
+                 0.4570457994644658 * x * (4.0 * zz - xx - yy) * coeff(13) +
+                 1.445305721320277 * z * (xx - yy) * coeff(14) -
+                 0.5900435899266435 * x * (xx - 3.0 * yy) * coeff(15);
+      }
+    }
+  }
+  return (result + 0.5).clamp_min(0.0);
+}
+
+std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Tensor& quats,
+                                           const at::Tensor& log_scales,
+                                           const RasterCamera& camera) {
+  validateCamera(camera);
+  const int64_t n = means.defined() ? means.size(0) : 0;
+  expectTensor(means, "means", n, {3}, means);
+  expectTensor(quats, "quats", n, {4}, means);
+  expectTensor(log_scales, "log_scales", n, {3}, means);
+  const auto out = ProjectFunction::apply(means, quats, log_scales, packCamera(toParams(camera)));
+  return {out[0], out[1], out[2], out[3]};
+}
+
+std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at::Tensor& conics,
+                                            const at::Tensor& opacities, const at::Tensor& values,
+                                            const at::Tensor& radii, const at::Tensor& depths,
+                                            int width, int height) {
+  const int64_t n = means2d.size(0);
+  expectTensor(conics, "conics", n, {3}, means2d);
+  expectTensor(opacities, "opacities", n, {}, means2d);
+  expectTensor(values, "values", n, {-1}, means2d);
+  expectTensor(depths, "depths", n, {}, means2d);
+  const auto out = RasterizeFunction::apply(means2d, conics, opacities, values, radii,
+                                            depths.detach(), width, height);
+  return {out[0], out[1]};
+}
+
+RenderResult render(const GaussianParams& g, const RasterCamera& camera,
+                    const RenderSettings& settings) {
+  validateCamera(camera);
+  if (!g.means.defined()) throw Error("<render>", "means", "a defined [N, 3] tensor");
+  const int64_t n = g.means.size(0);
+  if (g.means.scalar_type() != at::kFloat && g.means.scalar_type() != at::kDouble) {
+    throw Error("<render>", "means", "float32 or float64", c10::toString(g.means.scalar_type()));
+  }
+  const int coefficients = (settings.sh_degree + 1) * (settings.sh_degree + 1);
+  if (settings.sh_degree < 0 || settings.sh_degree > 3) {
+    throw Error("<render>", "sh_degree", "0..3", std::to_string(settings.sh_degree));
+  }
+  expectTensor(g.opacity_logits, "opacity_logits", n, {}, g.means);
+  expectTensor(g.sh, "sh", n, {-1, 3}, g.means);
+  if (g.sh.size(1) < coefficients) {
+    throw Error("<render>", "sh", "at least " + std::to_string(coefficients) +
+                                      " coefficients for SH degree " +
+                                      std::to_string(settings.sh_degree),
+                std::to_string(g.sh.size(1)));
+  }
+  const at::Tensor features =
+      g.features.defined() ? g.features : at::zeros({n, 0}, g.means.options());
+  expectTensor(features, "features", n, {-1}, g.means);
+
+  auto [means2d, conics, depths, radii] =
+      projectGaussians(g.means, g.quats, g.log_scales, camera);
+  const at::Tensor colors = evaluateSh(g.sh, g.means, camera.centre(), settings.sh_degree);
+  const at::Tensor values = at::cat({colors, features, depths.unsqueeze(1)}, 1);
+  const at::Tensor opacities = at::sigmoid(g.opacity_logits);
+  auto [image, alpha] = rasterizeToPixels(means2d, conics, opacities, values, radii, depths,
+                                          camera.width, camera.height);
+  const int64_t C = features.size(1);
+  const at::Tensor background = at::tensor(
+      {double(settings.background[0]), double(settings.background[1]),
+       double(settings.background[2])},
+      g.means.options());
+  RenderResult result;
+  result.rgb = image.slice(2, 0, 3) + (1.0 - alpha).unsqueeze(2) * background;
+  result.features = image.slice(2, 3, 3 + C);
+  const at::Tensor depth_sum = image.select(2, 3 + C);
+  result.depth = at::where(alpha > 0, depth_sum / alpha.clamp_min(1e-10), at::zeros_like(alpha));
+  result.alpha = alpha;
+  result.means2d = means2d;
+  result.radii = radii;
+  return result;
+}
+
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,320 @@
+// The CPU rasterizer (the reference): closed forms, gradients against central finite
+// differences in double precision, culling without NaNs, tiling against a brute-force render.
+#include <gtest/gtest.h>
+
+#include <torch/csrc/autograd/autograd.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/rasterizer.h"
+
+namespace sadsplat {
+namespace {
+
+using gaussians::GaussianParams;
+using gaussians::RasterCamera;
+using gaussians::RenderSettings;
+
+// A camera at the origin looking down +z.
+RasterCamera frontCamera(int width, int height, double f) {
+  RasterCamera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = f;
+  c.cx = width / 2.0;
+  c.cy = height / 2.0;
+  return c;
+}
+
+// n Gaussians in front of `camera`, in double, with C feature channels, seeded.
+GaussianParams randomScene(int n, int C, std::uint64_t seed, double spread = 0.35) {
+  at::manual_seed(seed);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  GaussianParams g;
+  g.means = at::cat({(at::rand({n, 2}, opts) - 0.5) * 2 * spread, 2.5 + at::rand({n, 1}, opts)}, 1);
+  g.quats = at::randn({n, 4}, opts);
+  g.log_scales = at::log(0.05 + 0.1 * at::rand({n, 3}, opts));
+  g.opacity_logits = at::rand({n}, opts) * 2 - 1.5;
+  g.sh = at::randn({n, 16, 3}, opts) * 0.1;
+  g.features = at::randn({n, C}, opts);
+  return g;
+}
+
+// A scalar loss touching every output with fixed random weights.
+struct WeightedLoss {
+  at::Tensor w_rgb, w_feat, w_alpha, w_depth;
+  WeightedLoss(int h, int w, int C) {
+    at::manual_seed(99);
+    const auto opts = at::TensorOptions().dtype(at::kDouble);
+    w_rgb = at::randn({h, w, 3}, opts);
+    w_feat = at::randn({h, w, C}, opts);
+    w_alpha = at::randn({h, w}, opts);
+    w_depth = at::randn({h, w}, opts) * 0.1;
+  }
+  at::Tensor operator()(const gaussians::RenderResult& r) const {
+    return (r.rgb * w_rgb).sum() + (r.features * w_feat).sum() + (r.alpha * w_alpha).sum() +
+           (r.depth * w_depth).sum();
+  }
+};
+
+void expectGradientsMatchFiniteDifferences(GaussianParams g, const RasterCamera& cam,
+                                           const RenderSettings& settings, double tolerance) {
+  at::Tensor GaussianParams::*const members[] = {
+      &GaussianParams::means, &GaussianParams::quats,          &GaussianParams::log_scales,
+      &GaussianParams::sh,    &GaussianParams::opacity_logits, &GaussianParams::features};
+  const char* names[] = {"means", "quats", "log_scales", "sh", "opacity_logits", "features"};
+  const WeightedLoss loss(cam.height, cam.width, static_cast<int>(g.features.size(1)));
+  std::vector<at::Tensor> tensors;
+  for (auto member : members) {
+    g.*member = (g.*member).detach().clone().requires_grad_(true);
+    tensors.push_back(g.*member);
+  }
+  const auto grads = torch::autograd::grad({loss(gaussians::render(g, cam, settings))}, tensors);
+
+  const double eps = 1e-6;
+  at::NoGradGuard no_grad;
+  for (std::size_t k = 0; k < tensors.size(); ++k) {
+    const at::Tensor base = tensors[k].detach();
+    const at::Tensor analytic = grads[k].reshape({-1});
+    for (int64_t i = 0; i < base.numel(); ++i) {
+      auto eval = [&](double delta) {
+        GaussianParams p = g;
+        at::Tensor changed = base.clone();
+        changed.view({-1})[i] += delta;
+        p.*members[k] = changed;
+        return loss(gaussians::render(p, cam, settings)).item<double>();
+      };
+      const double numeric = (eval(eps) - eval(-eps)) / (2 * eps);
+      EXPECT_NEAR(analytic[i].item<double>(), numeric, tolerance * (1.0 + std::abs(numeric)))
+          << names[k] << "[" << i << "]";
+    }
+  }
+}
+
+TEST(Rasterizer, SingleIsotropicGaussianMatchesTheClosedForm) {
+  const RasterCamera cam = frontCamera(32, 32, 40.0);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  const double sigma = 0.1, z = 4.0, opacity = 0.6;
+  GaussianParams g;
+  g.means = at::tensor({0.0, 0.0, z}, opts).reshape({1, 3});
+  g.quats = at::tensor({1.0, 0.0, 0.0, 0.0}, opts).reshape({1, 4});
+  g.log_scales = at::full({1, 3}, std::log(sigma), opts);
+  g.opacity_logits = at::full({1}, std::log(opacity / (1 - opacity)), opts);
+  g.sh = at::zeros({1, 16, 3}, opts);
+  g.sh[0][0] = at::tensor({0.5, -0.5, 1.0}, opts) / 0.28209479177387814;  // rgb 1, 0, 1.5
+  g.features = at::tensor({2.0, -3.0}, opts).reshape({1, 2});
+  RenderSettings settings;
+  settings.background = {0.25f, 0.5f, 0.75f};
+  const auto r = gaussians::render(g, cam, settings);
+
+  EXPECT_NEAR(r.means2d[0][0].item<double>(), 16.0, 1e-12);
+  EXPECT_NEAR(r.means2d[0][1].item<double>(), 16.0, 1e-12);
+  const double s2 = std::pow(40.0 * sigma / z, 2) + 0.3;  // EWA + low-pass dilation
+  for (auto [px, py] : std::vector<std::pair<int, int>>{{16, 16}, {15, 15}, {18, 16}, {16, 12}}) {
+    const double dx = 16.0 - (px + 0.5), dy = 16.0 - (py + 0.5);
+    const double alpha = opacity * std::exp(-0.5 * (dx * dx + dy * dy) / s2);
+    if (alpha < 1.0 / 255) continue;
+    EXPECT_NEAR(r.alpha[py][px].item<double>(), alpha, 1e-12) << px << "," << py;
+    EXPECT_NEAR(r.rgb[py][px][0].item<double>(), alpha * 1.0 + (1 - alpha) * 0.25, 1e-12);
+    EXPECT_NEAR(r.rgb[py][px][1].item<double>(), (1 - alpha) * 0.5, 1e-12);
+    EXPECT_NEAR(r.features[py][px][1].item<double>(), -3.0 * alpha, 1e-12);
+    EXPECT_NEAR(r.depth[py][px].item<double>(), z, 1e-12);
+  }
+  // Far from the centre alpha falls under 1/255: pure background, depth 0.
+  EXPECT_EQ(r.alpha[0][0].item<double>(), 0.0);
+  EXPECT_NEAR(r.rgb[0][0][2].item<double>(), 0.75, 1e-7);
+  EXPECT_EQ(r.depth[0][0].item<double>(), 0.0);
+  EXPECT_GT(r.radii[0].item<int>(), 0);
+}
+
+TEST(Rasterizer, GradientsOfEveryInputMatchFiniteDifferences) {
+  // One 16x16 tile, so no tile-boundary discontinuities; SH degree 3, 3 feature channels.
+  const RasterCamera cam = frontCamera(16, 16, 22.0);
+  RenderSettings settings;
+  settings.background = {0.1f, 0.2f, 0.3f};
+  expectGradientsMatchFiniteDifferences(randomScene(5, 3, 1), cam, settings, 1e-5);
+}
+
+TEST(Rasterizer, GradientsWithATiltedOffCentreCameraMatchFiniteDifferences) {
+  RasterCamera cam = frontCamera(16, 12, 18.0);
+  cam.cx = 7.3;
+  cam.cy = 6.6;
+  cam.fy = 19.5;
+  const double angle = 0.2;
+  cam.qvec = {std::cos(angle / 2), 0.0, std::sin(angle / 2), 0.0};
+  cam.tvec = {0.3, -0.1, 0.2};
+  RenderSettings settings;
+  settings.sh_degree = 2;
+  auto g = randomScene(4, 1, 2, 0.25);
+  g.means.select(1, 0).add_(-0.5);  // rotated camera: shift the scene into view
+  expectGradientsMatchFiniteDifferences(g, cam, settings, 1e-5);
+}
+
+TEST(Rasterizer, GradientsThroughTheFrustumClampMatchFiniteDifferences) {
+  // A large Gaussian whose centre lies outside 1.3x the field of view but whose footprint
+  // reaches into the image: the clamped Jacobian path of the projection.
+  const RasterCamera cam = frontCamera(16, 16, 16.0);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  GaussianParams g;
+  g.means = at::tensor({2.1, 0.1, 3.0}, opts).reshape({1, 3});  // x/z = 0.7 > 1.3 * 0.5
+  g.quats = at::tensor({0.9, 0.1, -0.2, 0.3}, opts).reshape({1, 4});
+  g.log_scales = at::tensor({std::log(0.9), std::log(0.7), std::log(0.8)}, opts).reshape({1, 3});
+  g.opacity_logits = at::full({1}, 0.2, opts);
+  g.sh = at::randn({1, 1, 3}, opts) * 0.1;
+  g.features = at::randn({1, 2}, opts);
+  RenderSettings settings;
+  settings.sh_degree = 0;
+  const auto r = gaussians::render(g, cam, settings);
+  ASSERT_GT(r.radii[0].item<int>(), 0);
+  ASSERT_GT(r.alpha.max().item<double>(), 0.01);
+  expectGradientsMatchFiniteDifferences(g, cam, settings, 1e-5);
+}
+
+TEST(Rasterizer, CulledAndDegenerateGaussiansGiveZerosNotNaNs) {
+  const RasterCamera cam = frontCamera(20, 20, 20.0);
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  GaussianParams g;
+  g.means = at::tensor({0.0f, 0.0f, -3.0f,     // behind the camera
+                        0.0f, 0.0f, 0.001f,    // in front of the near plane
+                        500.0f, 0.0f, 3.0f,    // far off-screen
+                        0.0f, 0.0f, 3.0f,      // zero quaternion
+                        0.1f, 0.0f, 3.0f,      // infinite scale
+                        0.0f, 0.1f, 3.0f},     // vanishing scale: only the dilation is left
+                       opts).reshape({6, 3});
+  g.quats = at::tensor({1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f,
+                        0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f}, opts)
+                .reshape({6, 4});
+  g.log_scales = at::full({6, 3}, -2.0f, opts);
+  g.log_scales[4].fill_(1000.0f);
+  g.log_scales[5].fill_(-100.0f);
+  g.opacity_logits = at::zeros({6}, opts);
+  g.sh = at::zeros({6, 16, 3}, opts);
+  g.features = at::ones({6, 2}, opts);
+  for (at::Tensor* t : {&g.means, &g.quats, &g.log_scales, &g.opacity_logits, &g.sh, &g.features}) {
+    t->requires_grad_(true);
+  }
+  const auto r = gaussians::render(g, cam);
+  const auto radii = r.radii;
+  EXPECT_EQ(radii[0].item<int>(), 0);
+  EXPECT_EQ(radii[1].item<int>(), 0);
+  EXPECT_EQ(radii[2].item<int>(), 0);
+  EXPECT_EQ(radii[3].item<int>(), 0);
+  EXPECT_EQ(radii[4].item<int>(), 0);
+  EXPECT_GT(radii[5].item<int>(), 0);
+  (r.rgb.sum() + r.features.sum() + r.alpha.sum() + r.depth.sum()).backward();
+  for (const at::Tensor* t : {&r.rgb, &r.features, &r.alpha, &r.depth}) {
+    EXPECT_TRUE(at::isfinite(*t).all().item<bool>());
+  }
+  for (at::Tensor* t : {&g.means, &g.quats, &g.log_scales, &g.opacity_logits, &g.features}) {
+    EXPECT_TRUE(at::isfinite(t->grad()).all().item<bool>());
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(t->grad()[i].abs().sum().item<float>(), 0.f) << i;
+  }
+}
+
+TEST(Rasterizer, EmptySceneRendersTheBackground) {
+  const RasterCamera cam = frontCamera(17, 9, 10.0);
+  GaussianParams g;
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  g.means = at::zeros({0, 3}, opts);
+  g.quats = at::zeros({0, 4}, opts);
+  g.log_scales = at::zeros({0, 3}, opts);
+  g.opacity_logits = at::zeros({0}, opts);
+  g.sh = at::zeros({0, 16, 3}, opts);
+  g.features = at::zeros({0, 4}, opts);
+  RenderSettings settings;
+  settings.background = {0.2f, 0.4f, 0.6f};
+  const auto r = gaussians::render(g, cam, settings);
+  ASSERT_EQ(r.rgb.sizes(), (std::vector<int64_t>{9, 17, 3}));
+  EXPECT_TRUE(at::allclose(r.rgb.select(2, 1), at::full({9, 17}, 0.4f, opts)));
+  EXPECT_EQ(r.features.sizes(), (std::vector<int64_t>{9, 17, 4}));
+  EXPECT_EQ(r.alpha.abs().sum().item<float>(), 0.f);
+  EXPECT_EQ(r.depth.abs().sum().item<float>(), 0.f);
+}
+
+TEST(Rasterizer, TiledRenderEqualsABruteForceComposite) {
+  // 40 Gaussians over a 45x35 image (3x3 tiles): compare with compositing every Gaussian at
+  // every pixel in global depth order, using the projection outputs.
+  const RasterCamera cam = frontCamera(45, 35, 30.0);
+  auto g = randomScene(40, 2, 5, 0.8);
+  const auto proj = gaussians::projectGaussians(g.means, g.quats, g.log_scales, cam);
+  const at::Tensor values = at::cat({at::rand({40, 3}, g.means.options()), g.features,
+                                     proj[2].unsqueeze(1)}, 1);
+  const at::Tensor opac = at::sigmoid(g.opacity_logits);
+  const auto out =
+      gaussians::rasterizeToPixels(proj[0], proj[1], opac, values, proj[3], proj[2], 45, 35);
+  const at::Tensor order = std::get<1>(proj[2].sort(/*stable=*/true, 0, false));
+  const auto m2 = proj[0].accessor<double, 2>();
+  const auto co = proj[1].accessor<double, 2>();
+  const auto radii = proj[3].accessor<int, 1>();
+  const auto op = opac.accessor<double, 1>();
+  const auto val = values.accessor<double, 2>();
+  const auto ord = order.accessor<int64_t, 1>();
+  const auto img = out[0].accessor<double, 3>();
+  double worst = 0;
+  for (int py = 0; py < 35; ++py) {
+    for (int px = 0; px < 45; ++px) {
+      std::vector<double> acc(6, 0.0);
+      double T = 1;
+      for (int k = 0; k < 40; ++k) {
+        const int64_t i = ord[k];
+        if (radii[i] == 0) continue;
+        // Only Gaussians whose 3-sigma box touches this pixel's tile take part, as in the
+        // reference rasterizer; far pixels get alpha < 1/255 anyway.
+        const double dx = m2[i][0] - (px + 0.5), dy = m2[i][1] - (py + 0.5);
+        const double power = -0.5 * (co[i][0] * dx * dx + co[i][2] * dy * dy) - co[i][1] * dx * dy;
+        if (power > 0) continue;
+        const int tx = px / 16, ty = py / 16;
+        const int x0 = std::max(0, int(std::floor((m2[i][0] - radii[i]) / 16)));
+        const int x1 = int(std::floor((m2[i][0] + radii[i]) / 16));
+        const int y0 = std::max(0, int(std::floor((m2[i][1] - radii[i]) / 16)));
+        const int y1 = int(std::floor((m2[i][1] + radii[i]) / 16));
+        if (tx < x0 || tx > x1 || ty < y0 || ty > y1) continue;
+        const double alpha = std::min(0.99, op[i] * std::exp(power));
+        if (alpha < 1.0 / 255) continue;
+        if (T * (1 - alpha) < 1e-4) break;
+        for (int ch = 0; ch < 6; ++ch) acc[ch] += val[i][ch] * alpha * T;
+        T *= 1 - alpha;
+      }
+      for (int ch = 0; ch < 6; ++ch) worst = std::max(worst, std::abs(acc[ch] - img[py][px][ch]));
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(out[1].max().item<double>(), 0.5);  // the scene does cover the image
+}
+
+TEST(Rasterizer, ScreenSpaceGradientReachesMeans2d) {
+  const RasterCamera cam = frontCamera(32, 32, 30.0);
+  auto g = randomScene(10, 0, 8);
+  g.means.requires_grad_(true);
+  const auto r = gaussians::render(g, cam);
+  r.means2d.retain_grad();
+  r.rgb.sum().backward();
+  ASSERT_TRUE(r.means2d.grad().defined());
+  const at::Tensor visible = r.radii > 0;
+  EXPECT_GT(visible.sum().item<int64_t>(), 5);
+  EXPECT_GT(r.means2d.grad().index({visible}).abs().sum().item<double>(), 0.0);
+}
+
+TEST(Rasterizer, BadInputsAreClearErrors) {
+  const RasterCamera cam = frontCamera(8, 8, 8.0);
+  auto g = randomScene(3, 2, 1);
+  g.quats = at::zeros({3, 3}, g.means.options());
+  try {
+    gaussians::render(g, cam);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "quats");
+  }
+  g = randomScene(3, 2, 1);
+  g.sh = g.sh.slice(1, 0, 4);
+  EXPECT_THROW(gaussians::render(g, cam), Error);  // degree 3 needs 16 coefficients
+  RasterCamera bad = cam;
+  bad.fx = 0;
+  EXPECT_THROW(gaussians::render(randomScene(3, 2, 1), bad), Error);
+}
+
+}  // namespace
+}  // namespace sadsplat
