@@ -76,23 +76,30 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 
 # --- CUDA -----------------------------------------------------------------------------------
+# SADSPLAT_COMPILE_CUDA: nvcc is there, the CUDA sources are compiled (CI checks they build).
+# SADSPLAT_HAVE_CUDA: LibTorch also has CUDA, so the CUDA backend is linked and usable. Debian's
+# LibTorch is CPU-only: there the CUDA sources compile into an object library and stop.
+set(SADSPLAT_COMPILE_CUDA OFF)
 set(SADSPLAT_HAVE_CUDA OFF)
 if(SADSPLAT_WITH_CUDA STREQUAL "AUTO")
   include(CheckLanguage)
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
-    set(SADSPLAT_HAVE_CUDA ON)
+    set(SADSPLAT_COMPILE_CUDA ON)
   endif()
 elseif(SADSPLAT_WITH_CUDA)
-  set(SADSPLAT_HAVE_CUDA ON)
+  set(SADSPLAT_COMPILE_CUDA ON)
 endif()
-if(SADSPLAT_HAVE_CUDA)
+if(SADSPLAT_COMPILE_CUDA)
   if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
     set(CMAKE_CUDA_ARCHITECTURES 90)
   endif()
   enable_language(CUDA)
   set(CMAKE_CUDA_STANDARD 17)
   set(CMAKE_CUDA_STANDARD_REQUIRED ON)
+  if(TARGET c10_cuda)
+    set(SADSPLAT_HAVE_CUDA ON)
+  endif()
 endif()
 
 # --- GoogleTest -----------------------------------------------------------------------------
@@ -106,7 +113,8 @@ add_library(sadsplat_build_flags INTERFACE)
 target_compile_definitions(sadsplat_build_flags INTERFACE
   SADSPLAT_HAVE_OPENCV=$<BOOL:${SADSPLAT_HAVE_OPENCV}>
   SADSPLAT_HAVE_PCL_IO=$<BOOL:${SADSPLAT_HAVE_PCL_IO}>
-  SADSPLAT_HAVE_CUDA=$<BOOL:${SADSPLAT_HAVE_CUDA}>)
+  SADSPLAT_HAVE_CUDA=$<BOOL:${SADSPLAT_HAVE_CUDA}>
+  SADSPLAT_COMPILE_CUDA=$<BOOL:${SADSPLAT_COMPILE_CUDA}>)
 target_compile_options(sadsplat_build_flags INTERFACE
   $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wno-unused-parameter>)
 add_library(sadsplat::build_flags ALIAS sadsplat_build_flags)

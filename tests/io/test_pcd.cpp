@@ -35,7 +35,9 @@ TEST(Pcd, SemanticCloudIsAPlainXyzRgblCloud) {
   for (std::size_t i = 0; i < back.size(); ++i) {
     EXPECT_EQ(back[i].x, cloud[i].x);
     EXPECT_EQ(back[i].label, cloud[i].label);
-    if (cloud[i].label != kUnlabelled) EXPECT_EQ(back[i].b, classes[cloud[i].label].color[2]);
+    if (cloud[i].label != kUnlabelled) {
+      EXPECT_EQ(back[i].b, classes[cloud[i].label].color[2]);
+    }
   }
 #else
   GTEST_SKIP() << "built without pcl_io";

@@ -65,21 +65,25 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
                                  const RasterResult& forward, const at::Tensor& g_image,
                                  const at::Tensor& g_alpha);
 
-#if SADSPLAT_HAVE_CUDA
+// The CUDA backend takes the stream to run on (a cudaStream_t, as void* so that this header
+// needs no CUDA) and expects the tensors' device to be current: the caller, which links LibTorch's
+// CUDA libraries, supplies both. The kernels themselves need no c10 CUDA headers, so they also
+// compile against a CPU-only LibTorch.
+#if SADSPLAT_COMPILE_CUDA
 ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
-                                    const at::Tensor& log_scales, const CameraParams& cam);
+                                    const at::Tensor& log_scales, const CameraParams& cam, void* stream);
 ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& quats,
                                     const at::Tensor& log_scales, const at::Tensor& radii,
                                     const CameraParams& cam, const at::Tensor& g_means2d,
-                                    const at::Tensor& g_conics, const at::Tensor& g_depths);
+                                    const at::Tensor& g_conics, const at::Tensor& g_depths, void* stream);
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const at::Tensor& radii, const at::Tensor& depths, int width,
-                                  int height);
+                                  int height, void* stream);
 RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const RasterResult& forward, const at::Tensor& g_image,
-                                  const at::Tensor& g_alpha);
+                                  const at::Tensor& g_alpha, void* stream);
 #endif
 
 /// Number of tiles along x and y for an image.

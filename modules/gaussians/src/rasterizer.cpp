@@ -7,6 +7,11 @@
 #include <string>
 #include <vector>
 
+#if SADSPLAT_HAVE_CUDA
+#include <c10/cuda/CUDAGuard.h>
+#include <c10/cuda/CUDAStream.h>
+#endif
+
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
@@ -62,6 +67,13 @@ CameraParams unpackCamera(const std::vector<double>& v) {
               "CUDA tensors");
 }
 
+#if SADSPLAT_HAVE_CUDA
+// LibTorch's current stream on the tensor's device (which the guard in the caller makes current).
+void* currentStream(const at::Tensor& t) {
+  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
+}
+#endif
+
 at::Tensor orZeros(const at::Tensor& grad, const at::Tensor& like) {
   return grad.defined() ? grad.contiguous() : at::zeros_like(like);
 }
@@ -75,7 +87,8 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     raster::ProjectionResult r;
     if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
-      r = raster::projectForwardCuda(m, q, s, cam);
+      const c10::cuda::CUDAGuard guard(m.device());
+      r = raster::projectForwardCuda(m, q, s, cam, currentStream(m));
 #else
       noCuda();
 #endif
@@ -98,7 +111,8 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     raster::ProjectionGrads g;
     if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
-      g = raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d);
+      const c10::cuda::CUDAGuard guard(m.device());
+      g = raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d, currentStream(m));
 #else
       noCuda();
 #endif
@@ -119,8 +133,10 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     raster::RasterResult r;
     if (m2.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
+      const c10::cuda::CUDAGuard guard(m2.device());
       r = raster::rasterizeForwardCuda(m2, co, op, val, radii.contiguous(), depths.contiguous(),
-                                       static_cast<int>(width), static_cast<int>(height));
+                                       static_cast<int>(width), static_cast<int>(height),
+                                       currentStream(m2));
 #else
       noCuda();
 #endif
@@ -150,7 +166,9 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     raster::RasterGrads g;
     if (val.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
-      g = raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
+      const c10::cuda::CUDAGuard guard(val.device());
+      g = raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha,
+                                        currentStream(val));
 #else
       noCuda();
 #endif

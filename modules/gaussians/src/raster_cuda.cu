@@ -1,0 +1,493 @@
+// The CUDA backend of the rasterizer: the same five steps as raster_cpu.cpp, with the math of
+// raster_math.h, as tile-based kernels in the manner of the reference 3DGS rasterizer. Runs on
+// LibTorch's current stream; float32 only.
+#include <ATen/ATen.h>
+
+#include <cuda_runtime.h>
+
+#include "raster_backend.h"
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/raster_math.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace raster {
+namespace {
+
+constexpr int kBlock = kTileSize * kTileSize;  // threads per tile block
+constexpr int kThreads1d = 256;
+
+Camera<float> toCamera(const CameraParams& p) {
+  Camera<float> c;
+  for (int i = 0; i < 9; ++i) c.R[i] = static_cast<float>(p.R[i]);
+  for (int i = 0; i < 3; ++i) c.t[i] = static_cast<float>(p.t[i]);
+  c.fx = static_cast<float>(p.fx);
+  c.fy = static_cast<float>(p.fy);
+  c.cx = static_cast<float>(p.cx);
+  c.cy = static_cast<float>(p.cy);
+  c.width = p.width;
+  c.height = p.height;
+  c.near_plane = static_cast<float>(p.near_plane);
+  return c;
+}
+
+void check(const at::Tensor& t, const char* name) {
+  if (!t.is_cuda() || t.scalar_type() != at::kFloat || !t.is_contiguous()) {
+    throw Error("<render>", name, "a contiguous float32 CUDA tensor",
+                std::string(c10::toString(t.scalar_type())) + " on " + t.device().str());
+  }
+}
+
+void checkLaunch(const char* kernel) {
+  const cudaError_t err = cudaGetLastError();
+  if (err != cudaSuccess) {
+    throw Error("<render>", kernel, "a successful CUDA kernel launch", cudaGetErrorString(err));
+  }
+}
+
+int blocksFor(int64_t n) { return static_cast<int>((n + kThreads1d - 1) / kThreads1d); }
+
+// ---- projection ------------------------------------------------------------------------------
+
+__global__ void projectForwardKernel(int64_t n, const float* __restrict__ means,
+                                     const float* __restrict__ quats,
+                                     const float* __restrict__ log_scales, Camera<float> cam,
+                                     float* means2d, float* conics, float* depths, int* radii) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  Projected<float> p;
+  if (!projectGaussian(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam, &p)) {
+    radii[i] = 0;
+    return;
+  }
+  means2d[2 * i] = p.mean2d[0];
+  means2d[2 * i + 1] = p.mean2d[1];
+  conics[3 * i] = p.conic[0];
+  conics[3 * i + 1] = p.conic[1];
+  conics[3 * i + 2] = p.conic[2];
+  depths[i] = p.depth;
+  radii[i] = p.radius;
+}
+
+__global__ void projectBackwardKernel(int64_t n, const float* __restrict__ means,
+                                      const float* __restrict__ quats,
+                                      const float* __restrict__ log_scales,
+                                      const int* __restrict__ radii, Camera<float> cam,
+                                      const float* __restrict__ g_means2d,
+                                      const float* __restrict__ g_conics,
+                                      const float* __restrict__ g_depths, float* g_means,
+                                      float* g_quats, float* g_log_scales) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n || radii[i] <= 0) return;
+  projectGaussianBackward(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam,
+                          g_means2d + 2 * i, g_conics + 3 * i, g_depths[i], g_means + 3 * i,
+                          g_quats + 4 * i, g_log_scales + 3 * i);
+}
+
+// ---- binning ---------------------------------------------------------------------------------
+
+__global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
+                                 const int* __restrict__ radii, int tiles_x, int tiles_y,
+                                 int64_t* counts) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  int64_t count = 0;
+  if (radii[i] > 0) {
+    int x0, y0, x1, y1;
+    tileRect(means2d + 2 * i, radii[i], tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    count = static_cast<int64_t>(max(0, x1 - x0)) * max(0, y1 - y0);
+  }
+  counts[i] = count;
+}
+
+// Key = tile id (high 32 bits) | depth's float bits (positive floats sort like their bits).
+__global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
+                                const int* __restrict__ radii, const float* __restrict__ depths,
+                                const int64_t* __restrict__ offsets, int tiles_x, int tiles_y,
+                                int64_t* keys, int* values) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n || radii[i] <= 0) return;
+  int64_t out = i == 0 ? 0 : offsets[i - 1];
+  int x0, y0, x1, y1;
+  tileRect(means2d + 2 * i, radii[i], tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+  const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
+  for (int ty = y0; ty < y1; ++ty) {
+    for (int tx = x0; tx < x1; ++tx) {
+      keys[out] = (static_cast<int64_t>(ty * tiles_x + tx) << 32) | depth_bits;
+      values[out] = static_cast<int>(i);
+      ++out;
+    }
+  }
+}
+
+__global__ void tileRangesKernel(int64_t m, const int64_t* __restrict__ keys, int* ranges) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= m) return;
+  const int tile = static_cast<int>(keys[i] >> 32);
+  if (i == 0 || static_cast<int>(keys[i - 1] >> 32) != tile) ranges[2 * tile] = static_cast<int>(i);
+  if (i == m - 1 || static_cast<int>(keys[i + 1] >> 32) != tile) {
+    ranges[2 * tile + 1] = static_cast<int>(i + 1);
+  }
+}
+
+Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii, const at::Tensor& depths,
+                     int width, int height, cudaStream_t stream) {
+  const int64_t n = means2d.size(0);
+  const auto [tiles_x, tiles_y] = tileGrid(width, height);
+  const auto opts = means2d.options();
+  Binning b;
+  b.tile_ranges = at::zeros({tiles_x * tiles_y, 2}, opts.dtype(at::kInt));
+  if (n == 0) {
+    b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
+    return b;
+  }
+  at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
+  countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
+      n, means2d.data_ptr<float>(), radii.data_ptr<int>(), tiles_x, tiles_y,
+      counts.data_ptr<int64_t>());
+  checkLaunch("countTilesKernel");
+  const at::Tensor offsets = counts.cumsum(0);
+  const int64_t m = offsets[n - 1].item<int64_t>();
+  at::Tensor keys = at::empty({m}, opts.dtype(at::kLong));
+  at::Tensor values = at::empty({m}, opts.dtype(at::kInt));
+  if (m > 0) {
+    writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
+        n, means2d.data_ptr<float>(), radii.data_ptr<int>(), depths.data_ptr<float>(),
+        offsets.data_ptr<int64_t>(), tiles_x, tiles_y, keys.data_ptr<int64_t>(),
+        values.data_ptr<int>());
+    checkLaunch("writeKeysKernel");
+    // Stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
+    auto sorted = at::sort(keys, /*stable=*/true, /*dim=*/0, /*descending=*/false);
+    keys = std::get<0>(sorted);
+    values = values.index_select(0, std::get<1>(sorted)).contiguous();
+    tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(m, keys.data_ptr<int64_t>(),
+                                                              b.tile_ranges.data_ptr<int>());
+    checkLaunch("tileRangesKernel");
+  }
+  b.gaussian_ids = values;
+  return b;
+}
+
+// ---- rasterization ---------------------------------------------------------------------------
+
+// One block per tile, one thread per pixel; Gaussians are staged through shared memory in
+// batches of kBlock. CH is the channel capacity (>= D), fixed at compile time so the per-pixel
+// accumulators can live in registers.
+template <int CH>
+__global__ void __launch_bounds__(kBlock)
+    rasterizeForwardKernel(int width, int height, int tiles_x, int D,
+                           const int* __restrict__ ranges, const int* __restrict__ ids,
+                           const float* __restrict__ means2d, const float* __restrict__ conics,
+                           const float* __restrict__ opacities, const float* __restrict__ values,
+                           float* image, float* alpha_out, int* last_out) {
+  const int tile = blockIdx.x;
+  const int tx = tile % tiles_x, ty = tile / tiles_x;
+  const int px = tx * kTileSize + threadIdx.x % kTileSize;
+  const int py = ty * kTileSize + threadIdx.x / kTileSize;
+  const bool inside = px < width && py < height;
+  const float fx = px + 0.5f, fy = py + 0.5f;
+  const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
+
+  __shared__ int s_id[kBlock];
+  __shared__ float s_mean[kBlock][2];
+  __shared__ float s_conic[kBlock][3];
+  __shared__ float s_opacity[kBlock];
+
+  float acc[CH];
+#pragma unroll
+  for (int c = 0; c < CH; ++c) acc[c] = 0.f;
+  float trans = 1.f;
+  int last = 0;
+  bool done = !inside;
+  for (int batch = start; batch < stop; batch += kBlock) {
+    if (__syncthreads_count(done) == kBlock) break;
+    const int k = batch + threadIdx.x;
+    if (k < stop) {
+      const int g = ids[k];
+      s_id[threadIdx.x] = g;
+      s_mean[threadIdx.x][0] = means2d[2 * g];
+      s_mean[threadIdx.x][1] = means2d[2 * g + 1];
+      s_conic[threadIdx.x][0] = conics[3 * g];
+      s_conic[threadIdx.x][1] = conics[3 * g + 1];
+      s_conic[threadIdx.x][2] = conics[3 * g + 2];
+      s_opacity[threadIdx.x] = opacities[g];
+    }
+    __syncthreads();
+    const int count = min(kBlock, stop - batch);
+    for (int j = 0; j < count && !done; ++j) {
+      float G;
+      bool clamped;
+      const float alpha =
+          pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
+      if (alpha == 0.f) continue;
+      const float next = trans * (1.f - alpha);
+      if (next < float(kMinTransmittance)) {
+        done = true;
+        break;
+      }
+      const float w = alpha * trans;
+      const float* v = values + static_cast<int64_t>(s_id[j]) * D;
+#pragma unroll
+      for (int c = 0; c < CH; ++c) {
+        if (c < D) acc[c] += w * v[c];
+      }
+      trans = next;
+      last = batch + j - start + 1;
+    }
+  }
+  if (!inside) return;
+  const int64_t pix = static_cast<int64_t>(py) * width + px;
+#pragma unroll
+  for (int c = 0; c < CH; ++c) {
+    if (c < D) image[pix * D + c] = acc[c];
+  }
+  alpha_out[pix] = 1.f - trans;
+  last_out[pix] = last;
+}
+
+__device__ __forceinline__ float warpSum(float v) {
+#pragma unroll
+  for (int offset = 16; offset > 0; offset /= 2) v += __shfl_down_sync(0xffffffffu, v, offset);
+  return v;
+}
+
+// Back to front over each tile's list. Every thread of the block visits the same Gaussian at the
+// same step, so per-Gaussian gradients are summed over the warp with shuffles and added with one
+// atomic per warp.
+template <int CH>
+__global__ void __launch_bounds__(kBlock)
+    rasterizeBackwardKernel(int width, int height, int tiles_x, int D,
+                            const int* __restrict__ ranges, const int* __restrict__ ids,
+                            const float* __restrict__ means2d, const float* __restrict__ conics,
+                            const float* __restrict__ opacities, const float* __restrict__ values,
+                            const float* __restrict__ alpha_fwd, const int* __restrict__ last_fwd,
+                            const float* __restrict__ g_image, const float* __restrict__ g_alpha,
+                            float* g_means2d, float* g_conics, float* g_opacities,
+                            float* g_values) {
+  const int tile = blockIdx.x;
+  const int tx = tile % tiles_x, ty = tile / tiles_x;
+  const int px = tx * kTileSize + threadIdx.x % kTileSize;
+  const int py = ty * kTileSize + threadIdx.x / kTileSize;
+  const bool inside = px < width && py < height;
+  const float fx = px + 0.5f, fy = py + 0.5f;
+  const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
+  const int lane = threadIdx.x % 32;
+
+  __shared__ int s_id[kBlock];
+  __shared__ float s_mean[kBlock][2];
+  __shared__ float s_conic[kBlock][3];
+  __shared__ float s_opacity[kBlock];
+
+  const int64_t pix = inside ? static_cast<int64_t>(py) * width + px : 0;
+  const float final_trans = inside ? 1.f - alpha_fwd[pix] : 1.f;
+  const int last = inside ? last_fwd[pix] : 0;
+  const float ga_out = inside ? g_alpha[pix] : 0.f;
+  float gpix[CH], accum[CH], last_value[CH];
+#pragma unroll
+  for (int c = 0; c < CH; ++c) {
+    gpix[c] = (inside && c < D) ? g_image[pix * D + c] : 0.f;
+    accum[c] = 0.f;
+    last_value[c] = 0.f;
+  }
+  float trans = final_trans;
+  float last_alpha = 0.f;
+
+  for (int batch_end = stop; batch_end > start; batch_end -= kBlock) {
+    __syncthreads();
+    const int k = batch_end - 1 - threadIdx.x;
+    if (k >= start) {
+      const int g = ids[k];
+      s_id[threadIdx.x] = g;
+      s_mean[threadIdx.x][0] = means2d[2 * g];
+      s_mean[threadIdx.x][1] = means2d[2 * g + 1];
+      s_conic[threadIdx.x][0] = conics[3 * g];
+      s_conic[threadIdx.x][1] = conics[3 * g + 1];
+      s_conic[threadIdx.x][2] = conics[3 * g + 2];
+      s_opacity[threadIdx.x] = opacities[g];
+    }
+    __syncthreads();
+    const int count = min(kBlock, batch_end - start);
+    for (int j = 0; j < count; ++j) {
+      const int position = batch_end - 1 - j - start;  // 0-based in the tile list
+      float G = 0.f, alpha = 0.f;
+      bool clamped = false;
+      if (position < last) {
+        alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
+      }
+      const bool contributes = alpha > 0.f;
+      if (!__any_sync(0xffffffffu, contributes)) continue;
+      const int g = s_id[j];
+      float g_mean[2] = {0.f, 0.f}, g_conic[3] = {0.f, 0.f, 0.f}, g_op = 0.f;
+      float w = 0.f;  // this pixel's weight of the Gaussian; 0 when it does not contribute
+      if (contributes) {
+        trans = trans / (1.f - alpha);
+        w = alpha * trans;
+        const float* v = values + static_cast<int64_t>(g) * D;
+        float g_a = 0.f;
+#pragma unroll
+        for (int c = 0; c < CH; ++c) {
+          if (c < D) {
+            accum[c] = last_alpha * last_value[c] + (1.f - last_alpha) * accum[c];
+            last_value[c] = v[c];
+            g_a += (v[c] - accum[c]) * gpix[c];
+          }
+        }
+        g_a = g_a * trans + ga_out * final_trans / (1.f - alpha);
+        last_alpha = alpha;
+        pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a, g_mean,
+                           g_conic, &g_op);
+      }
+      // Sum over the warp, one atomic per warp and quantity.
+      const float s0 = warpSum(g_mean[0]), s1 = warpSum(g_mean[1]);
+      const float s2 = warpSum(g_conic[0]), s3 = warpSum(g_conic[1]), s4 = warpSum(g_conic[2]);
+      const float s5 = warpSum(g_op);
+      if (lane == 0) {
+        atomicAdd(g_means2d + 2 * g, s0);
+        atomicAdd(g_means2d + 2 * g + 1, s1);
+        atomicAdd(g_conics + 3 * g, s2);
+        atomicAdd(g_conics + 3 * g + 1, s3);
+        atomicAdd(g_conics + 3 * g + 2, s4);
+        atomicAdd(g_opacities + g, s5);
+      }
+#pragma unroll
+      for (int c = 0; c < CH; ++c) {
+        if (c < D) {
+          const float sv = warpSum(w * gpix[c]);
+          if (lane == 0) atomicAdd(g_values + static_cast<int64_t>(g) * D + c, sv);
+        }
+      }
+    }
+  }
+}
+
+// The smallest compiled channel capacity that holds D channels.
+int channelCapacity(int64_t D) {
+  for (int capacity : {4, 8, 16, 36, 68, 132}) {
+    if (D <= capacity) return capacity;
+  }
+  throw Error("<render>", "channels", "at most 132 (RGB + 128 features + depth)",
+              std::to_string(D));
+}
+
+#define SADSPLAT_FOR_CHANNEL_CAPACITY(D, LAUNCH) \
+  switch (channelCapacity(D)) {                  \
+    case 4: LAUNCH(4); break;                    \
+    case 8: LAUNCH(8); break;                    \
+    case 16: LAUNCH(16); break;                  \
+    case 36: LAUNCH(36); break;                  \
+    case 68: LAUNCH(68); break;                  \
+    default: LAUNCH(132); break;                 \
+  }
+
+}  // namespace
+
+ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
+                                    const at::Tensor& log_scales, const CameraParams& cam,
+                                    void* stream_ptr) {
+  check(means, "means");
+  check(quats, "quats");
+  check(log_scales, "log_scales");
+  cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
+  const int64_t n = means.size(0);
+  ProjectionResult out;
+  out.means2d = at::zeros({n, 2}, means.options());
+  out.conics = at::zeros({n, 3}, means.options());
+  out.depths = at::zeros({n}, means.options());
+  out.radii = at::zeros({n}, means.options().dtype(at::kInt));
+  if (n == 0) return out;
+  projectForwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
+      n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
+      toCamera(cam), out.means2d.data_ptr<float>(), out.conics.data_ptr<float>(),
+      out.depths.data_ptr<float>(), out.radii.data_ptr<int>());
+  checkLaunch("projectForwardKernel");
+  return out;
+}
+
+ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& quats,
+                                    const at::Tensor& log_scales, const at::Tensor& radii,
+                                    const CameraParams& cam, const at::Tensor& g_means2d,
+                                    const at::Tensor& g_conics, const at::Tensor& g_depths,
+                                    void* stream_ptr) {
+  cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
+  const int64_t n = means.size(0);
+  ProjectionGrads g;
+  g.means = at::zeros_like(means);
+  g.quats = at::zeros_like(quats);
+  g.log_scales = at::zeros_like(log_scales);
+  if (n == 0) return g;
+  check(g_means2d, "grad means2d");
+  check(g_conics, "grad conics");
+  check(g_depths, "grad depths");
+  projectBackwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
+      n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
+      radii.data_ptr<int>(), toCamera(cam), g_means2d.data_ptr<float>(),
+      g_conics.data_ptr<float>(), g_depths.data_ptr<float>(), g.means.data_ptr<float>(),
+      g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
+  checkLaunch("projectBackwardKernel");
+  return g;
+}
+
+RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
+                                  const at::Tensor& opacities, const at::Tensor& values,
+                                  const at::Tensor& radii, const at::Tensor& depths, int width,
+                                  int height, void* stream_ptr) {
+  check(means2d, "means2d");
+  check(conics, "conics");
+  check(opacities, "opacities");
+  check(values, "values");
+  check(depths, "depths");
+  cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
+  const int64_t D = values.size(1);
+  RasterResult out;
+  out.image = at::zeros({height, width, D}, values.options());
+  out.alpha = at::zeros({height, width}, values.options());
+  out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
+  out.binning = binGaussians(means2d, radii, depths, width, height, stream);
+  const int tiles_x = tileGrid(width, height).first;
+  const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
+#define SADSPLAT_LAUNCH_FORWARD(CH)                                                          \
+  rasterizeForwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                               \
+      width, height, tiles_x, static_cast<int>(D), out.binning.tile_ranges.data_ptr<int>(),   \
+      out.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                    \
+      conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),        \
+      out.image.data_ptr<float>(), out.alpha.data_ptr<float>(), out.last.data_ptr<int>())
+  SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_FORWARD)
+#undef SADSPLAT_LAUNCH_FORWARD
+  checkLaunch("rasterizeForwardKernel");
+  return out;
+}
+
+RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
+                                  const at::Tensor& opacities, const at::Tensor& values,
+                                  const RasterResult& fwd, const at::Tensor& g_image,
+                                  const at::Tensor& g_alpha, void* stream_ptr) {
+  check(g_image, "grad image");
+  check(g_alpha, "grad alpha");
+  cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
+  const int64_t D = values.size(1);
+  const int height = static_cast<int>(fwd.alpha.size(0));
+  const int width = static_cast<int>(fwd.alpha.size(1));
+  RasterGrads g;
+  g.means2d = at::zeros_like(means2d);
+  g.conics = at::zeros_like(conics);
+  g.opacities = at::zeros_like(opacities);
+  g.values = at::zeros_like(values);
+  const int tiles_x = tileGrid(width, height).first;
+  const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
+#define SADSPLAT_LAUNCH_BACKWARD(CH)                                                         \
+  rasterizeBackwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                              \
+      width, height, tiles_x, static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),   \
+      fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                    \
+      conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),        \
+      fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(),       \
+      g_alpha.data_ptr<float>(), g.means2d.data_ptr<float>(), g.conics.data_ptr<float>(),     \
+      g.opacities.data_ptr<float>(), g.values.data_ptr<float>())
+  SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_BACKWARD)
+#undef SADSPLAT_LAUNCH_BACKWARD
+  checkLaunch("rasterizeBackwardKernel");
+  return g;
+}
+
+}  // namespace raster
+}  // namespace gaussians
+}  // namespace sadsplat
