@@ -6,6 +6,7 @@
 
 #include <ATen/Context.h>
 #include <ATen/Parallel.h>
+#include <c10/core/GradMode.h>
 
 #include <algorithm>
 #include <chrono>
@@ -94,7 +95,7 @@ int main(int argc, char** argv) {
         const auto t0 = Clock::now();
         sadsplat::gaussians::RenderResult r;
         {
-          at::NoGradGuard no_grad;
+          c10::AutoGradMode no_grad(false);
           r = sadsplat::gaussians::render(g, cam);
         }
         synchronize(device);

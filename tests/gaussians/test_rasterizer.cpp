@@ -2,6 +2,7 @@
 // differences in double precision, culling without NaNs, tiling against a brute-force render.
 #include <gtest/gtest.h>
 
+#include <c10/core/GradMode.h>
 #include <torch/csrc/autograd/autograd.h>
 
 #include <cmath>
@@ -75,7 +76,7 @@ void expectGradientsMatchFiniteDifferences(GaussianParams g, const RasterCamera&
   const auto grads = torch::autograd::grad({loss(gaussians::render(g, cam, settings))}, tensors);
 
   const double eps = 1e-6;
-  at::NoGradGuard no_grad;
+  c10::AutoGradMode no_grad(false);
   for (std::size_t k = 0; k < tensors.size(); ++k) {
     const at::Tensor base = tensors[k].detach();
     const at::Tensor analytic = grads[k].reshape({-1});
