@@ -69,6 +69,14 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
 // needs no CUDA) and expects the tensors' device to be current: the caller, which links LibTorch's
 // CUDA libraries, supplies both. The kernels themselves need no c10 CUDA headers, so they also
 // compile against a CPU-only LibTorch.
+/// SH colours [N, 3] of sh [N, K, 3] (contiguous) seen from `campos` (see raster::shColor).
+at::Tensor shForwardCpu(const at::Tensor& sh, const at::Tensor& means,
+                        const std::array<double, 3>& campos, int degree);
+/// Gradients {sh, means} of shForwardCpu for g_colors [N, 3].
+std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::Tensor& means,
+                                                const std::array<double, 3>& campos, int degree,
+                                                const at::Tensor& g_colors);
+
 #if SADSPLAT_COMPILE_CUDA
 ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
                                     const at::Tensor& log_scales, const CameraParams& cam, void* stream);
@@ -84,6 +92,11 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const RasterResult& forward, const at::Tensor& g_image,
                                   const at::Tensor& g_alpha, void* stream);
+at::Tensor shForwardCuda(const at::Tensor& sh, const at::Tensor& means,
+                         const std::array<double, 3>& campos, int degree, void* stream);
+std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh, const at::Tensor& means,
+                                                 const std::array<double, 3>& campos, int degree,
+                                                 const at::Tensor& g_colors, void* stream);
 #endif
 
 /// Number of tiles along x and y for an image.

@@ -99,6 +99,44 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
   return g;
 }
 
+at::Tensor shForwardCpu(const at::Tensor& sh, const at::Tensor& means,
+                        const std::array<double, 3>& campos, int degree) {
+  const int64_t n = means.size(0), K = sh.size(1);
+  at::Tensor colors = at::empty({n, 3}, means.options());
+  AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shForwardCpu", [&] {
+    const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
+    const scalar_t* s = sh.data_ptr<scalar_t>();
+    const scalar_t* m = means.data_ptr<scalar_t>();
+    scalar_t* c = colors.data_ptr<scalar_t>();
+    at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) shColor(s + i * K * 3, degree, m + 3 * i, cam, c + 3 * i);
+    });
+  });
+  return colors;
+}
+
+std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::Tensor& means,
+                                                const std::array<double, 3>& campos, int degree,
+                                                const at::Tensor& g_colors) {
+  const int64_t n = means.size(0), K = sh.size(1);
+  at::Tensor g_sh = at::zeros_like(sh), g_means = at::zeros_like(means);
+  AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shBackwardCpu", [&] {
+    const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
+    const scalar_t* s = sh.data_ptr<scalar_t>();
+    const scalar_t* m = means.data_ptr<scalar_t>();
+    const scalar_t* gc = g_colors.data_ptr<scalar_t>();
+    scalar_t* gs = g_sh.data_ptr<scalar_t>();
+    scalar_t* gm = g_means.data_ptr<scalar_t>();
+    at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        shColorBackward(s + i * K * 3, degree, m + 3 * i, cam, gc + 3 * i, gs + i * K * 3,
+                        gm + 3 * i);
+      }
+    });
+  });
+  return {g_sh, g_means};
+}
+
 namespace {
 
 // Per-tile lists sorted by (depth, id): the same order the CUDA backend's stable sort gives.

@@ -84,6 +84,27 @@ __global__ void projectBackwardKernel(int64_t n, const float* __restrict__ means
                           g_quats + 4 * i, g_log_scales + 3 * i);
 }
 
+// ---- spherical harmonics ---------------------------------------------------------------------
+
+__global__ void shForwardKernel(int64_t n, int64_t K, int degree, float3 campos,
+                                const float* __restrict__ sh, const float* __restrict__ means,
+                                float* colors) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  const float cam[3] = {campos.x, campos.y, campos.z};
+  shColor(sh + i * K * 3, degree, means + 3 * i, cam, colors + 3 * i);
+}
+
+__global__ void shBackwardKernel(int64_t n, int64_t K, int degree, float3 campos,
+                                 const float* __restrict__ sh, const float* __restrict__ means,
+                                 const float* __restrict__ g_colors, float* g_sh, float* g_means) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  const float cam[3] = {campos.x, campos.y, campos.z};
+  shColorBackward(sh + i * K * 3, degree, means + 3 * i, cam, g_colors + 3 * i, g_sh + i * K * 3,
+                  g_means + 3 * i);
+}
+
 // ---- binning ---------------------------------------------------------------------------------
 
 __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
@@ -252,8 +273,14 @@ __device__ __forceinline__ float warpSum(float v) {
 }
 
 // Back to front over each tile's list. Every thread of the block visits the same Gaussian at the
-// same step, so per-Gaussian gradients are summed over the warp with shuffles and added with one
-// atomic per warp.
+// same step. Position, conic and opacity gradients are summed over the warp with shuffles (one
+// atomic per warp). The D channel gradients, sum over pixels p of w[p, g] * dL/dpixel[p, c], are
+// a small matrix product per warp: each lane records its weight w for 32 consecutive Gaussians in
+// shared memory, then lane l computes the channel gradients of Gaussian l of that group from the
+// warp's 32 pixel gradients (also in shared memory) and adds them with one atomic per channel.
+// Dynamic shared memory: kWarps * 32 * D floats of pixel gradients.
+constexpr int kWarps = kBlock / 32;
+
 template <int CH>
 __global__ void __launch_bounds__(kBlock)
     rasterizeBackwardKernel(int width, int height, int tiles_x, int D,
@@ -271,24 +298,29 @@ __global__ void __launch_bounds__(kBlock)
   const bool inside = px < width && py < height;
   const float fx = px + 0.5f, fy = py + 0.5f;
   const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
-  const int lane = threadIdx.x % 32;
+  const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
 
   __shared__ int s_id[kBlock];
   __shared__ float s_mean[kBlock][2];
   __shared__ float s_conic[kBlock][3];
   __shared__ float s_opacity[kBlock];
+  __shared__ float s_weight[kWarps][32][33];  // [warp][pixel lane][Gaussian in group], padded
+  __shared__ int s_used[kWarps][32];          // whether any pixel of the warp used Gaussian k
+  extern __shared__ float s_gpix[];           // [warp][pixel lane][D]
+  float* my_gpix = s_gpix + (static_cast<int64_t>(warp) * 32 + lane) * D;
+  const float* warp_gpix = s_gpix + static_cast<int64_t>(warp) * 32 * D;
 
   const int64_t pix = inside ? static_cast<int64_t>(py) * width + px : 0;
   const float final_trans = inside ? 1.f - alpha_fwd[pix] : 1.f;
   const int last = inside ? last_fwd[pix] : 0;
   const float ga_out = inside ? g_alpha[pix] : 0.f;
-  float gpix[CH], accum[CH], last_value[CH];
+  float accum[CH], last_value[CH];
 #pragma unroll
   for (int c = 0; c < CH; ++c) {
-    gpix[c] = (inside && c < D) ? g_image[pix * D + c] : 0.f;
     accum[c] = 0.f;
     last_value[c] = 0.f;
   }
+  for (int c = 0; c < D; ++c) my_gpix[c] = inside ? g_image[pix * D + c] : 0.f;
   float trans = final_trans;
   float last_alpha = 0.f;
 
@@ -315,46 +347,58 @@ __global__ void __launch_bounds__(kBlock)
         alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
       }
       const bool contributes = alpha > 0.f;
-      if (!__any_sync(0xffffffffu, contributes)) continue;
-      const int g = s_id[j];
-      float g_mean[2] = {0.f, 0.f}, g_conic[3] = {0.f, 0.f, 0.f}, g_op = 0.f;
+      const bool any = __any_sync(0xffffffffu, contributes);
       float w = 0.f;  // this pixel's weight of the Gaussian; 0 when it does not contribute
-      if (contributes) {
-        trans = trans / (1.f - alpha);
-        w = alpha * trans;
-        const float* v = values + static_cast<int64_t>(g) * D;
-        float g_a = 0.f;
+      if (any) {
+        const int g = s_id[j];
+        float g_mean[2] = {0.f, 0.f}, g_conic[3] = {0.f, 0.f, 0.f}, g_op = 0.f;
+        if (contributes) {
+          trans = trans / (1.f - alpha);
+          w = alpha * trans;
+          const float* v = values + static_cast<int64_t>(g) * D;
+          float g_a = 0.f;
 #pragma unroll
-        for (int c = 0; c < CH; ++c) {
-          if (c < D) {
-            accum[c] = last_alpha * last_value[c] + (1.f - last_alpha) * accum[c];
-            last_value[c] = v[c];
-            g_a += (v[c] - accum[c]) * gpix[c];
+          for (int c = 0; c < CH; ++c) {
+            if (c < D) {
+              accum[c] = last_alpha * last_value[c] + (1.f - last_alpha) * accum[c];
+              last_value[c] = v[c];
+              g_a += (v[c] - accum[c]) * my_gpix[c];
+            }
+          }
+          g_a = g_a * trans + ga_out * final_trans / (1.f - alpha);
+          last_alpha = alpha;
+          pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a,
+                             g_mean, g_conic, &g_op);
+        }
+        const float s0 = warpSum(g_mean[0]), s1 = warpSum(g_mean[1]);
+        const float s2 = warpSum(g_conic[0]), s3 = warpSum(g_conic[1]), s4 = warpSum(g_conic[2]);
+        const float s5 = warpSum(g_op);
+        if (lane == 0) {
+          atomicAdd(g_means2d + 2 * g, s0);
+          atomicAdd(g_means2d + 2 * g + 1, s1);
+          atomicAdd(g_conics + 3 * g, s2);
+          atomicAdd(g_conics + 3 * g + 1, s3);
+          atomicAdd(g_conics + 3 * g + 2, s4);
+          atomicAdd(g_opacities + g, s5);
+        }
+      }
+      const int slot = j % 32;
+      s_weight[warp][lane][slot] = w;
+      if (lane == 0) s_used[warp][slot] = any;
+      if (slot == 31 || j == count - 1) {
+        __syncwarp();
+        // Lane l: Gaussian j - slot + l of this group.
+        if (lane <= slot && s_used[warp][lane]) {
+          const int g = s_id[j - slot + lane];
+          float* out = g_values + static_cast<int64_t>(g) * D;
+          for (int c = 0; c < D; ++c) {
+            float sum = 0.f;
+#pragma unroll 8
+            for (int p = 0; p < 32; ++p) sum += s_weight[warp][p][lane] * warp_gpix[p * D + c];
+            atomicAdd(out + c, sum);
           }
         }
-        g_a = g_a * trans + ga_out * final_trans / (1.f - alpha);
-        last_alpha = alpha;
-        pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a, g_mean,
-                           g_conic, &g_op);
-      }
-      // Sum over the warp, one atomic per warp and quantity.
-      const float s0 = warpSum(g_mean[0]), s1 = warpSum(g_mean[1]);
-      const float s2 = warpSum(g_conic[0]), s3 = warpSum(g_conic[1]), s4 = warpSum(g_conic[2]);
-      const float s5 = warpSum(g_op);
-      if (lane == 0) {
-        atomicAdd(g_means2d + 2 * g, s0);
-        atomicAdd(g_means2d + 2 * g + 1, s1);
-        atomicAdd(g_conics + 3 * g, s2);
-        atomicAdd(g_conics + 3 * g + 1, s3);
-        atomicAdd(g_conics + 3 * g + 2, s4);
-        atomicAdd(g_opacities + g, s5);
-      }
-#pragma unroll
-      for (int c = 0; c < CH; ++c) {
-        if (c < D) {
-          const float sv = warpSum(w * gpix[c]);
-          if (lane == 0) atomicAdd(g_values + static_cast<int64_t>(g) * D + c, sv);
-        }
+        __syncwarp();
       }
     }
   }
@@ -378,6 +422,17 @@ int channelCapacity(int64_t D) {
     case 68: LAUNCH(68); break;                  \
     default: LAUNCH(132); break;                 \
   }
+
+// Launches a backward kernel with `smem` bytes of dynamic shared memory (raising the kernel's
+// limit above the 48 KiB default where needed).
+template <typename Kernel, typename... Args>
+void launchBackward(Kernel kernel, int blocks, std::size_t smem, cudaStream_t stream,
+                    Args... args) {
+  // Static shared memory plus `smem` exceeds the 48 KiB default: opt in to more.
+  cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                       static_cast<int>(smem));
+  kernel<<<blocks, kBlock, smem, stream>>>(args...);
+}
 
 }  // namespace
 
@@ -425,6 +480,36 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
       g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
   checkLaunch("projectBackwardKernel");
   return g;
+}
+
+at::Tensor shForwardCuda(const at::Tensor& sh, const at::Tensor& means,
+                         const std::array<double, 3>& campos, int degree, void* stream_ptr) {
+  check(sh, "sh");
+  check(means, "means");
+  const int64_t n = means.size(0);
+  at::Tensor colors = at::empty({n, 3}, means.options());
+  if (n == 0) return colors;
+  const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
+  shForwardKernel<<<blocksFor(n), kThreads1d, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
+      n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
+      colors.data_ptr<float>());
+  checkLaunch("shForwardKernel");
+  return colors;
+}
+
+std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh, const at::Tensor& means,
+                                                 const std::array<double, 3>& campos, int degree,
+                                                 const at::Tensor& g_colors, void* stream_ptr) {
+  check(g_colors, "grad colors");
+  const int64_t n = means.size(0);
+  at::Tensor g_sh = at::zeros_like(sh), g_means = at::zeros_like(means);
+  if (n == 0) return {g_sh, g_means};
+  const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
+  shBackwardKernel<<<blocksFor(n), kThreads1d, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
+      n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
+      g_colors.data_ptr<float>(), g_sh.data_ptr<float>(), g_means.data_ptr<float>());
+  checkLaunch("shBackwardKernel");
+  return {g_sh, g_means};
 }
 
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
@@ -475,13 +560,14 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
 #define SADSPLAT_LAUNCH_BACKWARD(CH)                                                         \
-  rasterizeBackwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                              \
+  launchBackward(rasterizeBackwardKernel<CH>, num_tiles, gpix_bytes, stream,                  \
       width, height, tiles_x, static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),   \
       fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                    \
       conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),        \
       fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(),       \
       g_alpha.data_ptr<float>(), g.means2d.data_ptr<float>(), g.conics.data_ptr<float>(),     \
       g.opacities.data_ptr<float>(), g.values.data_ptr<float>())
+  const std::size_t gpix_bytes = sizeof(float) * kBlock * static_cast<std::size_t>(D);
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_BACKWARD)
 #undef SADSPLAT_LAUNCH_BACKWARD
   checkLaunch("rasterizeBackwardKernel");

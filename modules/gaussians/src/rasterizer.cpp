@@ -180,6 +180,50 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   }
 };
 
+struct ShFunction : public torch::autograd::Function<ShFunction> {
+  // camera: centre x, y, z and the SH degree.
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& sh,
+                               const at::Tensor& means, const std::vector<double>& camera) {
+    const at::Tensor s = sh.contiguous(), m = means.contiguous();
+    const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
+    const int degree = static_cast<int>(camera[3]);
+    at::Tensor colors;
+    if (m.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      const c10::cuda::CUDAGuard guard(m.device());
+      colors = raster::shForwardCuda(s, m, campos, degree, currentStream(m));
+#else
+      noCuda();
+#endif
+    } else {
+      colors = raster::shForwardCpu(s, m, campos, degree);
+    }
+    ctx->save_for_backward({s, m});
+    ctx->saved_data["camera"] = camera;
+    return {colors};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const auto camera = ctx->saved_data["camera"].toDoubleVector();
+    const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
+    const int degree = static_cast<int>(camera[3]);
+    const at::Tensor g = orZeros(grads[0], at::empty({saved[1].size(0), 3}, saved[1].options()));
+    std::pair<at::Tensor, at::Tensor> out;
+    if (saved[1].is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      const c10::cuda::CUDAGuard guard(saved[1].device());
+      out = raster::shBackwardCuda(saved[0], saved[1], campos, degree, g, currentStream(saved[1]));
+#else
+      noCuda();
+#endif
+    } else {
+      out = raster::shBackwardCpu(saved[0], saved[1], campos, degree, g);
+    }
+    return {out.first, out.second, at::Tensor()};
+  }
+};
+
 void expectTensor(const at::Tensor& t, const char* name, int64_t n, std::vector<int64_t> tail,
                   const at::Tensor& reference) {
   std::string want = "[" + std::to_string(n);
@@ -238,34 +282,18 @@ at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
   if (degree < 0 || degree > 3) {
     throw Error("<render>", "sh_degree", "0..3", std::to_string(degree));
   }
-  const at::Tensor centre =
-      at::tensor({camera_centre[0], camera_centre[1], camera_centre[2]}, means.options());
-  const at::Tensor dirs = means - centre;
-  const at::Tensor d = dirs / dirs.norm(2, 1, true).clamp_min(1e-12);
-  const at::Tensor x = d.select(1, 0).unsqueeze(1), y = d.select(1, 1).unsqueeze(1),
-                   z = d.select(1, 2).unsqueeze(1);
-  auto coeff = [&](int k) { return sh.select(1, k); };  // [N, 3]
-  at::Tensor result = 0.28209479177387814 * coeff(0);
-  if (degree > 0) {
-    constexpr double c1 = 0.4886025119029199;
-    result = result - c1 * y * coeff(1) + c1 * z * coeff(2) - c1 * x * coeff(3);
-    if (degree > 1) {
-      const at::Tensor xx = x * x, yy = y * y, zz = z * z, xy = x * y, yz = y * z, xz = x * z;
-      result = result + 1.0925484305920792 * xy * coeff(4) - 1.0925484305920792 * yz * coeff(5) +
-               0.31539156525252005 * (2.0 * zz - xx - yy) * coeff(6) -
-               1.0925484305920792 * xz * coeff(7) + 0.5462742152960396 * (xx - yy) * coeff(8);
-      if (degree > 2) {
-        result = result - 0.5900435899266435 * y * (3.0 * xx - yy) * coeff(9) +
-                 2.890611442640554 * xy * z * coeff(10) -
-                 0.4570457994644658 * y * (4.0 * zz - xx - yy) * coeff(11) +
-                 0.3731763325901154 * z * (2.0 * zz - 3.0 * xx - 3.0 * yy) * coeff(12) -
-                 0.4570457994644658 * x * (4.0 * zz - xx - yy) * coeff(13) +
-                 1.445305721320277 * z * (xx - yy) * coeff(14) -
-                 0.5900435899266435 * x * (xx - 3.0 * yy) * coeff(15);
-      }
-    }
+  const int64_t n = means.size(0);
+  expectTensor(means, "means", n, {3}, means);
+  expectTensor(sh, "sh", n, {-1, 3}, means);
+  if (sh.size(1) < (degree + 1) * (degree + 1)) {
+    throw Error("<render>", "sh",
+                "at least " + std::to_string((degree + 1) * (degree + 1)) +
+                    " coefficients for SH degree " + std::to_string(degree),
+                std::to_string(sh.size(1)));
   }
-  return (result + 0.5).clamp_min(0.0);
+  return ShFunction::apply(sh, means,
+                           std::vector<double>{camera_centre[0], camera_centre[1],
+                                               camera_centre[2], double(degree)})[0];
 }
 
 std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Tensor& quats,

@@ -399,6 +399,114 @@ SADSPLAT_HD void pixelAlphaBackward(const T mean2d[2], const T conic[3], T opaci
   g_conic[2] += T(-0.5) * dy * dy * g_power;
 }
 
+/// Real spherical-harmonics basis (degree <= 3, the constants of 3DGS) at the unit direction d;
+/// writes (degree + 1)^2 values.
+template <typename T>
+SADSPLAT_HD void shBasis(const T d[3], int degree, T b[16]) {
+  const T x = d[0], y = d[1], z = d[2];
+  b[0] = T(0.28209479177387814);
+  if (degree < 1) return;
+  const T C1 = T(0.4886025119029199);
+  b[1] = -C1 * y;
+  b[2] = C1 * z;
+  b[3] = -C1 * x;
+  if (degree < 2) return;
+  const T xx = x * x, yy = y * y, zz = z * z;
+  b[4] = T(1.0925484305920792) * x * y;
+  b[5] = T(-1.0925484305920792) * y * z;
+  b[6] = T(0.31539156525252005) * (T(2) * zz - xx - yy);
+  b[7] = T(-1.0925484305920792) * x * z;
+  b[8] = T(0.5462742152960396) * (xx - yy);
+  if (degree < 3) return;
+  b[9] = T(-0.5900435899266435) * y * (T(3) * xx - yy);
+  b[10] = T(2.890611442640554) * x * y * z;
+  b[11] = T(-0.4570457994644658) * y * (T(4) * zz - xx - yy);
+  b[12] = T(0.3731763325901154) * z * (T(2) * zz - T(3) * xx - T(3) * yy);
+  b[13] = T(-0.4570457994644658) * x * (T(4) * zz - xx - yy);
+  b[14] = T(1.445305721320277) * z * (xx - yy);
+  b[15] = T(-0.5900435899266435) * x * (xx - T(3) * yy);
+}
+
+/// Adds to g_d the gradient with respect to d of sum_k g_b[k] * shBasis(d)[k].
+template <typename T>
+SADSPLAT_HD void shBasisBackward(const T d[3], int degree, const T g_b[16], T g_d[3]) {
+  if (degree < 1) return;
+  const T x = d[0], y = d[1], z = d[2];
+  const T C1 = T(0.4886025119029199);
+  g_d[1] += -C1 * g_b[1];
+  g_d[2] += C1 * g_b[2];
+  g_d[0] += -C1 * g_b[3];
+  if (degree < 2) return;
+  const T xx = x * x, yy = y * y, zz = z * z;
+  const T a4 = T(1.0925484305920792), a5 = T(-1.0925484305920792), a6 = T(0.31539156525252005),
+          a7 = T(-1.0925484305920792), a8 = T(0.5462742152960396);
+  g_d[0] += g_b[4] * a4 * y - g_b[6] * T(2) * a6 * x + g_b[7] * a7 * z + g_b[8] * T(2) * a8 * x;
+  g_d[1] += g_b[4] * a4 * x + g_b[5] * a5 * z - g_b[6] * T(2) * a6 * y - g_b[8] * T(2) * a8 * y;
+  g_d[2] += g_b[5] * a5 * y + g_b[6] * T(4) * a6 * z + g_b[7] * a7 * x;
+  if (degree < 3) return;
+  const T c9 = T(-0.5900435899266435), c10 = T(2.890611442640554), c11 = T(-0.4570457994644658),
+          c12 = T(0.3731763325901154), c13 = T(-0.4570457994644658), c14 = T(1.445305721320277),
+          c15 = T(-0.5900435899266435);
+  g_d[0] += g_b[9] * c9 * T(6) * x * y + g_b[10] * c10 * y * z + g_b[11] * c11 * T(-2) * x * y +
+            g_b[12] * c12 * T(-6) * x * z + g_b[13] * c13 * (T(4) * zz - T(3) * xx - yy) +
+            g_b[14] * c14 * T(2) * x * z + g_b[15] * c15 * (T(3) * xx - T(3) * yy);
+  g_d[1] += g_b[9] * c9 * (T(3) * xx - T(3) * yy) + g_b[10] * c10 * x * z +
+            g_b[11] * c11 * (T(4) * zz - xx - T(3) * yy) + g_b[12] * c12 * T(-6) * y * z +
+            g_b[13] * c13 * T(-2) * x * y + g_b[14] * c14 * T(-2) * y * z +
+            g_b[15] * c15 * T(-6) * x * y;
+  g_d[2] += g_b[10] * c10 * x * y + g_b[11] * c11 * T(8) * y * z +
+            g_b[12] * c12 * (T(6) * zz - T(3) * xx - T(3) * yy) + g_b[13] * c13 * T(8) * x * z +
+            g_b[14] * c14 * (xx - yy);
+}
+
+/// Colour of one Gaussian (3DGS): SH of `degree` in the direction from the camera centre to the
+/// mean, + 0.5, clamped at 0. `sh` holds K >= (degree+1)^2 coefficients, [k][channel].
+template <typename T>
+SADSPLAT_HD void shColor(const T* sh, int degree, const T mean[3], const T campos[3], T color[3]) {
+  T d[3] = {mean[0] - campos[0], mean[1] - campos[1], mean[2] - campos[2]};
+  const T norm = mmax(msqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), T(1e-12));
+  for (int i = 0; i < 3; ++i) d[i] /= norm;
+  T b[16];
+  shBasis(d, degree, b);
+  const int K = (degree + 1) * (degree + 1);
+  for (int c = 0; c < 3; ++c) {
+    T v = T(0.5);
+    for (int k = 0; k < K; ++k) v += b[k] * sh[3 * k + c];
+    color[c] = mmax(v, T(0));
+  }
+}
+
+/// Backward of shColor: adds the gradients of sh (first (degree+1)^2 rows) and of the mean.
+template <typename T>
+SADSPLAT_HD void shColorBackward(const T* sh, int degree, const T mean[3], const T campos[3],
+                                 const T g_color[3], T* g_sh, T g_mean[3]) {
+  T d[3] = {mean[0] - campos[0], mean[1] - campos[1], mean[2] - campos[2]};
+  const T norm = mmax(msqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), T(1e-12));
+  for (int i = 0; i < 3; ++i) d[i] /= norm;
+  T b[16];
+  shBasis(d, degree, b);
+  const int K = (degree + 1) * (degree + 1);
+  T g[3];
+  for (int c = 0; c < 3; ++c) {
+    T v = T(0.5);
+    for (int k = 0; k < K; ++k) v += b[k] * sh[3 * k + c];
+    g[c] = v > T(0) ? g_color[c] : T(0);  // the clamp at 0
+  }
+  T g_b[16];
+  for (int k = 0; k < K; ++k) {
+    g_b[k] = T(0);
+    for (int c = 0; c < 3; ++c) {
+      g_sh[3 * k + c] += b[k] * g[c];
+      g_b[k] += sh[3 * k + c] * g[c];
+    }
+  }
+  T g_d[3] = {T(0), T(0), T(0)};
+  shBasisBackward(d, degree, g_b, g_d);
+  // d = v / |v|: dL/dv = (g_d - d (d . g_d)) / |v|.
+  const T dot = d[0] * g_d[0] + d[1] * g_d[1] + d[2] * g_d[2];
+  for (int i = 0; i < 3; ++i) g_mean[i] += (g_d[i] - d[i] * dot) / norm;
+}
+
 }  // namespace raster
 }  // namespace gaussians
 }  // namespace sadsplat
