@@ -4,6 +4,8 @@
 #include <ATen/Parallel.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -180,6 +182,19 @@ Binning binGaussians(const T* means2d, const int* radii, const T* depths, int64_
   return b;
 }
 
+// Below this power a Gaussian's alpha is certainly under kMinAlpha, so pixelAlpha (and its exp)
+// can be skipped; the 1e-3 margin leaves every borderline case to pixelAlpha itself, so results
+// are exactly those of the CUDA backend's unconditional calls.
+template <typename T>
+std::vector<T> skipThresholds(const T* opacities, int64_t n) {
+  std::vector<T> thresholds(static_cast<std::size_t>(n));
+  for (int64_t i = 0; i < n; ++i) {
+    thresholds[i] = opacities[i] > T(0) ? std::log(T(kMinAlpha) / opacities[i]) - T(1e-3)
+                                        : std::numeric_limits<T>::infinity();
+  }
+  return thresholds;
+}
+
 }  // namespace
 
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
@@ -204,6 +219,7 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     T* img = out.image.data_ptr<T>();
     T* alpha_out = out.alpha.data_ptr<T>();
     int* last_out = out.last.data_ptr<int>();
+    const std::vector<T> skip = skipThresholds(op, n);
     const int tiles_x = tileGrid(width, height).first;
     const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
@@ -219,6 +235,8 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
             int last = 0;
             for (int k = start; k < stop; ++k) {
               const int g = ids[k];
+              const T* mg = m2 + 2 * g;
+              if (gaussianPower(co + 3 * g, mg[0] - fx, mg[1] - fy) < skip[g]) continue;
               T G;
               bool clamped;
               const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
@@ -268,6 +286,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const int* ranges = fwd.binning.tile_ranges.data_ptr<int>();
     const int* ids = fwd.binning.gaussian_ids.data_ptr<int>();
     T* buf_base = buffers.data_ptr<T>();
+    const std::vector<T> skip = skipThresholds(op, n);
     const int tiles_x = tileGrid(width, height).first;
     const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
@@ -288,6 +307,8 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
             T last_alpha = T(0);
             for (int k = start + last_fwd[pix] - 1; k >= start; --k) {
               const int g = ids[k];
+              const T* mg = m2 + 2 * g;
+              if (gaussianPower(co + 3 * g, mg[0] - fx, mg[1] - fy) < skip[g]) continue;
               T G;
               bool clamped;
               const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
