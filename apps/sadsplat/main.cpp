@@ -18,6 +18,9 @@
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
+#if SADSPLAT_HAVE_OPENCV
+#include "sadsplat/synth/aerial_benchmark.h"
+#endif
 
 namespace {
 
@@ -92,6 +95,50 @@ int runDemo(const std::string& scene_dir, const std::string& out_dir) {
   return same ? 0 : 1;
 }
 
+#if SADSPLAT_HAVE_OPENCV
+struct SynthArgs {
+  std::string kind = "city";
+  std::uint64_t seed = 0;
+  std::string preset;
+  int views = -1, width = -1, height = -1, points = -1;
+  std::vector<int> labelled;
+  std::string out;
+  bool preview = false;
+};
+
+int runSynth(const SynthArgs& a) {
+  using namespace sadsplat;
+  const synth::SceneKind kind = synth::parseSceneKind(a.kind);
+  synth::SynthOptions o;
+  if (a.preset == "demo") {
+    o = synth::SynthOptions::demo(kind, a.seed);
+  } else if (a.preset.empty() || a.preset == "full") {
+    o.kind = kind;
+    o.seed = a.seed;
+  } else {
+    throw Error("<command line>", "--preset", "demo or full", a.preset);
+  }
+  if (a.views > 0) o.views = a.views;
+  if (a.width > 0) o.width = a.width;
+  if (a.height > 0) o.height = a.height;
+  if (a.points > 0) o.max_points = a.points;
+  if (!a.labelled.empty()) o.labelled = a.labelled;
+  std::cout << "generating " << a.kind << " seed " << a.seed << ": " << o.views << " views of "
+            << o.width << "x" << o.height << " ..." << std::flush;
+  const synth::SynthScene scene = synth::generate(o);
+  std::cout << " " << scene.seconds << " s, " << scene.points.size() << " sparse points\n";
+  synth::writeScene(scene, a.out);
+  if (a.preview) synth::writeContactSheet(scene, a.out + "/preview.png");
+  const synth::SynthStats stats = synth::computeStats(scene);
+  std::cout << "effective pixels: " << 100.0 * stats.effective_share << " %\nclass shares:";
+  for (std::size_t c = 0; c < scene.classes.size(); ++c) {
+    std::cout << " " << scene.classes[c].name << " " << 100.0 * stats.class_share[c] << "%";
+  }
+  std::cout << "\nwrote " << a.out << "\n";
+  return 0;
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -130,6 +177,21 @@ int main(int argc, char** argv) {
   std::string demo_out = "out/demo";
   demo->add_option("--scene", demo_scene, "scene directory")->capture_default_str();
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
+
+#if SADSPLAT_HAVE_OPENCV
+  auto* synth_cmd = app.add_subcommand("synth", "Generate a procedural aerial benchmark scene");
+  SynthArgs synth_args;
+  synth_cmd->add_option("--kind", synth_args.kind, "city, country or port")->capture_default_str();
+  synth_cmd->add_option("--seed", synth_args.seed, "scene seed")->capture_default_str();
+  synth_cmd->add_option("--preset", synth_args.preset, "demo (320x180) or full (1600x900)");
+  synth_cmd->add_option("--views", synth_args.views, "number of views (70)");
+  synth_cmd->add_option("--width", synth_args.width, "image width (1600)");
+  synth_cmd->add_option("--height", synth_args.height, "image height (900)");
+  synth_cmd->add_option("--points", synth_args.points, "sparse points to keep");
+  synth_cmd->add_option("--labelled", synth_args.labelled, "labelled views (0,7,28)")->delimiter(',');
+  synth_cmd->add_option("--out", synth_args.out, "scene directory to write")->required();
+  synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
+#endif
 
   CLI11_PARSE(app, argc, argv);
   try {
@@ -170,6 +232,10 @@ int main(int argc, char** argv) {
       filter.filter(out);
       saveGaussians(extract_out, out);
       std::cout << "kept " << out.size() << " of " << cloud->size() << " Gaussians\n";
+#if SADSPLAT_HAVE_OPENCV
+    } else if (*synth_cmd) {
+      return runSynth(synth_args);
+#endif
     } else if (*demo) {
       return runDemo(demo_scene, demo_out);
     }

@@ -1,0 +1,515 @@
+#include "sadsplat/synth/aerial_benchmark.h"
+
+#include <sys/stat.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/colmap.h"
+
+namespace sadsplat {
+namespace synth {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Vec3 {
+  float x, y, z;
+};
+Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3 normalize(Vec3 a) {
+  const float n = std::sqrt(dot(a, a));
+  return {a.x / n, a.y / n, a.z / n};
+}
+
+// A posed camera: world-to-camera rows (right, down, forward) and centre.
+struct Pose {
+  Vec3 centre;
+  Vec3 rows[3];
+};
+
+Pose orbitPose(const World& world, const SynthOptions& o, int i) {
+  const std::uint64_t s = o.seed;
+  const double theta = 2 * kPi * i / o.views + 0.03 * (hash01(s, 41, i) - 0.5);
+  const double phase = 2 * kPi * hash01(s, 42), phase2 = 2 * kPi * hash01(s, 43);
+  const double pitch = (42.0 + 14.0 * std::sin(2 * theta + phase)) * kPi / 180.0;
+  const double base = 0.85 * world.extent() / std::tan(o.horizontal_fov_deg * kPi / 360.0);
+  const double dist = base * (1.0 + 0.08 * std::sin(3 * theta + phase2));
+  const Vec3 target = {static_cast<float>(8 * (hash01(s, 44, i) - 0.5)),
+                       static_cast<float>(8 * (hash01(s, 45, i) - 0.5)), 0.f};
+  Pose p;
+  p.centre = {static_cast<float>(dist * std::cos(pitch) * std::cos(theta)),
+              static_cast<float>(dist * std::cos(pitch) * std::sin(theta)),
+              static_cast<float>(dist * std::sin(pitch))};
+  const Vec3 forward = normalize(target - p.centre);
+  const Vec3 right = normalize(cross(forward, {0, 0, 1}));
+  const Vec3 down = cross(forward, right);
+  p.rows[0] = right;
+  p.rows[1] = down;
+  p.rows[2] = forward;
+  return p;
+}
+
+std::array<double, 4> rotationToQuaternion(const Pose& p) {
+  const double R[3][3] = {{p.rows[0].x, p.rows[0].y, p.rows[0].z},
+                          {p.rows[1].x, p.rows[1].y, p.rows[1].z},
+                          {p.rows[2].x, p.rows[2].y, p.rows[2].z}};
+  std::array<double, 4> q{};
+  const double tr = R[0][0] + R[1][1] + R[2][2];
+  if (tr > 0) {
+    const double s = std::sqrt(tr + 1.0) * 2;
+    q = {0.25 * s, (R[2][1] - R[1][2]) / s, (R[0][2] - R[2][0]) / s, (R[1][0] - R[0][1]) / s};
+  } else {
+    int i = 0;
+    if (R[1][1] > R[0][0]) i = 1;
+    if (R[2][2] > R[i][i]) i = 2;
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const double s = std::sqrt(1.0 + R[i][i] - R[j][j] - R[k][k]) * 2;
+    q[0] = (R[k][j] - R[j][k]) / s;
+    q[1 + i] = 0.25 * s;
+    q[1 + j] = (R[j][i] + R[i][j]) / s;
+    q[1 + k] = (R[k][i] + R[i][k]) / s;
+  }
+  if (q[0] < 0) {
+    for (double& v : q) v = -v;
+  }
+  return q;
+}
+
+float noise(float x, float y, std::uint64_t seed) { return valueNoise(x, y, seed); }
+
+// Texture and light of a surface point seen along `dir` (unit, from the camera).
+Vec3 shade(const World& world, const Hit& h, Vec3 dir, Vec3 sun, std::uint64_t seed) {
+  const float px = h.p[0], py = h.p[1], pz = h.p[2];
+  Vec3 base = {h.color[0], h.color[1], h.color[2]};
+  Vec3 n = {h.n[0], h.n[1], h.n[2]};
+  float tex = 1.f, spec_strength = 0.f, shininess = 40.f;
+  switch (h.material) {
+    case Material::kAsphalt:
+      tex = 0.88f + 0.2f * noise(px / 1.3f, py / 1.3f, seed + 1) + 0.06f * noise(px * 3, py * 3, seed + 2);
+      break;
+    case Material::kMarking:
+      break;
+    case Material::kPaving: {
+      tex = 0.9f + 0.14f * noise(px / 3.f, py / 3.f, seed + 3);
+      const float gx = std::fabs(std::remainder(px, 1.5f)), gy = std::fabs(std::remainder(py, 1.5f));
+      if (gx < 0.06f || gy < 0.06f) tex *= 0.82f;
+      break;
+    }
+    case Material::kGrass:
+      tex = (0.75f + 0.45f * noise(px / 5.f, py / 5.f, seed + 4)) *
+            (0.88f + 0.2f * noise(px * 1.5f, py * 1.5f, seed + 5));
+      break;
+    case Material::kFoliage:
+      tex = 0.62f + 0.7f * noise(px / 0.7f + pz * 0.37f, py / 0.7f - pz * 0.29f, seed + 6);
+      n = normalize({n.x + 0.5f * (noise(px * 2, pz * 2, seed + 7) - 0.5f),
+                     n.y + 0.5f * (noise(py * 2, pz * 2, seed + 8) - 0.5f), n.z});
+      break;
+    case Material::kRoof:
+      tex = (std::fmod(std::fabs(px + 0.3f * py), 0.5f) < 0.25f ? 0.88f : 1.0f) *
+            (0.9f + 0.15f * noise(px / 4.f, py / 4.f, seed + 9));
+      break;
+    case Material::kFlatRoof:
+    case Material::kDeck:
+      tex = 0.82f + 0.25f * noise(px / 2.f, py / 2.f, seed + 10);
+      break;
+    case Material::kWall: {
+      const float u = std::fabs(n.x) > 0.5f ? py : px;
+      const float wu = std::fmod(std::fabs(u), 3.2f), wz = std::fmod(pz, 3.4f);
+      if (pz > 1.f && wu > 0.7f && wu < 2.5f && wz > 1.0f && wz < 2.6f) {
+        base = {0.13f, 0.16f, 0.21f};  // glass
+        spec_strength = 0.5f;
+        shininess = 80.f;
+      } else {
+        tex = 0.95f;
+      }
+      break;
+    }
+    case Material::kCarPaint:
+      spec_strength = 0.35f;
+      break;
+    case Material::kField: {
+      const float v = -std::sin(0.2f) * px + std::cos(0.2f) * py;
+      tex = (0.86f + 0.14f * std::sin(2.f * static_cast<float>(kPi) * v / 0.8f)) *
+            (0.85f + 0.25f * noise(px / 8.f, py / 8.f, seed + 11));
+      break;
+    }
+    case Material::kSoil:
+      tex = 0.78f + 0.4f * noise(px / 2.5f, py / 2.5f, seed + 12);
+      break;
+    case Material::kWater:
+      n = normalize({0.06f * (noise(px / 1.3f, py / 2.1f, seed + 13) - 0.5f),
+                     0.06f * (noise(px / 1.7f, py / 1.1f, seed + 14) - 0.5f), 1.f});
+      tex = 0.9f + 0.15f * noise(px / 9.f, py / 9.f, seed + 15);
+      spec_strength = 0.9f;
+      shininess = 120.f;
+      break;
+    case Material::kHull:
+      tex = 0.9f + 0.1f * noise(px / 3.f, pz / 3.f, seed + 16);
+      break;
+    case Material::kContainer: {
+      const float u = std::fabs(n.x) > 0.5f ? py : px;
+      tex = 0.88f + 0.12f * std::sin(2.f * static_cast<float>(kPi) * u / 0.3f);
+      break;
+    }
+    case Material::kSteel:
+      spec_strength = 0.15f;
+      break;
+    case Material::kConcrete: {
+      tex = 0.9f + 0.14f * noise(px / 5.f, py / 5.f, seed + 17);
+      const float gx = std::fabs(std::remainder(px, 6.f)), gy = std::fabs(std::remainder(py, 6.f));
+      if (gx < 0.08f || gy < 0.08f) tex *= 0.85f;
+      break;
+    }
+    case Material::kOutside:
+      tex = 0.8f + 0.4f * noise(px / 15.f, py / 15.f, seed + 18);
+      break;
+  }
+  const float o[3] = {px + h.n[0] * 0.03f, py + h.n[1] * 0.03f, pz + h.n[2] * 0.03f};
+  const float L[3] = {sun.x, sun.y, sun.z};
+  const bool shadow = dot(n, sun) <= 0.f || world.occluded(o, L, 200.f);
+  const float diffuse = shadow ? 0.f : std::max(0.f, dot(n, sun));
+  const float light = 0.38f + 0.78f * diffuse;
+  Vec3 c = {base.x * tex * light, base.y * tex * light, base.z * tex * light};
+  if (spec_strength > 0.f && !shadow) {
+    const Vec3 half = normalize({sun.x - dir.x, sun.y - dir.y, sun.z - dir.z});
+    const float s = spec_strength * std::pow(std::max(0.f, dot(n, half)), shininess);
+    c = {c.x + s, c.y + s, c.z + s};
+  }
+  // Aerial haze with distance.
+  const float f = 1.f - std::exp(-h.t / 2200.f);
+  const Vec3 haze = {0.72f, 0.77f, 0.83f};
+  return {c.x * (1 - f) + haze.x * f, c.y * (1 - f) + haze.y * f, c.z * (1 - f) + haze.z * f};
+}
+
+std::uint8_t toByte(float v) {
+  return static_cast<std::uint8_t>(std::lround(std::min(1.f, std::max(0.f, v)) * 255.f));
+}
+
+void renderView(const World& world, const SynthOptions& o, const Pose& pose, Vec3 sun,
+                SynthView* view) {
+  const int W = o.width, H = o.height;
+  const auto& cam = view->camera;
+  view->rgb = {W, H, 3, std::vector<std::uint8_t>(static_cast<std::size_t>(W) * H * 3)};
+  view->labels = {W, H, 1, std::vector<std::uint8_t>(static_cast<std::size_t>(W) * H)};
+  view->depth.assign(static_cast<std::size_t>(W) * H, 0.f);
+  const int threads = o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  auto rows = [&](int t) {
+    for (int v = t; v < H; v += threads) {
+      for (int u = 0; u < W; ++u) {
+        const Vec3 dc = {static_cast<float>((u + 0.5 - cam.cx) / cam.fx),
+                         static_cast<float>((v + 0.5 - cam.cy) / cam.fy), 1.f};
+        const float inv = 1.f / std::sqrt(dot(dc, dc));
+        const Vec3 d = {(pose.rows[0].x * dc.x + pose.rows[1].x * dc.y + pose.rows[2].x) * inv,
+                        (pose.rows[0].y * dc.x + pose.rows[1].y * dc.y + pose.rows[2].y) * inv,
+                        (pose.rows[0].z * dc.x + pose.rows[1].z * dc.y + pose.rows[2].z) * inv};
+        const float origin[3] = {pose.centre.x, pose.centre.y, pose.centre.z};
+        const float dir[3] = {d.x, d.y, d.z};
+        Hit hit;
+        const std::size_t pix = static_cast<std::size_t>(v) * W + u;
+        Vec3 color;
+        if (world.trace(origin, dir, 1e5f, &hit)) {
+          color = shade(world, hit, d, sun, o.seed * 131 + 7);
+          view->labels.pixels[pix] = hit.cls;
+          view->depth[pix] = hit.t * inv;  // camera z
+        } else {
+          const float k = std::min(1.f, std::max(0.f, d.z * 4.f));
+          color = {0.76f - 0.3f * k, 0.82f - 0.2f * k, 0.9f - 0.05f * k};
+          view->labels.pixels[pix] = io::kIgnoreLabel;
+        }
+        view->rgb.pixels[3 * pix] = toByte(color.x);
+        view->rgb.pixels[3 * pix + 1] = toByte(color.y);
+        view->rgb.pixels[3 * pix + 2] = toByte(color.z);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(rows, t);
+  rows(0);
+  for (auto& th : pool) th.join();
+}
+
+// Deterministic uniform numbers for point sampling.
+class Sequence {
+ public:
+  explicit Sequence(std::uint64_t seed) : seed_(seed) {}
+  float next() { return hash01(seed_, counter_++); }
+
+ private:
+  std::uint64_t seed_;
+  std::uint64_t counter_ = 0;
+};
+
+bool project(const SynthView& v, const float X[3], float* u, float* w, float* z) {
+  const auto& c = v.camera;
+  double R[9];
+  const double qw = c.qvec[0], qx = c.qvec[1], qy = c.qvec[2], qz = c.qvec[3];
+  R[0] = 1 - 2 * (qy * qy + qz * qz);
+  R[1] = 2 * (qx * qy - qw * qz);
+  R[2] = 2 * (qx * qz + qw * qy);
+  R[3] = 2 * (qx * qy + qw * qz);
+  R[4] = 1 - 2 * (qx * qx + qz * qz);
+  R[5] = 2 * (qy * qz - qw * qx);
+  R[6] = 2 * (qx * qz - qw * qy);
+  R[7] = 2 * (qy * qz + qw * qx);
+  R[8] = 1 - 2 * (qx * qx + qy * qy);
+  double p[3];
+  for (int i = 0; i < 3; ++i) p[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + c.tvec[i];
+  if (p[2] <= 1e-3) return false;
+  *u = static_cast<float>(c.fx * p[0] / p[2] + c.cx);
+  *w = static_cast<float>(c.fy * p[1] / p[2] + c.cy);
+  *z = static_cast<float>(p[2]);
+  return *u >= 0 && *w >= 0 && *u < c.width && *w < c.height;
+}
+
+void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthScene* scene) {
+  Sequence rnd(o.seed * 6700417 + 13);
+  const int V = static_cast<int>(scene->views.size());
+  const int attempts = o.max_points * 10;
+  for (int a = 0; a < attempts && static_cast<int>(scene->points.size()) < o.max_points; ++a) {
+    const int i = std::min(V - 1, static_cast<int>(rnd.next() * V));
+    const SynthView& v = scene->views[i];
+    const int u = std::min(o.width - 1, static_cast<int>(rnd.next() * o.width));
+    const int w = std::min(o.height - 1, static_cast<int>(rnd.next() * o.height));
+    const std::size_t pix = static_cast<std::size_t>(w) * o.width + u;
+    const std::uint8_t cls = v.labels.pixels[pix];
+    const float z = v.depth[pix];
+    if (cls == io::kIgnoreLabel || z <= 0.f) continue;
+    // Back-project the pixel centre; SfM-like noise moves it a little towards the camera, so no
+    // point ends up inside a solid.
+    const float zn = z * (1.f - 0.0002f * rnd.next());
+    const Vec3 dc = {static_cast<float>((u + 0.5 - v.camera.cx) / v.camera.fx),
+                     static_cast<float>((w + 0.5 - v.camera.cy) / v.camera.fy), 1.f};
+    const Pose& p = poses[i];
+    float X[3];
+    X[0] = p.centre.x + zn * (p.rows[0].x * dc.x + p.rows[1].x * dc.y + p.rows[2].x);
+    X[1] = p.centre.y + zn * (p.rows[0].y * dc.x + p.rows[1].y * dc.y + p.rows[2].y);
+    X[2] = p.centre.z + zn * (p.rows[0].z * dc.x + p.rows[1].z * dc.y + p.rows[2].z);
+    SynthPoint point;
+    std::copy(X, X + 3, point.xyz);
+    std::copy(&v.rgb.pixels[3 * pix], &v.rgb.pixels[3 * pix] + 3, point.rgb);
+    point.cls = cls;
+    for (int j = 0; j < V; ++j) {
+      float pu, pv, pz;
+      if (!project(scene->views[j], X, &pu, &pv, &pz)) continue;
+      const std::size_t q = static_cast<std::size_t>(pv) * o.width + static_cast<int>(pu);
+      const float dz = scene->views[j].depth[q];
+      if (dz > 0 && std::fabs(dz - pz) < 0.01f * pz) point.track.push_back({j, {pu, pv}});
+    }
+    if (point.track.size() >= 2) scene->points.push_back(std::move(point));
+  }
+}
+
+void makeDirectory(const std::string& dir) {
+  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
+    throw Error(dir, "directory", "a directory that can be created", std::strerror(errno));
+  }
+}
+
+void writePng(const std::string& path, const cv::Mat& image) {
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw Error(path, "PNG encoding", "success");
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+// NumPy .npy (version 1.0) of a float32 H x W array.
+void writeNpy(const std::string& path, const std::vector<float>& data, int height, int width) {
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
+                       std::to_string(height) + ", " + std::to_string(width) + "), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    out.write("\x93NUMPY\x01\x00", 8);
+    const std::uint16_t len = static_cast<std::uint16_t>(header.size());
+    out.write(reinterpret_cast<const char*>(&len), 2);
+    out << header;
+    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size() * 4));
+  });
+}
+
+cv::Mat colorLabels(const SynthView& v, const std::vector<ClassInfo>& classes) {
+  cv::Mat out(v.labels.height, v.labels.width, CV_8UC3);
+  for (int y = 0; y < out.rows; ++y) {
+    for (int x = 0; x < out.cols; ++x) {
+      const std::uint8_t l = v.labels.at(x, y);
+      cv::Vec3b& px = out.at<cv::Vec3b>(y, x);
+      if (l == io::kIgnoreLabel) {
+        px = {0, 0, 0};
+      } else {
+        px = {classes[l].color[2], classes[l].color[1], classes[l].color[0]};
+      }
+    }
+  }
+  return out;
+}
+
+cv::Mat bgr(const SynthView& v) {
+  cv::Mat rgb(v.rgb.height, v.rgb.width, CV_8UC3, const_cast<std::uint8_t*>(v.rgb.pixels.data()));
+  cv::Mat out;
+  cv::cvtColor(rgb, out, cv::COLOR_RGB2BGR);
+  return out;
+}
+
+}  // namespace
+
+SynthOptions SynthOptions::demo(SceneKind kind, std::uint64_t seed) {
+  SynthOptions o;
+  o.kind = kind;
+  o.seed = seed;
+  o.views = 70;
+  o.width = 320;
+  o.height = 180;
+  o.max_points = 6000;
+  return o;
+}
+
+SynthScene generate(const SynthOptions& o) {
+  if (o.views < 2 || o.width < 16 || o.height < 16) {
+    throw Error("<synth>", "views/width/height", "at least 2 views of at least 16x16 pixels",
+                std::to_string(o.views) + " views of " + std::to_string(o.width) + "x" +
+                    std::to_string(o.height));
+  }
+  for (int l : o.labelled) {
+    if (l < 0 || l >= o.views) {
+      throw Error("<synth>", "--labelled", "view indices below " + std::to_string(o.views),
+                  std::to_string(l));
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const World world(o.kind, o.seed);
+  SynthScene scene;
+  scene.classes = world.classes();
+  const double sun_azimuth = 2 * kPi * hash01(o.seed, 51), sun_elevation = (45 + 15 * hash01(o.seed, 52)) * kPi / 180;
+  const Vec3 sun = {static_cast<float>(std::cos(sun_elevation) * std::cos(sun_azimuth)),
+                    static_cast<float>(std::cos(sun_elevation) * std::sin(sun_azimuth)),
+                    static_cast<float>(std::sin(sun_elevation))};
+  const double f = (o.width / 2.0) / std::tan(o.horizontal_fov_deg * kPi / 360.0);
+  std::vector<Pose> poses;
+  for (int i = 0; i < o.views; ++i) {
+    const Pose pose = orbitPose(world, o, i);
+    poses.push_back(pose);
+    SynthView view;
+    char name[32];
+    std::snprintf(name, sizeof(name), "view_%03d.png", i);
+    view.name = name;
+    view.camera.width = o.width;
+    view.camera.height = o.height;
+    view.camera.fx = view.camera.fy = f;
+    view.camera.cx = o.width / 2.0;
+    view.camera.cy = o.height / 2.0;
+    view.camera.qvec = rotationToQuaternion(pose);
+    for (int r = 0; r < 3; ++r) view.camera.tvec[r] = -dot(pose.rows[r], pose.centre);
+    renderView(world, o, pose, sun, &view);
+    scene.views.push_back(std::move(view));
+  }
+  samplePoints(o, poses, &scene);
+  for (int i = 0; i < o.views; ++i) {
+    const bool test = std::find(o.test.begin(), o.test.end(), i) != o.test.end();
+    if (test) {
+      scene.split.test.push_back(scene.views[i].name);
+    } else {
+      scene.split.train.push_back(scene.views[i].name);
+      if (std::find(o.labelled.begin(), o.labelled.end(), i) != o.labelled.end()) {
+        scene.split.labelled.push_back(scene.views[i].name);
+      }
+    }
+  }
+  scene.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return scene;
+}
+
+void writeScene(const SynthScene& scene, const std::string& dir) {
+  makeDirectory(dir);
+  for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"}) makeDirectory(dir + sub);
+  io::ColmapModel model;
+  io::ColmapCamera cam;
+  cam.id = 1;
+  cam.model = io::CameraModel::kPinhole;
+  const auto& c0 = scene.views.front().camera;
+  cam.width = static_cast<std::uint64_t>(c0.width);
+  cam.height = static_cast<std::uint64_t>(c0.height);
+  cam.params = {c0.fx, c0.fy, c0.cx, c0.cy};
+  model.cameras.push_back(cam);
+  for (std::size_t i = 0; i < scene.views.size(); ++i) {
+    const SynthView& v = scene.views[i];
+    writePng(dir + "/images/" + v.name, bgr(v));
+    cv::Mat labels(v.labels.height, v.labels.width, CV_8UC1, const_cast<std::uint8_t*>(v.labels.pixels.data()));
+    writePng(dir + "/labels/" + v.name, labels);
+    writeNpy(dir + "/depth/" + v.name.substr(0, v.name.size() - 4) + ".npy", v.depth, v.rgb.height, v.rgb.width);
+    io::ColmapImage im;
+    im.id = static_cast<std::uint32_t>(i + 1);
+    im.qvec = v.camera.qvec;
+    im.tvec = v.camera.tvec;
+    im.camera_id = 1;
+    im.name = v.name;
+    model.images.push_back(im);
+  }
+  for (std::size_t k = 0; k < scene.points.size(); ++k) {
+    const SynthPoint& p = scene.points[k];
+    io::ColmapPoint3D out;
+    out.id = k + 1;
+    for (int a = 0; a < 3; ++a) out.xyz[a] = p.xyz[a];
+    for (int a = 0; a < 3; ++a) out.rgb[a] = p.rgb[a];
+    out.error = 0.5;
+    for (const auto& [view, uv] : p.track) {
+      auto& points2d = model.images[view].points2d;
+      out.track.emplace_back(static_cast<std::uint32_t>(view + 1), static_cast<std::uint32_t>(points2d.size()));
+      points2d.push_back({uv[0], uv[1], static_cast<std::int64_t>(k + 1)});
+    }
+    model.points.push_back(std::move(out));
+  }
+  io::writeColmapText(dir + "/sparse/0", model);
+  io::writeClassesJson(dir + "/classes.json", scene.classes);
+  io::writeSplitJson(dir + "/split.json", scene.split);
+}
+
+void writeContactSheet(const SynthScene& scene, const std::string& png_path) {
+  const int V = static_cast<int>(scene.views.size());
+  const int picks[4] = {0, V / 4, V / 2, (3 * V) / 4};
+  const int panel_w = std::min(480, scene.views[0].rgb.width);
+  const int panel_h = panel_w * scene.views[0].rgb.height / scene.views[0].rgb.width;
+  cv::Mat sheet(4 * panel_h, 2 * panel_w, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int r = 0; r < 4; ++r) {
+    const SynthView& v = scene.views[picks[r]];
+    cv::Mat a, b;
+    cv::resize(bgr(v), a, cv::Size(panel_w, panel_h), 0, 0, cv::INTER_AREA);
+    cv::resize(colorLabels(v, scene.classes), b, cv::Size(panel_w, panel_h), 0, 0, cv::INTER_NEAREST);
+    a.copyTo(sheet(cv::Rect(0, r * panel_h, panel_w, panel_h)));
+    b.copyTo(sheet(cv::Rect(panel_w, r * panel_h, panel_w, panel_h)));
+  }
+  writePng(png_path, sheet);
+}
+
+SynthStats computeStats(const SynthScene& scene) {
+  SynthStats s;
+  std::vector<double> counts(scene.classes.size(), 0.0);
+  double labelled = 0, total = 0;
+  for (const auto& v : scene.views) {
+    for (std::uint8_t l : v.labels.pixels) {
+      total += 1;
+      if (l != io::kIgnoreLabel) {
+        counts[l] += 1;
+        labelled += 1;
+      }
+    }
+  }
+  s.class_share.resize(counts.size());
+  for (std::size_t c = 0; c < counts.size(); ++c) s.class_share[c] = labelled > 0 ? counts[c] / labelled : 0;
+  s.effective_share = total > 0 ? labelled / total : 0;
+  return s;
+}
+
+}  // namespace synth
+}  // namespace sadsplat
