@@ -204,32 +204,49 @@ void renderView(const World& world, const SynthOptions& o, const Pose& pose, Vec
   view->labels = {W, H, 1, std::vector<std::uint8_t>(static_cast<std::size_t>(W) * H)};
   view->depth.assign(static_cast<std::size_t>(W) * H, 0.f);
   const int threads = o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  const int ss = std::max(1, o.samples_per_axis);
+  const float origin[3] = {pose.centre.x, pose.centre.y, pose.centre.z};
+  // Unit world direction and 1/|camera direction| of the ray through image point (x, y).
+  auto ray = [&](double x, double y, float dir[3]) {
+    const Vec3 dc = {static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f};
+    const float inv = 1.f / std::sqrt(dot(dc, dc));
+    dir[0] = (pose.rows[0].x * dc.x + pose.rows[1].x * dc.y + pose.rows[2].x) * inv;
+    dir[1] = (pose.rows[0].y * dc.x + pose.rows[1].y * dc.y + pose.rows[2].y) * inv;
+    dir[2] = (pose.rows[0].z * dc.x + pose.rows[1].z * dc.y + pose.rows[2].z) * inv;
+    return inv;
+  };
+  auto radiance = [&](const float dir[3]) {
+    Hit hit;
+    if (world.trace(origin, dir, 1e5f, &hit)) return shade(world, hit, {dir[0], dir[1], dir[2]}, sun, o.seed * 131 + 7);
+    const float k = std::min(1.f, std::max(0.f, dir[2] * 4.f));
+    return Vec3{0.76f - 0.3f * k, 0.82f - 0.2f * k, 0.9f - 0.05f * k};
+  };
   auto rows = [&](int t) {
     for (int v = t; v < H; v += threads) {
       for (int u = 0; u < W; ++u) {
-        const Vec3 dc = {static_cast<float>((u + 0.5 - cam.cx) / cam.fx),
-                         static_cast<float>((v + 0.5 - cam.cy) / cam.fy), 1.f};
-        const float inv = 1.f / std::sqrt(dot(dc, dc));
-        const Vec3 d = {(pose.rows[0].x * dc.x + pose.rows[1].x * dc.y + pose.rows[2].x) * inv,
-                        (pose.rows[0].y * dc.x + pose.rows[1].y * dc.y + pose.rows[2].y) * inv,
-                        (pose.rows[0].z * dc.x + pose.rows[1].z * dc.y + pose.rows[2].z) * inv};
-        const float origin[3] = {pose.centre.x, pose.centre.y, pose.centre.z};
-        const float dir[3] = {d.x, d.y, d.z};
-        Hit hit;
         const std::size_t pix = static_cast<std::size_t>(v) * W + u;
-        Vec3 color;
+        // Label and depth from the pixel centre; colour averaged over ss x ss sub-pixel rays.
+        float dir[3];
+        const float inv = ray(u + 0.5, v + 0.5, dir);
+        Hit hit;
         if (world.trace(origin, dir, 1e5f, &hit)) {
-          color = shade(world, hit, d, sun, o.seed * 131 + 7);
           view->labels.pixels[pix] = hit.cls;
           view->depth[pix] = hit.t * inv;  // camera z
         } else {
-          const float k = std::min(1.f, std::max(0.f, d.z * 4.f));
-          color = {0.76f - 0.3f * k, 0.82f - 0.2f * k, 0.9f - 0.05f * k};
           view->labels.pixels[pix] = io::kIgnoreLabel;
         }
-        view->rgb.pixels[3 * pix] = toByte(color.x);
-        view->rgb.pixels[3 * pix + 1] = toByte(color.y);
-        view->rgb.pixels[3 * pix + 2] = toByte(color.z);
+        Vec3 color = {0, 0, 0};
+        for (int sy = 0; sy < ss; ++sy) {
+          for (int sx = 0; sx < ss; ++sx) {
+            ray(u + (sx + 0.5) / ss, v + (sy + 0.5) / ss, dir);
+            const Vec3 c = radiance(dir);
+            color = {color.x + c.x, color.y + c.y, color.z + c.z};
+          }
+        }
+        const float n = 1.f / (ss * ss);
+        view->rgb.pixels[3 * pix] = toByte(color.x * n);
+        view->rgb.pixels[3 * pix + 1] = toByte(color.y * n);
+        view->rgb.pixels[3 * pix + 2] = toByte(color.z * n);
       }
     }
   };

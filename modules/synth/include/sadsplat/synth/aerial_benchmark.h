@@ -25,6 +25,7 @@ struct SynthOptions {
   std::vector<int> test = {14, 21, 35, 42, 49, 56, 63};        ///< test views (those < views)
   double horizontal_fov_deg = 60.0;
   int max_points = 20000;  ///< sparse points kept (a few thousand to tens of thousands)
+  int samples_per_axis = 2;  ///< colour anti-aliasing: s x s rays per pixel (labels, depth: 1)
   int threads = 0;         ///< 0 = all hardware threads
 
   /// \brief The `--preset demo` size: 320x180, 40 views, 4000 points.

@@ -1,0 +1,173 @@
+// The procedural benchmark: determinism, exact geometry, label/depth/point consistency through the
+// written files, and the scene import of what it writes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/colmap.h"
+#include "sadsplat/io/scene_import.h"
+#include "sadsplat/synth/aerial_benchmark.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+synth::SynthOptions small(synth::SceneKind kind, std::uint64_t seed) {
+  synth::SynthOptions o;
+  o.kind = kind;
+  o.seed = seed;
+  o.views = 10;
+  o.width = 96;
+  o.height = 54;
+  o.max_points = 400;
+  o.labelled = {0, 7};
+  o.test = {3, 6};
+  return o;
+}
+
+// Depth map from a written .npy file (float32, H x W).
+std::vector<float> readNpy(const std::string& path, int* height, int* width) {
+  const std::string bytes = test::readFile(path);
+  EXPECT_EQ(bytes.compare(0, 6, "\x93NUMPY"), 0);
+  std::uint16_t len = 0;
+  std::memcpy(&len, bytes.data() + 8, 2);
+  const std::string header = bytes.substr(10, len);
+  const auto open = header.find("'shape': (");
+  *height = std::stoi(header.substr(open + 10));
+  *width = std::stoi(header.substr(header.find(", ", open + 10) + 2));
+  std::vector<float> data(static_cast<std::size_t>(*height) * *width);
+  std::memcpy(data.data(), bytes.data() + 10 + len, data.size() * 4);
+  return data;
+}
+
+TEST(AerialBenchmark, IsDeterministicAndIndependentOfThreads) {
+  auto o = small(synth::SceneKind::kCity, 3);
+  o.threads = 1;
+  const auto a = synth::generate(o);
+  o.threads = 2;
+  const auto b = synth::generate(o);
+  ASSERT_EQ(a.views.size(), b.views.size());
+  for (std::size_t i = 0; i < a.views.size(); ++i) {
+    EXPECT_EQ(a.views[i].rgb.pixels, b.views[i].rgb.pixels);
+    EXPECT_EQ(a.views[i].labels.pixels, b.views[i].labels.pixels);
+    EXPECT_EQ(a.views[i].depth, b.views[i].depth);
+  }
+  ASSERT_EQ(a.points.size(), b.points.size());
+  test::TempDir d1, d2;
+  synth::writeScene(a, d1.file("s"));
+  synth::writeScene(b, d2.file("s"));
+  std::string listing;
+  ASSERT_EQ(test::runCommand("cd '" + d1.file("s") + "' && find . -type f | sort", &listing), 0);
+  std::istringstream files(listing);
+  std::string f;
+  int compared = 0;
+  while (std::getline(files, f)) {
+    EXPECT_EQ(test::readFile(d1.file("s/" + f)), test::readFile(d2.file("s/" + f))) << f;
+    ++compared;
+  }
+  EXPECT_GE(compared, 10 * 3 + 5);  // images, labels, depth per view + model, classes, split
+  // A different seed gives a different scene.
+  const auto c = synth::generate(small(synth::SceneKind::kCity, 4));
+  EXPECT_NE(a.views[0].rgb.pixels, c.views[0].rgb.pixels);
+}
+
+TEST(AerialBenchmark, RaysHitTheGroundAndObjectsExactly) {
+  const synth::World world(synth::SceneKind::kPort, 1);
+  // Outside the labelled area: plain ground at z = 0, label 255.
+  const float o[3] = {world.extent() + 20.f, 5.f, 50.f}, down[3] = {0.f, 0.f, -1.f};
+  synth::Hit hit;
+  ASSERT_TRUE(world.trace(o, down, 1e4f, &hit));
+  EXPECT_FLOAT_EQ(hit.t, 50.f);
+  EXPECT_EQ(hit.cls, 255);
+  // Straight down onto the top of the tallest object.
+  int tallest = 0;
+  for (int i = 0; i < static_cast<int>(world.objects().size()); ++i) {
+    if (world.objects()[i].hi[2] > world.objects()[tallest].hi[2]) tallest = i;
+  }
+  const auto& ob = world.objects()[tallest];
+  const float top[3] = {0.5f * (ob.lo[0] + ob.hi[0]), 0.5f * (ob.lo[1] + ob.hi[1]), ob.hi[2] + 10.f};
+  ASSERT_TRUE(world.trace(top, down, 1e4f, &hit));
+  EXPECT_NEAR(hit.t, 10.f, 1e-3f);
+  EXPECT_EQ(hit.cls, ob.cls);
+  EXPECT_FLOAT_EQ(hit.n[2], ob.shape == synth::Object::kBox ? 1.f : hit.n[2]);
+  // Upwards from above everything: sky.
+  const float up[3] = {0.f, 0.f, 1.f};
+  EXPECT_FALSE(world.trace(top, up, 1e4f, &hit));
+}
+
+TEST(AerialBenchmark, SparsePointsProjectOntoTheirSurfaceInTheWrittenFiles) {
+  const auto scene = synth::generate(small(synth::SceneKind::kCountry, 2));
+  ASSERT_GE(scene.points.size(), 200u);
+  test::TempDir dir;
+  synth::writeScene(scene, dir.file("s"));
+  // Read back only what was written: COLMAP model and depth/label files.
+  const auto model = io::readColmapModel(dir.file("s/sparse/0"));
+  ASSERT_EQ(model.points.size(), scene.points.size());
+  ASSERT_EQ(model.images.size(), scene.views.size());
+  const auto& cam = model.cameras[0].params;  // fx fy cx cy
+  int checked = 0, label_agree = 0;
+  for (std::size_t k = 0; k < model.points.size(); ++k) {
+    const auto& p = model.points[k];
+    ASSERT_GE(p.track.size(), 2u);
+    for (const auto& [image_id, idx] : p.track) {
+      const auto& im = model.images[image_id - 1];
+      const double w = im.qvec[0], x = im.qvec[1], y = im.qvec[2], z = im.qvec[3];
+      const double R[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                           2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                           2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+      double c[3];
+      for (int r = 0; r < 3; ++r) {
+        c[r] = R[3 * r] * p.xyz[0] + R[3 * r + 1] * p.xyz[1] + R[3 * r + 2] * p.xyz[2] + im.tvec[r];
+      }
+      const double u = cam[0] * c[0] / c[2] + cam[2], v = cam[1] * c[1] / c[2] + cam[3];
+      EXPECT_NEAR(u, im.points2d[idx].x, 1e-2);
+      int H = 0, W = 0;
+      const std::string stem = im.name.substr(0, im.name.size() - 4);
+      const auto depth = readNpy(dir.file("s/depth/" + stem + ".npy"), &H, &W);
+      const int pu = static_cast<int>(u), pv = static_cast<int>(v);
+      ASSERT_TRUE(pu >= 0 && pv >= 0 && pu < W && pv < H);
+      EXPECT_NEAR(depth[pv * W + pu], c[2], 0.01 * c[2]) << "point " << k << " in " << im.name;
+      label_agree += scene.views[image_id - 1].labels.at(pu, pv) == scene.points[k].cls;
+      ++checked;
+    }
+  }
+  // Points near a class boundary may land on the neighbouring pixel's class in another view.
+  EXPECT_GT(label_agree, 0.93 * checked) << label_agree << " of " << checked;
+}
+
+TEST(AerialBenchmark, WrittenScenesLoadThroughTheSceneImport) {
+  const auto scene = synth::generate(small(synth::SceneKind::kPort, 5));
+  test::TempDir dir;
+  synth::writeScene(scene, dir.file("s"));
+  const io::Scene imported = io::importScene(dir.file("s"));
+  ASSERT_EQ(imported.views.size(), 10u);
+  ASSERT_EQ(imported.classes.size(), 8u);
+  EXPECT_EQ(imported.classes[0].name, "water");
+  EXPECT_TRUE(imported.views[0].labelled && imported.views[7].labelled);
+  EXPECT_TRUE(imported.views[3].test && !imported.views[3].train);
+  EXPECT_FALSE(imported.views[1].labelled);
+  EXPECT_EQ(imported.views[4].labels.pixels, scene.views[4].labels.pixels);  // all views labelled
+  EXPECT_EQ(imported.points.size(), scene.points.size());
+  const auto stats = synth::computeStats(scene);
+  double sum = 0;
+  for (double s : stats.class_share) sum += s;
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+  EXPECT_GT(stats.effective_share, 0.5);
+}
+
+TEST(AerialBenchmark, BadOptionsAreClearErrors) {
+  EXPECT_THROW(synth::parseSceneKind("desert"), Error);
+  auto o = small(synth::SceneKind::kCity, 0);
+  o.labelled = {12};
+  try {
+    synth::generate(o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "--labelled");
+  }
+}
+
+}  // namespace
+}  // namespace sadsplat
