@@ -241,9 +241,10 @@ void World::buildCountry() {
   auto river_x = [&](float y) { return river_x_ + 10.f * std::sin(y / 22.f + 2.f * seed_); };
   // Farmsteads away from the road and the river.
   const int farms = rng.integer(2, 4);
-  for (int f = 0; f < farms; ++f) {
+  for (int f = 0, attempts = 0; f < farms && attempts < 200; ++attempts) {
     float fx = rng.uniform(-extent_ + 25, extent_ - 25), fy = rng.uniform(-extent_ + 25, extent_ - 25);
     if (std::fabs(fy - road_y(fx)) < 18 || std::fabs(fx - river_x(fy)) < 22) continue;
+    ++f;
     const int n = rng.integer(1, 4);
     for (int b = 0; b < n; ++b) {
       const float w = rng.uniform(8.f, 22.f), d = rng.uniform(7.f, 14.f);
