@@ -17,6 +17,8 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/pipeline/runs.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/aerial_benchmark.h"
@@ -28,13 +30,6 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-void makeDirectory(const std::string& dir) {
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw sadsplat::Error(dir, "directory", "a directory that can be created",
-                          std::strerror(errno));
-  }
 }
 
 bool endsWith(const std::string& s, const std::string& suffix) {
@@ -54,45 +49,6 @@ void saveGaussians(const std::string& path, const pcl::PointCloud<sadsplat::Gaus
   } else {
     throw sadsplat::Error(path, "output file name", "a name ending in .ply or .pcd");
   }
-}
-
-// `sadsplat demo`: for now the I/O round trip of the fixture scene (import, cache, initial
-// Gaussians, PLY / PCD / semantic PCD), checked end to end. Grows into train + eval.
-int runDemo(const std::string& scene_dir, const std::string& out_dir) {
-  using namespace sadsplat;
-  makeDirectory(out_dir);
-  const auto start = Clock::now();
-  std::cout << "[1/5] importing " << scene_dir << "\n";
-  const io::Scene scene = io::importScene(scene_dir);
-  const std::string cache_path = out_dir + "/scene.cache";
-  std::cout << "[2/5] writing and re-reading the scene cache " << cache_path << "\n";
-  io::writeSceneCache(cache_path, scene);
-  const io::Scene cached = io::readSceneCache(cache_path);
-  std::cout << "[3/5] initial Gaussians from " << cached.points.size() << " sparse points\n";
-  auto cloud = gaussians::initialCloud(cached.points);
-  std::cout << "[4/5] tensors <-> cloud, PLY and PCD round trips\n";
-  const auto tensors = gaussians::fromCloud(cloud);
-  const auto back = gaussians::toCloud(tensors);
-  bool same = back.size() == cloud.size();
-  for (std::size_t i = 0; same && i < cloud.size(); ++i) {
-    same = bitwiseEqual(back[i], cloud[i]);
-  }
-  const std::string ply_path = out_dir + "/initial.ply";
-  io::writeGaussianPly(ply_path, back);
-  const auto from_ply = io::readGaussianPly(ply_path);
-  for (std::size_t i = 0; same && i < cloud.size(); ++i) {
-    same = bitwiseEqual(from_ply[i], cloud[i]);
-  }
-  if (io::havePcdSupport()) {
-    io::savePcd(out_dir + "/initial.pcd", back);
-    io::savePcd(out_dir + "/initial_semantic.pcd", toSemanticCloud(back, cached.classes));
-  }
-  std::cout << "[5/5] done in " << secondsSince(start) << " s\n\n"
-            << io::describeFile(cache_path) << "\n"
-            << io::describeFile(ply_path) << "\n"
-            << "round trips exact: " << (same ? "yes" : "NO") << "\n"
-            << "outputs in " << out_dir << "\n";
-  return same ? 0 : 1;
 }
 
 #if SADSPLAT_HAVE_OPENCV
@@ -172,11 +128,31 @@ int main(int argc, char** argv) {
   extract->add_option("--out", extract_out, "output .ply or .pcd")->required();
   extract->add_flag("--negative", extract_negative, "keep every class except this one");
 
-  auto* demo = app.add_subcommand("demo", "Run the main job on the built-in demo scene");
-  std::string demo_scene = std::string(SADSPLAT_DATA_DIR) + "/tiny_scene";
+  auto* train = app.add_subcommand("train", "Train semantic Gaussians on a scene");
+  std::string train_scene, train_out, train_config_file, train_device;
+  int train_iterations = -1;
+  long long train_seed = -1;
+  double train_scale = 0.5;
+  bool train_resume = false;
+  train->add_option("SCENE", train_scene, "scene directory or scene cache")->required();
+  train->add_option("--out", train_out, "run directory")->required();
+  train->add_option("--config", train_config_file, "JSON file with TrainConfig keys");
+  train->add_option("--iterations", train_iterations, "iterations (paper: 7000)");
+  train->add_option("--device", train_device, "cpu or cuda");
+  train->add_option("--seed", train_seed, "random seed (42)");
+  train->add_option("--scale", train_scale, "image scale when importing a directory")->capture_default_str();
+  train->add_flag("--resume", train_resume, "continue from RUN/checkpoint.bin");
+
+  auto* evaluate = app.add_subcommand("eval", "Evaluate a training run on its test views");
+  std::string eval_run, eval_scene;
+  evaluate->add_option("RUN", eval_run, "run directory")->required();
+  evaluate->add_option("--scene", eval_scene, "scene to evaluate on (default: the run's)");
+
+  auto* demo = app.add_subcommand("demo", "Generate the demo city, train on CPU, evaluate");
   std::string demo_out = "out/demo";
-  demo->add_option("--scene", demo_scene, "scene directory")->capture_default_str();
+  int demo_iterations = 1500;
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
+  demo->add_option("--iterations", demo_iterations, "training iterations")->capture_default_str();
 
 #if SADSPLAT_HAVE_OPENCV
   auto* synth_cmd = app.add_subcommand("synth", "Generate a procedural aerial benchmark scene");
@@ -236,8 +212,27 @@ int main(int argc, char** argv) {
     } else if (*synth_cmd) {
       return runSynth(synth_args);
 #endif
+    } else if (*train) {
+      sadsplat::gaussians::TrainConfig config;
+      if (!train_config_file.empty()) {
+        config = sadsplat::gaussians::TrainConfig::fromJson(
+            sadsplat::io::readWholeFile(train_config_file), train_config_file);
+      }
+      if (train_iterations > 0) config.iterations = train_iterations;
+      if (!train_device.empty()) config.device = train_device;
+      if (train_seed >= 0) config.seed = static_cast<std::uint64_t>(train_seed);
+      sadsplat::pipeline::TrainRunOptions options;
+      options.scene = train_scene;
+      options.out = train_out;
+      options.scale = train_scale;
+      options.resume = train_resume;
+      options.progress = &std::cout;
+      const double seconds = sadsplat::pipeline::trainRun(options, config);
+      std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
+    } else if (*evaluate) {
+      std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
     } else if (*demo) {
-      return runDemo(demo_scene, demo_out);
+      return sadsplat::pipeline::runDemo(demo_out, demo_iterations, std::cout);
     }
   } catch (const sadsplat::Error& e) {
     std::cerr << "sadsplat: error: " << e.what() << "\n";

@@ -1,0 +1,45 @@
+#pragma once
+/// \file evaluation.h
+/// \brief Evaluating a trained model on the test views of a scene: class maps, confusion
+/// matrix, mIoU / mAcc / OA, PSNR / SSIM, metrics.json and per-view PNG panels.
+
+#include <string>
+#include <vector>
+
+#include "sadsplat/eval/metrics.h"
+#include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/io/scene.h"
+
+namespace sadsplat {
+namespace eval {
+
+/// \brief Everything measured on the test views.
+struct EvalResult {
+  ConfusionMatrix confusion{1};
+  double psnr = 0;  ///< mean over test views
+  double ssim = 0;  ///< mean over test views
+  std::vector<std::string> views;
+};
+
+/// \brief Renders every test view (views with a label map; all views with labels if the scene
+/// has no test split) and scores it. If `panel_dir` is not empty and the build has OpenCV, writes
+/// one PNG per view there: image | render | ground truth | prediction | error mask.
+/// \throws sadsplat::Error if the scene has no labelled test view
+EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
+                    const std::string& panel_dir = "");
+
+/// \brief Run facts written next to the metrics.
+struct RunFacts {
+  std::int64_t num_gaussians = 0;
+  int iterations = 0;
+  double train_seconds = 0;
+  std::string device;
+};
+
+/// \brief metrics.json text: miou, macc, oacc, per_class_iou, psnr, ssim, num_gaussians,
+/// iterations, train_seconds, device, classes, confusion_matrix, views.
+std::string metricsJson(const EvalResult& result, const std::vector<ClassInfo>& classes,
+                        const RunFacts& facts);
+
+}  // namespace eval
+}  // namespace sadsplat

@@ -1,0 +1,136 @@
+#include "sadsplat/eval/evaluation.h"
+
+#include <nlohmann/json.hpp>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/image_metrics.h"
+#include "sadsplat/io/atomic_file.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#endif
+
+namespace sadsplat {
+namespace eval {
+namespace {
+
+#if SADSPLAT_HAVE_OPENCV
+cv::Mat classImage(const std::vector<std::uint8_t>& ids, int W, int H,
+                   const std::vector<ClassInfo>& classes) {
+  cv::Mat out(H, W, CV_8UC3);
+  for (int i = 0; i < W * H; ++i) {
+    const auto id = ids[i];
+    cv::Vec3b c(0, 0, 0);
+    if (id < classes.size()) c = {classes[id].color[2], classes[id].color[1], classes[id].color[0]};
+    out.at<cv::Vec3b>(i / W, i % W) = c;
+  }
+  return out;
+}
+
+void writePanel(const std::string& path, const io::View& view, const at::Tensor& render_rgb,
+                const std::vector<std::uint8_t>& pred, const std::vector<ClassInfo>& classes) {
+  const int W = view.camera.width, H = view.camera.height;
+  cv::Mat image(H, W, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.pixels.data()));
+  const at::Tensor bytes = render_rgb.clamp(0, 1).mul(255).round().to(at::kByte).to(at::kCPU).contiguous();
+  cv::Mat render(H, W, CV_8UC3, bytes.data_ptr<std::uint8_t>());
+  cv::Mat error(H, W, CV_8UC3);
+  for (int i = 0; i < W * H; ++i) {
+    const auto gt = view.labels.pixels[i];
+    error.at<cv::Vec3b>(i / W, i % W) =
+        gt == io::kIgnoreLabel ? cv::Vec3b(60, 60, 60)
+                               : (gt == pred[i] ? cv::Vec3b(255, 255, 255) : cv::Vec3b(255, 0, 0));
+  }
+  cv::Mat panel;
+  cv::hconcat(std::vector<cv::Mat>{image, render, classImage(view.labels.pixels, W, H, classes),
+                                   classImage(pred, W, H, classes), error},
+              panel);
+  cv::Mat bgr;
+  cv::cvtColor(panel, bgr, cv::COLOR_RGB2BGR);
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", bgr, png);
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
+#endif
+
+}  // namespace
+
+EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
+                    const std::string& panel_dir) {
+  EvalResult result;
+  result.confusion = ConfusionMatrix(static_cast<int>(scene.classes.size()));
+  bool any_test = false;
+  for (const auto& v : scene.views) any_test = any_test || v.test;
+  double psnr_sum = 0, ssim_sum = 0;
+  for (const io::View& view : scene.views) {
+    if ((any_test && !view.test) || view.labels.empty()) continue;
+    const gaussians::RenderResult r = trainer.renderView(view);
+    const at::Tensor pred = trainer.predictClasses(r).to(at::kCPU).contiguous();
+    std::vector<std::uint8_t> labels = view.labels.pixels;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+      if (view.mask.pixels[i] == 0) labels[i] = io::kIgnoreLabel;
+    }
+    result.confusion.add(labels.data(), pred.data_ptr<std::int64_t>(), labels.size());
+    const int W = view.camera.width, H = view.camera.height;
+    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(view.rgb.pixels.data()), {H, W, 3},
+                                        at::TensorOptions().dtype(at::kByte))
+                              .to(at::kFloat)
+                              .div(255.0)
+                              .to(r.rgb.device());
+    const at::Tensor rgb = r.rgb.clamp(0, 1);
+    psnr_sum += gaussians::psnr(rgb, gt);
+    ssim_sum += gaussians::ssim(rgb, gt).item<double>();
+    result.views.push_back(view.name);
+#if SADSPLAT_HAVE_OPENCV
+    if (!panel_dir.empty()) {
+      std::vector<std::uint8_t> pred8(pred.numel());
+      const std::int64_t* p = pred.data_ptr<std::int64_t>();
+      for (std::size_t i = 0; i < pred8.size(); ++i) pred8[i] = static_cast<std::uint8_t>(p[i]);
+      const std::string stem = view.name.substr(0, view.name.find_last_of('.'));
+      writePanel(panel_dir + "/" + stem + ".png", view, rgb, pred8, scene.classes);
+    }
+#endif
+  }
+  if (result.views.empty()) {
+    throw Error(scene.source, "test views", "at least one test view with a label map");
+  }
+  result.psnr = psnr_sum / result.views.size();
+  result.ssim = ssim_sum / result.views.size();
+  return result;
+}
+
+std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& classes,
+                        const RunFacts& facts) {
+  nlohmann::json per_class = nlohmann::json::object();
+  const auto iou = r.confusion.perClassIou();
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    per_class[classes[c].name] = iou[c] >= 0 ? nlohmann::json(iou[c]) : nlohmann::json(nullptr);
+  }
+  nlohmann::json matrix = nlohmann::json::array();
+  for (int g = 0; g < r.confusion.numClasses(); ++g) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int p = 0; p < r.confusion.numClasses(); ++p) row.push_back(r.confusion.at(g, p));
+    matrix.push_back(row);
+  }
+  nlohmann::json names = nlohmann::json::array();
+  for (const auto& c : classes) names.push_back(c.name);
+  const nlohmann::json j = {{"miou", r.confusion.meanIou()},
+                            {"macc", r.confusion.meanAccuracy()},
+                            {"oacc", r.confusion.overallAccuracy()},
+                            {"per_class_iou", per_class},
+                            {"psnr", r.psnr},
+                            {"ssim", r.ssim},
+                            {"num_gaussians", facts.num_gaussians},
+                            {"iterations", facts.iterations},
+                            {"train_seconds", facts.train_seconds},
+                            {"device", facts.device},
+                            {"classes", names},
+                            {"confusion_matrix", matrix},
+                            {"views", r.views}};
+  return j.dump(2) + "\n";
+}
+
+}  // namespace eval
+}  // namespace sadsplat

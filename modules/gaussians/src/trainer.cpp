@@ -1,0 +1,585 @@
+#include "sadsplat/gaussians/trainer.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <c10/core/GradMode.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/gaussian_tensors.h"
+#include "sadsplat/gaussians/image_metrics.h"
+#include "sadsplat/gaussians/initialization.h"
+#include "sadsplat/gaussians/tensor_archive.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace {
+
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+// A CPU generator for (seed, purpose, iteration): randomness that a resumed run reproduces.
+at::Generator generatorFor(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
+  return at::detail::createCPUGenerator(mix(seed ^ mix(purpose ^ mix(iteration))));
+}
+
+// One optimised tensor with its Adam moments (per-row tensors are resized by densification).
+struct Param {
+  std::string name;
+  at::Tensor value, m, v;
+  double lr = 0;
+  bool per_gaussian = true;
+};
+
+double logit(double p) { return std::log(p / (1 - p)); }
+
+}  // namespace
+
+std::string TrainConfig::toJson() const {
+  nlohmann::json j = {{"iterations", iterations},
+                      {"feature_dim", feature_dim},
+                      {"max_sh_degree", max_sh_degree},
+                      {"sh_increase_interval", sh_increase_interval},
+                      {"lambda_ssim", lambda_ssim},
+                      {"lambda_rgb", lambda_rgb},
+                      {"lambda_semantic", lambda_semantic},
+                      {"semantic_interval", semantic_interval},
+                      {"lr_position_init", lr_position_init},
+                      {"lr_position_final", lr_position_final},
+                      {"lr_sh_dc", lr_sh_dc},
+                      {"lr_sh_rest", lr_sh_rest},
+                      {"lr_opacity", lr_opacity},
+                      {"lr_scaling", lr_scaling},
+                      {"lr_rotation", lr_rotation},
+                      {"lr_feature", lr_feature},
+                      {"lr_decoder", lr_decoder},
+                      {"densify_from", densify_from},
+                      {"densify_until", densify_until},
+                      {"densify_interval", densify_interval},
+                      {"densify_grad_threshold", densify_grad_threshold},
+                      {"percent_dense", percent_dense},
+                      {"min_opacity", min_opacity},
+                      {"opacity_reset_interval", opacity_reset_interval},
+                      {"max_screen_radius", max_screen_radius},
+                      {"checkpoint_interval", checkpoint_interval},
+                      {"seed", seed},
+                      {"background", {background[0], background[1], background[2]}},
+                      {"device", device},
+                      {"max_gaussians", max_gaussians}};
+  return j.dump(2) + "\n";
+}
+
+TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& origin) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(origin, "JSON syntax", "valid JSON", e.what());
+  }
+  if (!j.is_object()) throw Error(origin, "top level", "a JSON object", j.type_name());
+  TrainConfig c;
+  nlohmann::json defaults = nlohmann::json::parse(c.toJson());
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!defaults.contains(it.key())) throw Error(origin, it.key(), "a known configuration key", "unknown");
+    if (it.value().type() != defaults[it.key()].type() &&
+        !(it.value().is_number() && defaults[it.key()].is_number())) {
+      throw Error(origin, it.key(), std::string("a ") + defaults[it.key()].type_name(),
+                  it.value().type_name());
+    }
+    defaults[it.key()] = it.value();
+  }
+  const auto& d = defaults;
+  c.iterations = d["iterations"];
+  c.feature_dim = d["feature_dim"];
+  c.max_sh_degree = d["max_sh_degree"];
+  c.sh_increase_interval = d["sh_increase_interval"];
+  c.lambda_ssim = d["lambda_ssim"];
+  c.lambda_rgb = d["lambda_rgb"];
+  c.lambda_semantic = d["lambda_semantic"];
+  c.semantic_interval = d["semantic_interval"];
+  c.lr_position_init = d["lr_position_init"];
+  c.lr_position_final = d["lr_position_final"];
+  c.lr_sh_dc = d["lr_sh_dc"];
+  c.lr_sh_rest = d["lr_sh_rest"];
+  c.lr_opacity = d["lr_opacity"];
+  c.lr_scaling = d["lr_scaling"];
+  c.lr_rotation = d["lr_rotation"];
+  c.lr_feature = d["lr_feature"];
+  c.lr_decoder = d["lr_decoder"];
+  c.densify_from = d["densify_from"];
+  c.densify_until = d["densify_until"];
+  c.densify_interval = d["densify_interval"];
+  c.densify_grad_threshold = d["densify_grad_threshold"];
+  c.percent_dense = d["percent_dense"];
+  c.min_opacity = d["min_opacity"];
+  c.opacity_reset_interval = d["opacity_reset_interval"];
+  c.max_screen_radius = d["max_screen_radius"];
+  c.checkpoint_interval = d["checkpoint_interval"];
+  c.seed = d["seed"];
+  for (int k = 0; k < 3; ++k) c.background[k] = d["background"][k];
+  c.device = d["device"];
+  c.max_gaussians = d["max_gaussians"];
+  return c;
+}
+
+struct Trainer::State {
+  TrainConfig config;
+  at::Device device{at::kCPU};
+  int iteration = 0;
+  double extent = 1;
+  int num_classes = 0;
+  // Scene data on the device.
+  std::vector<RasterCamera> cameras;
+  std::vector<at::Tensor> images;  // [H, W, 3] float in [0, 1]
+  std::vector<at::Tensor> masks;   // [H, W] float, 1 = valid pixel
+  std::vector<at::Tensor> labels;  // [H, W] int64, -1 = not supervised (empty if unlabelled)
+  std::vector<int> train_views, labelled_views;
+  // Parameters: means, sh_dc, sh_rest, opacity, scales, quats, features; decoder W, b.
+  std::vector<Param> params;
+  at::Tensor log_alpha;  // [N], carried along (trained by the drop, later)
+  // Densification statistics.
+  at::Tensor grad_accum, denom, max_radii;
+  std::int64_t adam_step = 0;
+
+  Param& p(const std::string& name) {
+    for (auto& q : params) {
+      if (q.name == name) return q;
+    }
+    throw Error("<trainer>", name, "a known parameter");
+  }
+  const Param& p(const std::string& name) const { return const_cast<State*>(this)->p(name); }
+  std::int64_t n() const { return params[0].value.size(0); }
+
+  GaussianParams gaussians() const {
+    GaussianParams g;
+    g.means = p("means").value;
+    g.quats = p("quats").value;
+    g.log_scales = p("scales").value;
+    g.opacity_logits = p("opacity").value;
+    g.sh = at::cat({p("sh_dc").value, p("sh_rest").value}, 1);
+    g.features = p("features").value;
+    return g;
+  }
+
+  int shDegree() const {
+    return std::min(config.max_sh_degree, iteration / std::max(1, config.sh_increase_interval));
+  }
+
+  at::Tensor decode(const at::Tensor& features) const {
+    return at::linear(features, p("decoder_w").value, p("decoder_b").value);
+  }
+
+  // Keeps the Gaussians where `keep` is true, then appends `extra` rows (per parameter name).
+  void resize(const at::Tensor& keep, const std::map<std::string, at::Tensor>& extra) {
+    const at::Tensor idx = keep.nonzero().squeeze(1);
+    for (Param& q : params) {
+      if (!q.per_gaussian) continue;
+      at::Tensor value = q.value.detach().index_select(0, idx);
+      at::Tensor m = q.m.index_select(0, idx), v = q.v.index_select(0, idx);
+      const auto it = extra.find(q.name);
+      if (it != extra.end()) {
+        value = at::cat({value, it->second.detach()}, 0);
+        m = at::cat({m, at::zeros_like(it->second)}, 0);
+        v = at::cat({v, at::zeros_like(it->second)}, 0);
+      }
+      q.value = value.contiguous().requires_grad_(true);
+      q.m = m.contiguous();
+      q.v = v.contiguous();
+    }
+    const std::int64_t added = extra.empty() ? 0 : extra.begin()->second.size(0);
+    auto grow = [&](const at::Tensor& t, const at::Tensor& fill) {
+      at::Tensor kept = t.index_select(0, idx);
+      return added > 0 ? at::cat({kept, fill}, 0) : kept;
+    };
+    log_alpha = grow(log_alpha, extra.count("log_alpha") ? extra.at("log_alpha")
+                                                           : at::zeros({added}, log_alpha.options()));
+    grad_accum = grow(grad_accum, at::zeros({added}, grad_accum.options()));
+    denom = grow(denom, at::zeros({added}, denom.options()));
+    max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
+  }
+
+  void densifyAndPrune(bool prune_big) {
+    const double threshold = config.densify_grad_threshold;
+    const at::Tensor avg = grad_accum / denom.clamp_min(1);
+    const at::Tensor scales = p("scales").value.detach().exp();
+    const at::Tensor max_scale = std::get<0>(scales.max(1));
+    const at::Tensor big_grad = avg >= threshold;
+    const double dense = config.percent_dense * extent;
+    const bool room = n() < config.max_gaussians;
+    const at::Tensor clone = room ? big_grad & (max_scale <= dense) : at::zeros_like(big_grad);
+    const at::Tensor split = room ? big_grad & (max_scale > dense) : at::zeros_like(big_grad);
+
+    std::map<std::string, at::Tensor> extra;
+    const at::Tensor clone_idx = clone.nonzero().squeeze(1);
+    const at::Tensor split_idx = split.nonzero().squeeze(1);
+    // Split: two samples from each large Gaussian, scales divided by 1.6 (3DGS).
+    at::Tensor split_means;
+    {
+      const at::Tensor s = scales.index_select(0, split_idx).repeat({2, 1});
+      at::Generator gen = generatorFor(config.seed, 7, static_cast<std::uint64_t>(iteration));
+      const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(device) * s;
+      const at::Tensor q = p("quats").value.detach().index_select(0, split_idx).repeat({2, 1});
+      const at::Tensor qn = q / q.norm(2, 1, true);
+      const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2), z = qn.select(1, 3);
+      const at::Tensor R = at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                                      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                                      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+                                     1)
+                             .view({-1, 3, 3});
+      split_means = at::bmm(R, noise.unsqueeze(2)).squeeze(2) +
+                    p("means").value.detach().index_select(0, split_idx).repeat({2, 1});
+    }
+    for (const Param& q : params) {
+      if (!q.per_gaussian) continue;
+      const at::Tensor src = q.value.detach();
+      const at::Tensor cloned = src.index_select(0, clone_idx);
+      std::vector<int64_t> reps(static_cast<std::size_t>(src.dim()), 1);
+      reps[0] = 2;
+      at::Tensor splitted = src.index_select(0, split_idx).repeat(reps);
+      if (q.name == "means") splitted = split_means;
+      if (q.name == "scales") splitted = splitted - std::log(1.6);
+      extra[q.name] = at::cat({cloned, splitted}, 0);
+    }
+    extra["log_alpha"] = at::cat({log_alpha.index_select(0, clone_idx),
+                                  log_alpha.index_select(0, split_idx).repeat({2})}, 0);
+    // Originals of split Gaussians go; so do transparent (and, later, huge) ones.
+    at::Tensor keep = split.logical_not();
+    const at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
+    at::Tensor remove = opacity < config.min_opacity;
+    if (prune_big) {
+      remove = remove | (max_radii > config.max_screen_radius) | (max_scale > 0.1 * extent);
+    }
+    keep = keep & remove.logical_not();
+    resize(keep, extra);
+    grad_accum.zero_();
+    denom.zero_();
+    max_radii.zero_();
+  }
+};
+
+Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State) {
+  State& s = *state_;
+  s.config = config;
+  if (config.iterations < 1 || config.feature_dim < 0 || config.feature_dim > kFeatureDim ||
+      config.max_sh_degree < 0 || config.max_sh_degree > 3 || config.semantic_interval < 0) {
+    throw Error("<config>", "iterations / feature_dim / max_sh_degree / semantic_interval",
+                "iterations >= 1, feature_dim 0..32, max_sh_degree 0..3, semantic_interval >= 0");
+  }
+  if (config.device == "cuda") {
+    if (!at::hasCUDA()) {
+      throw Error("<config>", "device", "cpu (no CUDA device or no CUDA build here)", "cuda");
+    }
+    s.device = at::Device(at::kCUDA, 0);
+  } else if (config.device != "cpu") {
+    throw Error("<config>", "device", "cpu or cuda", config.device);
+  }
+  if (s.config.densify_until < 0) s.config.densify_until = config.iterations / 2;
+  s.num_classes = static_cast<int>(scene.classes.size());
+  if (s.num_classes < 1) throw Error(scene.source, "classes", "at least one class");
+
+  // Views: images, masks, labels on the device; cameras; scene extent from the camera centres.
+  std::vector<std::array<double, 3>> centres;
+  for (std::size_t i = 0; i < scene.views.size(); ++i) {
+    const io::View& v = scene.views[i];
+    s.cameras.push_back(RasterCamera::fromPinhole(v.camera));
+    centres.push_back(s.cameras.back().centre());
+    if (!v.train) {
+      s.images.emplace_back();
+      s.masks.emplace_back();
+      s.labels.emplace_back();
+      continue;
+    }
+    const int H = v.camera.height, W = v.camera.width;
+    at::Tensor rgb = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()), {H, W, 3},
+                                   at::TensorOptions().dtype(at::kByte))
+                         .to(at::kFloat)
+                         .div(255.0);
+    at::Tensor mask = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()), {H, W},
+                                    at::TensorOptions().dtype(at::kByte))
+                          .to(at::kFloat)
+                          .div(255.0);
+    s.images.push_back(rgb.to(s.device));
+    s.masks.push_back(mask.to(s.device));
+    at::Tensor labels;
+    if (v.labelled && !v.labels.empty()) {
+      labels = at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
+                             at::TensorOptions().dtype(at::kByte))
+                   .to(at::kLong);
+      labels = at::where((labels == io::kIgnoreLabel) | (mask.to(at::kCPU) < 0.5),
+                         at::full_like(labels, -1), labels);
+      s.labelled_views.push_back(static_cast<int>(i));
+    }
+    s.labels.push_back(labels.defined() ? labels.to(s.device) : labels);
+    s.train_views.push_back(static_cast<int>(i));
+  }
+  if (s.train_views.empty()) throw Error(scene.source, "split", "at least one training view");
+  std::array<double, 3> mean{0, 0, 0};
+  for (const auto& c : centres) {
+    for (int k = 0; k < 3; ++k) mean[k] += c[k] / centres.size();
+  }
+  double radius = 0;
+  for (const auto& c : centres) {
+    radius = std::max(radius, std::sqrt(std::pow(c[0] - mean[0], 2) + std::pow(c[1] - mean[1], 2) +
+                                        std::pow(c[2] - mean[2], 2)));
+  }
+  s.extent = std::max(1e-3, 1.1 * radius);
+
+  // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
+  InitOptions init;
+  init.seed = config.seed;
+  const GaussianTensors t = fromCloud(initialCloud(scene.points, init), s.device, config.feature_dim);
+  auto add = [&](const std::string& name, const at::Tensor& value, double lr, bool per_gaussian = true) {
+    Param q;
+    q.name = name;
+    q.value = value.detach().clone().contiguous().requires_grad_(true);
+    q.m = at::zeros_like(q.value);
+    q.v = at::zeros_like(q.value);
+    q.lr = lr;
+    q.per_gaussian = per_gaussian;
+    s.params.push_back(q);
+  };
+  add("means", t.means, config.lr_position_init * s.extent);
+  add("sh_dc", t.sh_dc, config.lr_sh_dc);
+  add("sh_rest", t.sh_rest, config.lr_sh_rest);
+  add("opacity", t.opacity_logit, config.lr_opacity);
+  add("scales", t.log_scales, config.lr_scaling);
+  add("quats", t.rotations, config.lr_rotation);
+  add("features", t.features, config.lr_feature);
+  at::Generator gen = generatorFor(config.seed, 3, 0);
+  const double bound = 1.0 / std::sqrt(std::max(1, config.feature_dim));
+  add("decoder_w",
+      at::empty({s.num_classes, config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),
+      config.lr_decoder, false);
+  add("decoder_b", at::zeros({s.num_classes}, at::TensorOptions().device(s.device)), config.lr_decoder, false);
+  s.log_alpha = t.log_alpha;
+  const auto fopts = at::TensorOptions().dtype(at::kFloat).device(s.device);
+  s.grad_accum = at::zeros({s.n()}, fopts);
+  s.denom = at::zeros({s.n()}, fopts);
+  s.max_radii = at::zeros({s.n()}, fopts);
+}
+
+Trainer::~Trainer() = default;
+
+int Trainer::iteration() const { return state_->iteration; }
+const TrainConfig& Trainer::config() const { return state_->config; }
+std::int64_t Trainer::numGaussians() const { return state_->n(); }
+GaussianParams Trainer::parameters() const { return state_->gaussians(); }
+
+StepStats Trainer::step() {
+  State& s = *state_;
+  const TrainConfig& c = s.config;
+  const int it = s.iteration;
+  // Position learning rate: exponential from init to final over the run (3DGS).
+  const double t = std::min(1.0, static_cast<double>(it) / std::max(1, c.iterations));
+  s.p("means").lr = std::exp(std::log(c.lr_position_init) * (1 - t) + std::log(c.lr_position_final) * t) * s.extent;
+
+  // This iteration's views: the next one of a seeded shuffle of the training views, and every
+  // semantic_interval iterations the next labelled view.
+  auto pick = [&](const std::vector<int>& views, std::uint64_t purpose, int counter) {
+    const int n = static_cast<int>(views.size());
+    const int epoch = counter / n, pos = counter % n;
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::vector<std::uint64_t> keys(n);
+    for (int i = 0; i < n; ++i) keys[i] = mix(c.seed ^ mix(purpose ^ mix(epoch * 1000003ull + i)));
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
+    return views[order[pos]];
+  };
+  std::vector<int> views = {pick(s.train_views, 1, it)};
+  if (!s.labelled_views.empty() && c.semantic_interval > 0 && c.lambda_semantic > 0 &&
+      it % c.semantic_interval == 0) {
+    const int lv = pick(s.labelled_views, 2, it / c.semantic_interval);
+    if (lv != views[0]) views.push_back(lv);
+  }
+
+  RenderSettings settings;
+  settings.sh_degree = s.shDegree();
+  settings.background = c.background;
+  const GaussianParams g = s.gaussians();
+  at::Tensor total;
+  double rgb_sum = 0, sem_sum = 0;
+  std::vector<RenderResult> renders;
+  for (int v : views) {
+    RenderResult r = render(g, s.cameras[v], settings);
+    r.means2d.retain_grad();
+    const at::Tensor& gt = s.images[v];
+    const at::Tensor mask = s.masks[v].unsqueeze(2);
+    const at::Tensor l1 = ((r.rgb - gt).abs() * mask).mean();
+    const at::Tensor rgb_loss = (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
+    at::Tensor loss = c.lambda_rgb * rgb_loss;
+    rgb_sum += rgb_loss.item<double>();
+    const at::Tensor& labels = s.labels[v];
+    if (labels.defined() && c.lambda_semantic > 0 && c.feature_dim > 0) {
+      // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
+      // class-score space of the built-in backend), averaged over supervised pixels only.
+      const at::Tensor supervised = labels >= 0;
+      const at::Tensor logits = s.decode(r.features);
+      const at::Tensor target = labels.clamp_min(0).unsqueeze(2);
+      const at::Tensor cosine = logits.gather(2, target).squeeze(2) / logits.norm(2, 2).clamp_min(1e-8);
+      const at::Tensor count = supervised.sum().clamp_min(1);
+      const at::Tensor sem = ((1 - cosine) * supervised.to(cosine.scalar_type())).sum() / count;
+      loss = loss + c.lambda_semantic * sem;
+      sem_sum += sem.item<double>();
+    }
+    total = total.defined() ? total + loss : loss;
+    renders.push_back(r);
+  }
+  total.backward();
+
+  {
+    c10::AutoGradMode no_grad(false);
+    // Densification statistics: NDC-space screen gradient of visible Gaussians (3DGS).
+    for (std::size_t k = 0; k < renders.size(); ++k) {
+      const RenderResult& r = renders[k];
+      const RasterCamera& cam = s.cameras[views[k]];
+      if (!r.means2d.grad().defined()) continue;
+      const at::Tensor scale = at::tensor({cam.width * 0.5, cam.height * 0.5}, r.means2d.options());
+      const at::Tensor norm = (r.means2d.grad() * scale).norm(2, 1);
+      const at::Tensor visible = r.radii > 0;
+      s.grad_accum += at::where(visible, norm, at::zeros_like(norm));
+      s.denom += visible.to(at::kFloat);
+      s.max_radii = at::where(visible, at::max(s.max_radii, r.radii.to(at::kFloat)), s.max_radii);
+    }
+    // Adam (own implementation so densification can reshape its state).
+    ++s.adam_step;
+    const double b1 = 0.9, b2 = 0.999, eps = 1e-15;
+    const double bc1 = 1 - std::pow(b1, static_cast<double>(s.adam_step));
+    const double bc2 = 1 - std::pow(b2, static_cast<double>(s.adam_step));
+    for (Param& q : s.params) {
+      at::Tensor grad = q.value.grad();
+      if (!grad.defined()) continue;
+      q.m.mul_(b1).add_(grad, 1 - b1);
+      q.v.mul_(b2).addcmul_(grad, grad, 1 - b2);
+      const at::Tensor update = (q.m / bc1) / ((q.v / bc2).sqrt() + eps);
+      q.value.sub_(update * q.lr);
+      q.value.mutable_grad().reset();
+    }
+    s.iteration = it + 1;
+    const int done = s.iteration;
+    if (done <= c.densify_until) {
+      if (done > c.densify_from && done % c.densify_interval == 0) {
+        s.densifyAndPrune(done > c.opacity_reset_interval);
+      }
+      if (c.opacity_reset_interval > 0 && done % c.opacity_reset_interval == 0) {
+        Param& o = s.p("opacity");
+        o.value.clamp_max_(logit(0.01));
+        o.m.zero_();
+        o.v.zero_();
+      }
+    }
+  }
+  StepStats stats;
+  stats.iteration = s.iteration;
+  stats.rgb_loss = rgb_sum / views.size();
+  stats.semantic_loss = sem_sum;
+  stats.loss = total.item<double>();
+  stats.num_gaussians = s.n();
+  return stats;
+}
+
+RenderResult Trainer::renderView(const io::View& view) const {
+  c10::AutoGradMode no_grad(false);
+  RenderSettings settings;
+  settings.sh_degree = state_->shDegree();
+  settings.background = state_->config.background;
+  return render(state_->gaussians(), RasterCamera::fromPinhole(view.camera), settings);
+}
+
+at::Tensor Trainer::predictClasses(const RenderResult& r) const {
+  c10::AutoGradMode no_grad(false);
+  const at::Tensor logits = state_->decode(r.features);
+  // argmax of cos(decoded, one-hot class embedding) = argmax of the decoded vector.
+  return logits.argmax(2);
+}
+
+pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
+  c10::AutoGradMode no_grad(false);
+  const State& s = *state_;
+  GaussianTensors t;
+  t.means = s.p("means").value.detach();
+  t.normals = at::zeros_like(t.means);
+  t.sh_dc = s.p("sh_dc").value.detach();
+  t.sh_rest = s.p("sh_rest").value.detach();
+  t.opacity_logit = s.p("opacity").value.detach();
+  t.log_scales = s.p("scales").value.detach();
+  t.rotations = s.p("quats").value.detach();
+  t.features = s.p("features").value.detach();
+  t.log_alpha = s.log_alpha;
+  t.confidence = at::zeros_like(s.log_alpha);
+  t.labels = t.features.size(1) > 0 ? s.decode(t.features).argmax(1)
+                                    : at::full({s.n()}, -1, t.means.options().dtype(at::kLong));
+  return gaussians::toCloud(t);
+}
+
+void Trainer::saveCheckpoint(const std::string& path) const {
+  const State& s = *state_;
+  TensorArchive a;
+  for (const Param& q : s.params) {
+    a.tensors[q.name] = q.value.detach();
+    a.tensors[q.name + ".m"] = q.m;
+    a.tensors[q.name + ".v"] = q.v;
+  }
+  a.tensors["log_alpha"] = s.log_alpha;
+  a.tensors["grad_accum"] = s.grad_accum;
+  a.tensors["denom"] = s.denom;
+  a.tensors["max_radii"] = s.max_radii;
+  a.numbers["iteration"] = s.iteration;
+  a.numbers["adam_step"] = static_cast<double>(s.adam_step);
+  a.numbers["num_classes"] = s.num_classes;
+  writeTensorArchive(path, a);
+}
+
+void Trainer::loadCheckpoint(const std::string& path) {
+  State& s = *state_;
+  const TensorArchive a = readTensorArchive(path);
+  if (static_cast<int>(a.number("num_classes", path)) != s.num_classes) {
+    throw Error(path, "num_classes", "the scene's class count " + std::to_string(s.num_classes));
+  }
+  for (Param& q : s.params) {
+    const at::Tensor& value = a.tensor(q.name, path);
+    if (!q.per_gaussian && !value.sizes().equals(q.value.sizes())) {
+      throw Error(path, "tensor " + q.name, "the shape of this configuration's " + q.name);
+    }
+    q.value = value.to(s.device).contiguous().requires_grad_(true);
+    q.m = a.tensor(q.name + ".m", path).to(s.device).contiguous();
+    q.v = a.tensor(q.name + ".v", path).to(s.device).contiguous();
+  }
+  s.log_alpha = a.tensor("log_alpha", path).to(s.device);
+  s.grad_accum = a.tensor("grad_accum", path).to(s.device);
+  s.denom = a.tensor("denom", path).to(s.device);
+  s.max_radii = a.tensor("max_radii", path).to(s.device);
+  s.iteration = static_cast<int>(a.number("iteration", path));
+  s.adam_step = static_cast<std::int64_t>(a.number("adam_step", path));
+  checkConsistency();
+}
+
+void Trainer::checkConsistency() const {
+  const State& s = *state_;
+  const std::int64_t n = s.n();
+  auto expect = [&](const at::Tensor& t, const std::string& name) {
+    if (!t.defined() || t.size(0) != n) {
+      throw Error("<trainer>", name, std::to_string(n) + " rows",
+                  t.defined() ? std::to_string(t.size(0)) : "undefined");
+    }
+  };
+  for (const Param& q : s.params) {
+    if (!q.per_gaussian) continue;
+    expect(q.value, q.name);
+    expect(q.m, q.name + " Adam m");
+    expect(q.v, q.name + " Adam v");
+  }
+  expect(s.log_alpha, "log_alpha");
+  expect(s.grad_accum, "grad_accum");
+  expect(s.denom, "denom");
+  expect(s.max_radii, "max_radii");
+}
+
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,200 @@
+#include "sadsplat/pipeline/runs.h"
+
+#include <sys/stat.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/eval/evaluation.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/pcd.h"
+#include "sadsplat/io/scene_cache.h"
+#include "sadsplat/io/scene_import.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include "sadsplat/synth/aerial_benchmark.h"
+#endif
+
+namespace sadsplat {
+namespace pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool isDirectory(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+void makeDirectory(const std::string& dir) {
+  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
+    throw Error(dir, "directory", "a directory that can be created", std::strerror(errno));
+  }
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
+std::string formatSeconds(double s) {
+  std::ostringstream out;
+  const int total = static_cast<int>(std::round(s));
+  out << total / 60 << "m" << std::setw(2) << std::setfill('0') << total % 60 << "s";
+  return out.str();
+}
+
+void writeRunJson(const std::string& dir, const std::string& scene, double scale,
+                  const std::string& device, int iterations, double seconds) {
+  const nlohmann::json j = {{"scene", scene}, {"scale", scale}, {"device", device},
+                            {"iterations", iterations}, {"train_seconds", seconds}};
+  writeText(dir + "/run.json", j.dump(2) + "\n");
+}
+
+void writeModel(const std::string& dir, const gaussians::Trainer& trainer,
+                const std::vector<ClassInfo>& classes) {
+  const auto cloud = trainer.toCloud();
+  io::writeGaussianPly(dir + "/model.ply", cloud);
+  if (io::havePcdSupport()) {
+    io::savePcd(dir + "/model.pcd", cloud);
+    io::savePcd(dir + "/model_semantic.pcd", toSemanticCloud(cloud, classes));
+  }
+}
+
+}  // namespace
+
+io::Scene loadScene(const std::string& path, double scale) {
+  if (isDirectory(path)) {
+    io::ImportOptions options;
+    options.scale = scale;
+    return io::importScene(path, options);
+  }
+  return io::readSceneCache(path);
+}
+
+double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_in) {
+  makeDirectory(o.out);
+  const std::string checkpoint = o.out + "/checkpoint.bin";
+  gaussians::TrainConfig config = config_in;
+  double previous_seconds = 0;
+  if (o.resume) {
+    if (!exists(checkpoint)) throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
+    // The run's own configuration wins: resuming continues the same run.
+    config = gaussians::TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"),
+                                              o.out + "/config.json");
+    config.iterations = config_in.iterations;
+    const auto run = nlohmann::json::parse(io::readWholeFile(o.out + "/run.json"));
+    previous_seconds = run.value("train_seconds", 0.0);
+  }
+  const io::Scene scene = loadScene(o.scene, o.scale);
+  gaussians::Trainer trainer(scene, config);
+  if (o.resume) trainer.loadCheckpoint(checkpoint);
+  writeText(o.out + "/config.json", trainer.config().toJson());
+  const auto start = Clock::now();
+  auto seconds = [&] { return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count(); };
+  const int first = trainer.iteration();
+  while (trainer.iteration() < config.iterations) {
+    const gaussians::StepStats stats = trainer.step();
+    const int it = stats.iteration;
+    if (o.progress && (it % 10 == 0 || it == config.iterations)) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      const double rate = (it - first) / std::max(1e-9, elapsed);
+      *o.progress << "\r[" << it << "/" << config.iterations << "] loss " << std::fixed
+                  << std::setprecision(4) << stats.loss << " (rgb " << stats.rgb_loss << ", sem "
+                  << stats.semantic_loss << ")  gaussians " << stats.num_gaussians << "  "
+                  << std::setprecision(1) << rate << " it/s  ETA "
+                  << formatSeconds((config.iterations - it) / std::max(rate, 1e-9)) << "   "
+                  << std::flush;
+    }
+    if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 && it < config.iterations) {
+      trainer.saveCheckpoint(checkpoint);
+      writeRunJson(o.out, o.scene, o.scale, config.device, it, seconds());
+    }
+  }
+  if (o.progress) *o.progress << "\n";
+  const double total = seconds();
+  trainer.saveCheckpoint(checkpoint);
+  writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);
+  writeModel(o.out, trainer, scene.classes);
+  return total;
+}
+
+std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
+  const auto run = nlohmann::json::parse(io::readWholeFile(run_dir + "/run.json"));
+  const std::string scene_path = scene_override.empty() ? run.at("scene").get<std::string>() : scene_override;
+  const double run_scale = scene_override.empty() ? run.value("scale", scale) : scale;
+  const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
+      io::readWholeFile(run_dir + "/config.json"), run_dir + "/config.json");
+  const io::Scene scene = loadScene(scene_path, run_scale);
+  gaussians::Trainer trainer(scene, config);
+  trainer.loadCheckpoint(run_dir + "/checkpoint.bin");
+  makeDirectory(run_dir + "/panels");
+  const eval::EvalResult result = eval::evaluate(trainer, scene, run_dir + "/panels");
+  eval::RunFacts facts;
+  facts.num_gaussians = trainer.numGaussians();
+  facts.iterations = trainer.iteration();
+  facts.train_seconds = run.value("train_seconds", 0.0);
+  facts.device = config.device;
+  const std::string text = eval::metricsJson(result, scene.classes, facts);
+  writeText(run_dir + "/metrics.json", text);
+  return text;
+}
+
+int runDemo(const std::string& out_dir, int iterations, std::ostream& out) {
+#if SADSPLAT_HAVE_OPENCV
+  makeDirectory(out_dir);
+  const auto start = Clock::now();
+  const std::string scene_dir = out_dir + "/city_demo";
+  out << "[1/3] generating the demo city scene (" << scene_dir << ")\n";
+  const auto scene = synth::generate(synth::SynthOptions::demo(synth::SceneKind::kCity, 0));
+  synth::writeScene(scene, scene_dir);
+  out << "      " << scene.views.size() << " views 320x180, " << scene.points.size()
+      << " sparse points, " << std::fixed << std::setprecision(1) << scene.seconds << " s\n";
+  out << "[2/3] training " << iterations << " iterations on the CPU\n";
+  gaussians::TrainConfig config;
+  config.iterations = iterations;
+  config.sh_increase_interval = std::max(1, iterations / 4);
+  config.densify_from = std::min(config.densify_from, iterations / 10);
+  config.opacity_reset_interval = std::max(iterations, config.opacity_reset_interval);
+  TrainRunOptions o;
+  o.scene = scene_dir;
+  o.out = out_dir + "/run";
+  o.scale = 1.0;
+  o.progress = &out;
+  const double seconds = trainRun(o, config);
+  out << "[3/3] evaluating the test views\n";
+  const auto metrics = nlohmann::json::parse(evalRun(o.out));
+  out << "\n| metric | value |\n|---|---|\n" << std::setprecision(2)
+      << "| mIoU | " << 100 * metrics["miou"].get<double>() << " % |\n"
+      << "| mAcc | " << 100 * metrics["macc"].get<double>() << " % |\n"
+      << "| overall accuracy | " << 100 * metrics["oacc"].get<double>() << " % |\n"
+      << "| PSNR | " << metrics["psnr"].get<double>() << " dB |\n"
+      << "| SSIM | " << std::setprecision(3) << metrics["ssim"].get<double>() << " |\n"
+      << "| Gaussians | " << metrics["num_gaussians"].get<std::int64_t>() << " |\n"
+      << "| training time | " << std::setprecision(1) << seconds << " s |\n"
+      << "| total time | " << std::chrono::duration<double>(Clock::now() - start).count() << " s |\n";
+  out << "per-class IoU:";
+  for (auto it = metrics["per_class_iou"].begin(); it != metrics["per_class_iou"].end(); ++it) {
+    out << " " << it.key() << " "
+        << (it.value().is_null() ? std::string("-") : std::to_string(it.value().get<double>()).substr(0, 5));
+  }
+  out << "\noutputs: " << o.out << " (model.ply, metrics.json, panels/)\n";
+  return 0;
+#else
+  throw Error("<demo>", "build", "a sadsplat build with OpenCV (the demo generates its scene)");
+#endif
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat
