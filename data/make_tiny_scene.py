@@ -153,8 +153,9 @@ def main():
             rgb_rows.append(rgb)
             label_rows.append(lab)
         png(os.path.join(scene, "images", names[i]), W, H, rgb_rows)
-        if i in labelled:
-            png(os.path.join(scene, "labels", names[i]), W, H, label_rows, gray=True)
+        # Every view has its ground truth (the test views need it); split.json says which
+        # training views are labelled, i.e. supervise training.
+        png(os.path.join(scene, "labels", names[i]), W, H, label_rows, gray=True)
 
     # Sparse points: surface samples seen (unoccluded, in frame) from at least two views.
     rng = random.Random(7)

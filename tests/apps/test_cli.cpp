@@ -60,8 +60,29 @@ TEST(Cli, ImportInfoExtractAndDemoWorkOnTheFixture) {
                              dir.file("s.cache") + " --out " + dir.file("w.ply"), &out), 1);
   EXPECT_NE(out.find("one of: road, grass, building"), std::string::npos) << out;
 
-  ASSERT_EQ(test::runCommand(kCli + " demo --out " + dir.file("demo"), &out), 0) << out;
-  EXPECT_NE(out.find("round trips exact: yes"), std::string::npos) << out;
+}
+
+TEST(Cli, TrainEvalAndResumeOnTheFixture) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  test::TempDir dir;
+  std::string out;
+  const std::string run = dir.file("run");
+  ASSERT_EQ(test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 30 --out " + run, &out), 0)
+      << out;
+  for (const char* f : {"model.ply", "config.json", "run.json", "checkpoint.bin"}) {
+    EXPECT_FALSE(test::readFile(run + "/" + f).empty()) << f;
+  }
+  ASSERT_EQ(test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 40 --resume --out " + run, &out), 0)
+      << out;
+  EXPECT_NE(out.find("[40/40]"), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(kCli + " eval " + run, &out), 0) << out;
+  for (const char* key : {"\"miou\"", "\"macc\"", "\"oacc\"", "\"per_class_iou\"", "\"psnr\"", "\"ssim\"",
+                          "\"num_gaussians\"", "\"iterations\": 40", "\"train_seconds\"", "\"device\""}) {
+    EXPECT_NE(out.find(key), std::string::npos) << key;
+  }
+  EXPECT_FALSE(test::readFile(run + "/panels/view_002.png").empty());
+  EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out), 1);
+  EXPECT_NE(out.find("device"), std::string::npos) << out;
 }
 
 }  // namespace

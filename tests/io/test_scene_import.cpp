@@ -43,7 +43,8 @@ TEST_F(SceneImport, ReadsTheFixtureWithRolesLabelsAndPoints) {
   EXPECT_EQ(v0.name, "view_000.png");
   EXPECT_TRUE(v0.train && v0.labelled && !v0.test);
   EXPECT_TRUE(scene.views[2].test && !scene.views[2].train);
-  EXPECT_TRUE(scene.views[1].labels.empty());
+  EXPECT_FALSE(scene.views[1].labelled);
+  EXPECT_FALSE(scene.views[1].labels.empty());  // ground truth exists for every view
   ASSERT_EQ(v0.labels.pixels.size(), 64u * 48u);
   EXPECT_EQ(v0.camera.width, 64);
   EXPECT_DOUBLE_EQ(v0.camera.fx, 52.0);

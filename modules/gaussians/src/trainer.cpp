@@ -42,6 +42,17 @@ double logit(double p) { return std::log(p / (1 - p)); }
 
 }  // namespace
 
+at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
+                        const at::Tensor& weight, const at::Tensor& bias) {
+  const at::Tensor supervised = labels >= 0;
+  const at::Tensor logits = at::linear(features, weight, bias);
+  const at::Tensor target = labels.clamp_min(0).unsqueeze(2);
+  const at::Tensor cosine = logits.gather(2, target).squeeze(2) / logits.norm(2, 2).clamp_min(1e-8);
+  // where() (not a multiplication by the mask) so unsupervised pixels get exactly zero gradient.
+  const at::Tensor per_pixel = at::where(supervised, 1 - cosine, at::zeros_like(cosine));
+  return per_pixel.sum() / supervised.sum().clamp_min(1).to(per_pixel.scalar_type());
+}
+
 std::string TrainConfig::toJson() const {
   nlohmann::json j = {{"iterations", iterations},
                       {"feature_dim", feature_dim},
@@ -419,12 +430,8 @@ StepStats Trainer::step() {
     if (labels.defined() && c.lambda_semantic > 0 && c.feature_dim > 0) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
       // class-score space of the built-in backend), averaged over supervised pixels only.
-      const at::Tensor supervised = labels >= 0;
-      const at::Tensor logits = s.decode(r.features);
-      const at::Tensor target = labels.clamp_min(0).unsqueeze(2);
-      const at::Tensor cosine = logits.gather(2, target).squeeze(2) / logits.norm(2, 2).clamp_min(1e-8);
-      const at::Tensor count = supervised.sum().clamp_min(1);
-      const at::Tensor sem = ((1 - cosine) * supervised.to(cosine.scalar_type())).sum() / count;
+      const at::Tensor sem =
+          semanticLoss(r.features, labels, s.p("decoder_w").value, s.p("decoder_b").value);
       loss = loss + c.lambda_semantic * sem;
       sem_sum += sem.item<double>();
     }

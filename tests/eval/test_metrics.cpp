@@ -1,0 +1,40 @@
+#include <gtest/gtest.h>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/eval/metrics.h"
+
+namespace sadsplat {
+namespace {
+
+TEST(ConfusionMatrix, MetricsMatchAHandComputedExample) {
+  // gt:   0 0 0 1 1 2 255 2
+  // pred: 0 0 1 1 0 2   1 2
+  const std::uint8_t gt[] = {0, 0, 0, 1, 1, 2, 255, 2};
+  const std::int64_t pred[] = {0, 0, 1, 1, 0, 2, 1, 2};
+  eval::ConfusionMatrix cm(4);  // class 3 never occurs
+  cm.add(gt, pred, 8);
+  EXPECT_EQ(cm.total(), 7);
+  EXPECT_EQ(cm.at(0, 0), 2);
+  EXPECT_EQ(cm.at(0, 1), 1);
+  EXPECT_EQ(cm.at(1, 0), 1);
+  // IoU: class 0: 2 / (2 + 1 + 1) = 0.5; class 1: 1 / (1 + 1 + 1) = 1/3; class 2: 1; class 3: absent.
+  const auto iou = cm.perClassIou();
+  EXPECT_DOUBLE_EQ(iou[0], 0.5);
+  EXPECT_DOUBLE_EQ(iou[1], 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(iou[2], 1.0);
+  EXPECT_EQ(iou[3], -1.0);
+  EXPECT_DOUBLE_EQ(cm.meanIou(), (0.5 + 1.0 / 3.0 + 1.0) / 3.0);
+  // Accuracy per gt class: 2/3, 1/2, 2/2.
+  EXPECT_DOUBLE_EQ(cm.meanAccuracy(), (2.0 / 3.0 + 0.5 + 1.0) / 3.0);
+  EXPECT_DOUBLE_EQ(cm.overallAccuracy(), 5.0 / 7.0);
+}
+
+TEST(ConfusionMatrix, RejectsPredictionsOutsideTheClasses) {
+  eval::ConfusionMatrix cm(2);
+  const std::uint8_t gt[] = {0};
+  const std::int64_t pred[] = {5};
+  EXPECT_THROW(cm.add(gt, pred, 1), Error);
+}
+
+}  // namespace
+}  // namespace sadsplat
