@@ -20,8 +20,9 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
-#if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/aerial_benchmark.h"
+#if SADSPLAT_HAVE_OPENCV
+#include "sadsplat/synth/scene_writer.h"
 #endif
 
 namespace {
@@ -51,7 +52,6 @@ void saveGaussians(const std::string& path, const pcl::PointCloud<sadsplat::Gaus
   }
 }
 
-#if SADSPLAT_HAVE_OPENCV
 struct SynthArgs {
   std::string kind = "city";
   std::uint64_t seed = 0;
@@ -59,6 +59,7 @@ struct SynthArgs {
   int views = -1, width = -1, height = -1, points = -1;
   std::vector<int> labelled;
   std::string out;
+  std::string cache;
   bool preview = false;
 };
 
@@ -83,17 +84,24 @@ int runSynth(const SynthArgs& a) {
             << o.width << "x" << o.height << " ..." << std::flush;
   const synth::SynthScene scene = synth::generate(o);
   std::cout << " " << scene.seconds << " s, " << scene.points.size() << " sparse points\n";
-  synth::writeScene(scene, a.out);
-  if (a.preview) synth::writeContactSheet(scene, a.out + "/preview.png");
+  if (!a.cache.empty()) io::writeSceneCache(a.cache, synth::toScene(scene));
+  if (!a.out.empty()) {
+#if SADSPLAT_HAVE_OPENCV
+    synth::writeScene(scene, a.out);
+    if (a.preview) synth::writeContactSheet(scene, a.out + "/preview.png");
+#else
+    throw Error(a.out, "--out", "a sadsplat build with OpenCV to write PNG scene directories",
+                "a build without it (use --cache)");
+#endif
+  }
   const synth::SynthStats stats = synth::computeStats(scene);
   std::cout << "effective pixels: " << 100.0 * stats.effective_share << " %\nclass shares:";
   for (std::size_t c = 0; c < scene.classes.size(); ++c) {
     std::cout << " " << scene.classes[c].name << " " << 100.0 * stats.class_share[c] << "%";
   }
-  std::cout << "\nwrote " << a.out << "\n";
+  std::cout << "\nwrote " << (a.out.empty() ? a.cache : a.out) << "\n";
   return 0;
 }
-#endif
 
 }  // namespace
 
@@ -154,7 +162,6 @@ int main(int argc, char** argv) {
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
   demo->add_option("--iterations", demo_iterations, "training iterations")->capture_default_str();
 
-#if SADSPLAT_HAVE_OPENCV
   auto* synth_cmd = app.add_subcommand("synth", "Generate a procedural aerial benchmark scene");
   SynthArgs synth_args;
   synth_cmd->add_option("--kind", synth_args.kind, "city, country or port")->capture_default_str();
@@ -165,9 +172,9 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--height", synth_args.height, "image height (900)");
   synth_cmd->add_option("--points", synth_args.points, "sparse points to keep");
   synth_cmd->add_option("--labelled", synth_args.labelled, "labelled views (0,7,28)")->delimiter(',');
-  synth_cmd->add_option("--out", synth_args.out, "scene directory to write")->required();
+  synth_cmd->add_option("--out", synth_args.out, "scene directory to write (PNG, needs OpenCV)");
+  synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
-#endif
 
   CLI11_PARSE(app, argc, argv);
   try {
@@ -208,10 +215,11 @@ int main(int argc, char** argv) {
       filter.filter(out);
       saveGaussians(extract_out, out);
       std::cout << "kept " << out.size() << " of " << cloud->size() << " Gaussians\n";
-#if SADSPLAT_HAVE_OPENCV
     } else if (*synth_cmd) {
+      if (synth_args.out.empty() && synth_args.cache.empty()) {
+        throw sadsplat::Error("<command line>", "synth", "--out DIR and/or --cache FILE");
+      }
       return runSynth(synth_args);
-#endif
     } else if (*train) {
       sadsplat::gaussians::TrainConfig config;
       if (!train_config_file.empty()) {

@@ -1,38 +1,9 @@
 #!/usr/bin/env bash
-# Run ON THE GPU MACHINE (Ubuntu 24.04, LibTorch 2.11 + CUDA 13, no PCL/OpenCV/VTK) from the
-# repository root, with .deps/debs carried (scripts/gpu/fetch_deps.sh makes it here):
+# Run ON THE GPU MACHINE from the repository root, with .deps/debs carried:
 #   bash scripts/gpu/build_and_test.sh [extra ctest args]
-# Builds the CUDA-enabled project without OpenCV/VTK and runs the test suite. Logs go to
-# $OUT (when set) so that they come back from the device call.
+# Builds (scripts/gpu/build.sh) and runs the test suite; logs go to $OUT when set.
 set -euo pipefail
 out="${OUT:-/tmp/sadsplat-gpu-out}"
-mkdir -p "$out"
-prefix=/tmp/sadsplat-deps
-rm -rf "$prefix" && mkdir -p "$prefix"
-for deb in .deps/debs/*.deb; do dpkg -x "$deb" "$prefix"; done
-export LD_LIBRARY_PATH="$prefix/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
-
-torch_cmake=/opt/torch/.venv/lib/python3.12/site-packages/torch/share/cmake
-if [ ! -d "$torch_cmake" ]; then
-  torch_cmake=$(python3 -c 'import torch; print(torch.utils.cmake_prefix_path)')
-fi
-export PATH=/usr/local/cuda/bin:$PATH
-generator=(-G "Unix Makefiles")
-command -v ninja >/dev/null && generator=(-G Ninja)
-
-{
-  echo "== machine"; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv || true
-  nvcc --version | tail -2; g++ --version | head -1; cmake --version | head -1
-} 2>&1 | tee "$out/gpu_env.log"
-
-start=$(date +%s)
-cmake -S . -B build-gpu "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$torch_cmake" \
-  -DSADSPLAT_PCL_ROOT="$prefix" \
-  -Dnlohmann_json_DIR="$prefix/usr/share/cmake/nlohmann_json" \
-  -DCLI11_DIR="$prefix/usr/share/cmake/CLI11" \
-  -DSADSPLAT_WITH_CUDA=ON -DSADSPLAT_WITH_OPENCV=OFF -DSADSPLAT_WITH_VTK=OFF \
-  2>&1 | tee "$out/gpu_configure.log"
-cmake --build build-gpu -j "$(nproc)" 2>&1 | tee "$out/gpu_build.log"
-echo "build seconds: $(( $(date +%s) - start ))" | tee -a "$out/gpu_build.log"
+bash "$(dirname "$0")/build.sh"
+export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 ctest --test-dir build-gpu --output-on-failure -j 8 "$@" 2>&1 | tee "$out/gpu_ctest.log"

@@ -9,6 +9,7 @@
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/synth/aerial_benchmark.h"
+#include "sadsplat/synth/scene_writer.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -155,6 +156,16 @@ TEST(AerialBenchmark, WrittenScenesLoadThroughTheSceneImport) {
   for (double s : stats.class_share) sum += s;
   EXPECT_NEAR(sum, 1.0, 1e-9);
   EXPECT_GT(stats.effective_share, 0.5);
+  // The in-memory conversion equals the import of the written directory.
+  const io::Scene direct = synth::toScene(scene);
+  ASSERT_EQ(direct.views.size(), imported.views.size());
+  for (std::size_t i = 0; i < direct.views.size(); ++i) {
+    EXPECT_EQ(direct.views[i].rgb.pixels, imported.views[i].rgb.pixels);
+    EXPECT_EQ(direct.views[i].labelled, imported.views[i].labelled);
+    EXPECT_EQ(direct.views[i].test, imported.views[i].test);
+    EXPECT_DOUBLE_EQ(direct.views[i].camera.fx, imported.views[i].camera.fx);
+  }
+  EXPECT_EQ(direct.points.size(), imported.points.size());
 }
 
 TEST(AerialBenchmark, BadOptionsAreClearErrors) {

@@ -20,6 +20,7 @@
 
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/aerial_benchmark.h"
+#include "sadsplat/synth/scene_writer.h"
 #endif
 
 namespace sadsplat {

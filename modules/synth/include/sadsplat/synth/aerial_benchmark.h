@@ -62,11 +62,10 @@ struct SynthScene {
 /// \throws sadsplat::Error on bad options
 SynthScene generate(const SynthOptions& options);
 
-/// \brief Writes the scene directory (creating it), atomically file by file.
-void writeScene(const SynthScene& scene, const std::string& dir);
-
-/// \brief Writes a contact sheet: a few views beside their label maps (class colours).
-void writeContactSheet(const SynthScene& scene, const std::string& png_path);
+/// \brief The scene as an imported scene (what io::importScene would give for its directory:
+/// the same cameras, images, label maps, split and points), e.g. to write a scene cache directly
+/// on a machine without OpenCV.
+io::Scene toScene(const SynthScene& scene);
 
 /// \brief Pixel statistics: share of each class among labelled pixels, and the "effective
 /// pixel" share (pixels with a class) over all views.
