@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
 
   auto* demo = app.add_subcommand("demo", "Generate the demo city, train on CPU, evaluate");
   std::string demo_out = "out/demo";
-  int demo_iterations = 1500;
+  int demo_iterations = 600;
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
   demo->add_option("--iterations", demo_iterations, "training iterations")->capture_default_str();
 
