@@ -22,7 +22,7 @@ cv::Mat classImage(const std::vector<std::uint8_t>& ids, int W, int H,
   for (int i = 0; i < W * H; ++i) {
     const auto id = ids[i];
     cv::Vec3b c(0, 0, 0);
-    if (id < classes.size()) c = {classes[id].color[2], classes[id].color[1], classes[id].color[0]};
+    if (id < classes.size()) c = {classes[id].color[0], classes[id].color[1], classes[id].color[2]};  // RGB; the panel is converted to BGR once
     out.at<cv::Vec3b>(i / W, i % W) = c;
   }
   return out;

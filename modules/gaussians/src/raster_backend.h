@@ -8,6 +8,8 @@
 #include <array>
 #include <tuple>
 
+#include "sadsplat/gaussians/raster_math.h"
+
 namespace sadsplat {
 namespace gaussians {
 namespace raster {
@@ -98,6 +100,22 @@ std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh, const at:
                                                  const std::array<double, 3>& campos, int degree,
                                                  const at::Tensor& g_colors, void* stream);
 #endif
+
+/// The camera in the scalar type of a computation.
+template <typename T>
+Camera<T> toCamera(const CameraParams& p) {
+  Camera<T> c;
+  for (int i = 0; i < 9; ++i) c.R[i] = static_cast<T>(p.R[i]);
+  for (int i = 0; i < 3; ++i) c.t[i] = static_cast<T>(p.t[i]);
+  c.fx = static_cast<T>(p.fx);
+  c.fy = static_cast<T>(p.fy);
+  c.cx = static_cast<T>(p.cx);
+  c.cy = static_cast<T>(p.cy);
+  c.width = p.width;
+  c.height = p.height;
+  c.near_plane = static_cast<T>(p.near_plane);
+  return c;
+}
 
 /// Number of tiles along x and y for an image.
 inline std::pair<int, int> tileGrid(int width, int height) {

@@ -17,20 +17,6 @@ namespace gaussians {
 namespace raster {
 namespace {
 
-template <typename T>
-Camera<T> toCamera(const CameraParams& p) {
-  Camera<T> c;
-  for (int i = 0; i < 9; ++i) c.R[i] = static_cast<T>(p.R[i]);
-  for (int i = 0; i < 3; ++i) c.t[i] = static_cast<T>(p.t[i]);
-  c.fx = static_cast<T>(p.fx);
-  c.fy = static_cast<T>(p.fy);
-  c.cx = static_cast<T>(p.cx);
-  c.cy = static_cast<T>(p.cy);
-  c.width = p.width;
-  c.height = p.height;
-  c.near_plane = static_cast<T>(p.near_plane);
-  return c;
-}
 
 // Grain sizes for at::parallel_for.
 constexpr int64_t kGaussianGrain = 2048;

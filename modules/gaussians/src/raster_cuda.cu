@@ -17,19 +17,6 @@ namespace {
 constexpr int kBlock = kTileSize * kTileSize;  // threads per tile block
 constexpr int kThreads1d = 256;
 
-Camera<float> toCamera(const CameraParams& p) {
-  Camera<float> c;
-  for (int i = 0; i < 9; ++i) c.R[i] = static_cast<float>(p.R[i]);
-  for (int i = 0; i < 3; ++i) c.t[i] = static_cast<float>(p.t[i]);
-  c.fx = static_cast<float>(p.fx);
-  c.fy = static_cast<float>(p.fy);
-  c.cx = static_cast<float>(p.cx);
-  c.cy = static_cast<float>(p.cy);
-  c.width = p.width;
-  c.height = p.height;
-  c.near_plane = static_cast<float>(p.near_plane);
-  return c;
-}
 
 void check(const at::Tensor& t, const char* name) {
   if (!t.is_cuda() || t.scalar_type() != at::kFloat || !t.is_contiguous()) {
@@ -191,6 +178,22 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii, const a
 
 // ---- rasterization ---------------------------------------------------------------------------
 
+// Copies Gaussian g's 2D data into this thread's slot of the block's shared batch.
+__device__ __forceinline__ void stageGaussian(int g, const float* __restrict__ means2d,
+                                              const float* __restrict__ conics,
+                                              const float* __restrict__ opacities, int* s_id,
+                                              float (*s_mean)[2], float (*s_conic)[3],
+                                              float* s_opacity) {
+  const int slot = threadIdx.x;
+  s_id[slot] = g;
+  s_mean[slot][0] = means2d[2 * g];
+  s_mean[slot][1] = means2d[2 * g + 1];
+  s_conic[slot][0] = conics[3 * g];
+  s_conic[slot][1] = conics[3 * g + 1];
+  s_conic[slot][2] = conics[3 * g + 2];
+  s_opacity[slot] = opacities[g];
+}
+
 // One block per tile, one thread per pixel; Gaussians are staged through shared memory in
 // batches of kBlock. CH is the channel capacity (>= D), fixed at compile time so the per-pixel
 // accumulators can live in registers.
@@ -223,16 +226,7 @@ __global__ void __launch_bounds__(kBlock)
   for (int batch = start; batch < stop; batch += kBlock) {
     if (__syncthreads_count(done) == kBlock) break;
     const int k = batch + threadIdx.x;
-    if (k < stop) {
-      const int g = ids[k];
-      s_id[threadIdx.x] = g;
-      s_mean[threadIdx.x][0] = means2d[2 * g];
-      s_mean[threadIdx.x][1] = means2d[2 * g + 1];
-      s_conic[threadIdx.x][0] = conics[3 * g];
-      s_conic[threadIdx.x][1] = conics[3 * g + 1];
-      s_conic[threadIdx.x][2] = conics[3 * g + 2];
-      s_opacity[threadIdx.x] = opacities[g];
-    }
+    if (k < stop) stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
     __syncthreads();
     const int count = min(kBlock, stop - batch);
     for (int j = 0; j < count && !done; ++j) {
@@ -328,14 +322,7 @@ __global__ void __launch_bounds__(kBlock)
     __syncthreads();
     const int k = batch_end - 1 - threadIdx.x;
     if (k >= start) {
-      const int g = ids[k];
-      s_id[threadIdx.x] = g;
-      s_mean[threadIdx.x][0] = means2d[2 * g];
-      s_mean[threadIdx.x][1] = means2d[2 * g + 1];
-      s_conic[threadIdx.x][0] = conics[3 * g];
-      s_conic[threadIdx.x][1] = conics[3 * g + 1];
-      s_conic[threadIdx.x][2] = conics[3 * g + 2];
-      s_opacity[threadIdx.x] = opacities[g];
+      stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
     }
     __syncthreads();
     const int count = min(kBlock, batch_end - start);
@@ -452,7 +439,7 @@ ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& q
   if (n == 0) return out;
   projectForwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
       n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
-      toCamera(cam), out.means2d.data_ptr<float>(), out.conics.data_ptr<float>(),
+      toCamera<float>(cam), out.means2d.data_ptr<float>(), out.conics.data_ptr<float>(),
       out.depths.data_ptr<float>(), out.radii.data_ptr<int>());
   checkLaunch("projectForwardKernel");
   return out;
@@ -475,7 +462,7 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
   check(g_depths, "grad depths");
   projectBackwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
       n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
-      radii.data_ptr<int>(), toCamera(cam), g_means2d.data_ptr<float>(),
+      radii.data_ptr<int>(), toCamera<float>(cam), g_means2d.data_ptr<float>(),
       g_conics.data_ptr<float>(), g_depths.data_ptr<float>(), g.means.data_ptr<float>(),
       g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
   checkLaunch("projectBackwardKernel");

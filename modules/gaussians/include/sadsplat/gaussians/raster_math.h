@@ -147,6 +147,71 @@ struct Projected {
   int radius;   ///< 3-sigma screen radius in pixels; 0 = culled
 };
 
+/// The intermediate terms of the EWA projection of one Gaussian, shared by the forward pass and
+/// the backward pass (which recomputes them instead of storing them).
+template <typename T>
+struct EwaTerms {
+  T p[3];                        ///< centre in camera coordinates
+  T Rq[9], s[3], M[9], S[9];     ///< rotation, scales, M = Rq diag(s), 3D covariance S = M M^T
+  T cx_ratio, cy_ratio;          ///< x/z, y/z clamped to the frustum limits
+  bool clamp_x, clamp_y;         ///< whether the clamp was active
+  T tx, ty;                      ///< clamped x, y
+  T J00, J02, J11, J12;          ///< the projection Jacobian's non-zero entries
+  T Tm[6];                       ///< J R (2 x 3)
+  T a, b, c;                     ///< 2D covariance (with the dilation)
+};
+
+template <typename T>
+SADSPLAT_HD void ewaTerms(const T mean[3], const T quat[4], const T log_scale[3],
+                          const Camera<T>& cam, EwaTerms<T>* e) {
+  const T* R = cam.R;
+  for (int i = 0; i < 3; ++i) {
+    e->p[i] = R[3 * i] * mean[0] + R[3 * i + 1] * mean[1] + R[3 * i + 2] * mean[2] + cam.t[i];
+  }
+  quatToRotation(quat, e->Rq);
+  for (int j = 0; j < 3; ++j) e->s[j] = mexp(log_scale[j]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) e->M[3 * i + j] = e->Rq[3 * i + j] * e->s[j];
+  }
+  const T* M = e->M;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      e->S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
+    }
+  }
+  const T z = e->p[2];
+  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
+  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
+  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
+  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
+  const T rx = e->p[0] / z, ry = e->p[1] / z;
+  e->clamp_x = rx > lim_x_pos || rx < -lim_x_neg;
+  e->clamp_y = ry > lim_y_pos || ry < -lim_y_neg;
+  e->cx_ratio = mmin(lim_x_pos, mmax(-lim_x_neg, rx));
+  e->cy_ratio = mmin(lim_y_pos, mmax(-lim_y_neg, ry));
+  e->tx = e->cx_ratio * z;
+  e->ty = e->cy_ratio * z;
+  e->J00 = cam.fx / z;
+  e->J02 = -cam.fx * e->tx / (z * z);
+  e->J11 = cam.fy / z;
+  e->J12 = -cam.fy * e->ty / (z * z);
+  for (int j = 0; j < 3; ++j) {
+    e->Tm[j] = e->J00 * R[j] + e->J02 * R[6 + j];
+    e->Tm[3 + j] = e->J11 * R[3 + j] + e->J12 * R[6 + j];
+  }
+  const T* Tm = e->Tm;
+  const T* S = e->S;
+  T TS[6];
+  for (int r = 0; r < 2; ++r) {
+    for (int j = 0; j < 3; ++j) {
+      TS[3 * r + j] = Tm[3 * r] * S[j] + Tm[3 * r + 1] * S[3 + j] + Tm[3 * r + 2] * S[6 + j];
+    }
+  }
+  e->a = TS[0] * Tm[0] + TS[1] * Tm[1] + TS[2] * Tm[2] + T(kDilation);
+  e->b = TS[0] * Tm[3] + TS[1] * Tm[4] + TS[2] * Tm[5];
+  e->c = TS[3] * Tm[3] + TS[4] * Tm[4] + TS[5] * Tm[5] + T(kDilation);
+}
+
 /// Projects one Gaussian (EWA splatting with the low-pass dilation). Returns false (radius 0)
 /// when it is behind the near plane, degenerate (non-finite or non-positive 2D covariance) or
 /// entirely off-screen.
@@ -154,62 +219,20 @@ template <typename T>
 SADSPLAT_HD bool projectGaussian(const T mean[3], const T quat[4], const T log_scale[3],
                                  const Camera<T>& cam, Projected<T>* out) {
   out->radius = 0;
-  const T* R = cam.R;
-  T p[3];
-  for (int i = 0; i < 3; ++i) {
-    p[i] = R[3 * i] * mean[0] + R[3 * i + 1] * mean[1] + R[3 * i + 2] * mean[2] + cam.t[i];
-  }
-  if (!(p[2] > cam.near_plane)) return false;
-
-  // 3D covariance: (Rq S)(Rq S)^T.
-  T Rq[9];
-  quatToRotation(quat, Rq);
-  T M[9];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) M[3 * i + j] = Rq[3 * i + j] * mexp(log_scale[j]);
-  }
-  T S[9];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
-    }
-  }
-  // Jacobian of the perspective projection at the (frustum-clamped) centre.
-  const T z = p[2];
-  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
-  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
-  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
-  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
-  const T tx = mmin(lim_x_pos, mmax(-lim_x_neg, p[0] / z)) * z;
-  const T ty = mmin(lim_y_pos, mmax(-lim_y_neg, p[1] / z)) * z;
-  const T J00 = cam.fx / z, J02 = -cam.fx * tx / (z * z);
-  const T J11 = cam.fy / z, J12 = -cam.fy * ty / (z * z);
-  // Tm = J R (2 x 3).
-  T Tm[6];
-  for (int j = 0; j < 3; ++j) {
-    Tm[j] = J00 * R[j] + J02 * R[6 + j];
-    Tm[3 + j] = J11 * R[3 + j] + J12 * R[6 + j];
-  }
-  // cov2 = Tm S Tm^T + dilation.
-  T TS[6];
-  for (int r = 0; r < 2; ++r) {
-    for (int j = 0; j < 3; ++j) {
-      TS[3 * r + j] = Tm[3 * r] * S[j] + Tm[3 * r + 1] * S[3 + j] + Tm[3 * r + 2] * S[6 + j];
-    }
-  }
-  const T a = TS[0] * Tm[0] + TS[1] * Tm[1] + TS[2] * Tm[2] + T(kDilation);
-  const T b = TS[0] * Tm[3] + TS[1] * Tm[4] + TS[2] * Tm[5];
-  const T c = TS[3] * Tm[3] + TS[4] * Tm[4] + TS[5] * Tm[5] + T(kDilation);
-  const T det = a * c - b * b;
-  if (!(det > T(0)) || !mfinite(det) || !mfinite(a) || !mfinite(c)) return false;
-  out->conic[0] = c / det;
-  out->conic[1] = -b / det;
-  out->conic[2] = a / det;
-  const T mid = T(0.5) * (a + c);
+  EwaTerms<T> e;
+  ewaTerms(mean, quat, log_scale, cam, &e);
+  if (!(e.p[2] > cam.near_plane)) return false;
+  const T det = e.a * e.c - e.b * e.b;
+  if (!(det > T(0)) || !mfinite(det) || !mfinite(e.a) || !mfinite(e.c)) return false;
+  out->conic[0] = e.c / det;
+  out->conic[1] = -e.b / det;
+  out->conic[2] = e.a / det;
+  const T mid = T(0.5) * (e.a + e.c);
   const T lambda = mid + msqrt(mmax(T(0.1), mid * mid - det));
   const T radius = mceil(T(3) * msqrt(lambda));
-  out->mean2d[0] = cam.fx * p[0] / z + cam.cx;
-  out->mean2d[1] = cam.fy * p[1] / z + cam.cy;
+  const T z = e.p[2];
+  out->mean2d[0] = cam.fx * e.p[0] / z + cam.cx;
+  out->mean2d[1] = cam.fy * e.p[1] / z + cam.cy;
   out->depth = z;
   if (!mfinite(out->mean2d[0]) || !mfinite(out->mean2d[1]) || !mfinite(radius)) return false;
   // Off-screen: the 3-sigma box misses the image.
@@ -229,61 +252,21 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
                                          const T g_conic[3], T g_depth, T g_mean[3],
                                          T g_quat[4], T g_log_scale[3]) {
   const T* R = cam.R;
-  T p[3];
-  for (int i = 0; i < 3; ++i) {
-    p[i] = R[3 * i] * mean[0] + R[3 * i + 1] * mean[1] + R[3 * i + 2] * mean[2] + cam.t[i];
-  }
-  T Rq[9], s[3], M[9], S[9];
-  quatToRotation(quat, Rq);
-  for (int j = 0; j < 3; ++j) s[j] = mexp(log_scale[j]);
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) M[3 * i + j] = Rq[3 * i + j] * s[j];
-  }
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
-    }
-  }
-  const T z = p[2];
-  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
-  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
-  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
-  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
-  const T rx = p[0] / z, ry = p[1] / z;
-  const bool clamp_x = rx > lim_x_pos || rx < -lim_x_neg;
-  const bool clamp_y = ry > lim_y_pos || ry < -lim_y_neg;
-  const T cx_ratio = mmin(lim_x_pos, mmax(-lim_x_neg, rx));
-  const T cy_ratio = mmin(lim_y_pos, mmax(-lim_y_neg, ry));
-  const T tx = cx_ratio * z, ty = cy_ratio * z;
-  const T J00 = cam.fx / z, J02 = -cam.fx * tx / (z * z);
-  const T J11 = cam.fy / z, J12 = -cam.fy * ty / (z * z);
-  T Tm[6];
-  for (int j = 0; j < 3; ++j) {
-    Tm[j] = J00 * R[j] + J02 * R[6 + j];
-    Tm[3 + j] = J11 * R[3 + j] + J12 * R[6 + j];
-  }
-  T TS[6];
-  for (int r = 0; r < 2; ++r) {
-    for (int j = 0; j < 3; ++j) {
-      TS[3 * r + j] = Tm[3 * r] * S[j] + Tm[3 * r + 1] * S[3 + j] + Tm[3 * r + 2] * S[6 + j];
-    }
-  }
-  const T a = TS[0] * Tm[0] + TS[1] * Tm[1] + TS[2] * Tm[2] + T(kDilation);
-  const T b = TS[0] * Tm[3] + TS[1] * Tm[4] + TS[2] * Tm[5];
-  const T c = TS[3] * Tm[3] + TS[4] * Tm[4] + TS[5] * Tm[5] + T(kDilation);
-  const T det = a * c - b * b;
-  const T Y[3] = {c / det, -b / det, a / det};  // conic (ya, yb, yc)
+  EwaTerms<T> e;
+  ewaTerms(mean, quat, log_scale, cam, &e);
+  const T* Tm = e.Tm;
+  const T* S = e.S;
+  const T* M = e.M;
+  const T z = e.p[2];
+  const T det = e.a * e.c - e.b * e.b;
+  const T Y[3] = {e.c / det, -e.b / det, e.a / det};  // conic (ya, yb, yc)
 
   // Conic = X^-1: dL/dX = -Y Gm Y with Gm = [[ga, gb/2], [gb/2, gc]] (b is one variable).
   const T ga = g_conic[0], gb = T(0.5) * g_conic[1], gc = g_conic[2];
-  // P = Gm Y
   const T P00 = ga * Y[0] + gb * Y[1], P01 = ga * Y[1] + gb * Y[2];
   const T P10 = gb * Y[0] + gc * Y[1], P11 = gb * Y[1] + gc * Y[2];
-  // G2 = -Y P (symmetric).
-  const T G00 = -(Y[0] * P00 + Y[1] * P10);
   const T G01 = -(Y[0] * P01 + Y[1] * P11);
-  const T G11 = -(Y[1] * P01 + Y[2] * P11);
-  const T G2[4] = {G00, G01, G01, G11};
+  const T G2[4] = {-(Y[0] * P00 + Y[1] * P10), G01, G01, -(Y[1] * P01 + Y[2] * P11)};
 
   // dL/dS = Tm^T G2 Tm (3 x 3), dL/dTm = 2 G2 Tm S (2 x 3).
   T G2T[6];  // G2 Tm
@@ -310,24 +293,24 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
   // J as a function of (tx, ty, z); tx = clamp(x / z) z.
   T gp[3] = {T(0), T(0), T(0)};
   const T z2 = z * z, z3 = z2 * z;
-  gp[2] += -cam.fx / z2 * gJ00 + T(2) * cam.fx * tx / z3 * gJ02 - cam.fy / z2 * gJ11 +
-           T(2) * cam.fy * ty / z3 * gJ12;
+  gp[2] += -cam.fx / z2 * gJ00 + T(2) * cam.fx * e.tx / z3 * gJ02 - cam.fy / z2 * gJ11 +
+           T(2) * cam.fy * e.ty / z3 * gJ12;
   const T g_tx = -cam.fx / z2 * gJ02;
   const T g_ty = -cam.fy / z2 * gJ12;
-  if (clamp_x) {
-    gp[2] += g_tx * cx_ratio;  // tx = lim z
+  if (e.clamp_x) {
+    gp[2] += g_tx * e.cx_ratio;  // tx = lim z
   } else {
     gp[0] += g_tx;
   }
-  if (clamp_y) {
-    gp[2] += g_ty * cy_ratio;
+  if (e.clamp_y) {
+    gp[2] += g_ty * e.cy_ratio;
   } else {
     gp[1] += g_ty;
   }
   // mean2d = f p / z + c; depth = z.
   gp[0] += g_mean2d[0] * cam.fx / z;
   gp[1] += g_mean2d[1] * cam.fy / z;
-  gp[2] += -g_mean2d[0] * cam.fx * p[0] / z2 - g_mean2d[1] * cam.fy * p[1] / z2 + g_depth;
+  gp[2] += -g_mean2d[0] * cam.fx * e.p[0] / z2 - g_mean2d[1] * cam.fy * e.p[1] / z2 + g_depth;
   for (int j = 0; j < 3; ++j) g_mean[j] += R[j] * gp[0] + R[3 + j] * gp[1] + R[6 + j] * gp[2];
 
   // S = M M^T: dL/dM = 2 gS M (gS symmetric).
@@ -341,10 +324,10 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
   for (int j = 0; j < 3; ++j) {
     T gs = T(0);
     for (int i = 0; i < 3; ++i) {
-      gs += gM[3 * i + j] * Rq[3 * i + j];
-      gR[3 * i + j] = gM[3 * i + j] * s[j];
+      gs += gM[3 * i + j] * e.Rq[3 * i + j];
+      gR[3 * i + j] = gM[3 * i + j] * e.s[j];
     }
-    g_log_scale[j] += gs * s[j];
+    g_log_scale[j] += gs * e.s[j];
   }
   T dq[4];
   quatToRotationBackward(quat, gR, dq);
