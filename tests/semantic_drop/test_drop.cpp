@@ -1,0 +1,120 @@
+// The semantic-aware drop: Hard Concrete closed form and gradients, semantic confidence by hand,
+// drop rates, and the drop filters' PCL behaviour.
+#include <gtest/gtest.h>
+
+#include <torch/csrc/autograd/autograd.h>
+
+#include <cmath>
+#include <set>
+
+#include "sadsplat/semantic_drop/drop_filters.h"
+#include "sadsplat/semantic_drop/hard_concrete.h"
+#include "sadsplat/semantic_drop/semantic_confidence.h"
+
+namespace sadsplat {
+namespace {
+
+using namespace semantic_drop;
+
+TEST(HardConcrete, EmpiricalNonZeroProbabilityMatchesTheClosedForm) {
+  at::manual_seed(11);
+  for (double la : {-2.0, -0.5, 0.0, 1.5}) {
+    const at::Tensor log_alpha = at::full({400000}, la, at::TensorOptions().dtype(at::kDouble));
+    const at::Tensor z = sampleGate(log_alpha, at::rand_like(log_alpha));
+    const double empirical = (z > 0).to(at::kDouble).mean().item<double>();
+    EXPECT_NEAR(empirical, probabilityNonZero(la), 0.003) << "log_alpha " << la;
+    EXPECT_GE(z.min().item<double>(), 0.0);
+    EXPECT_LE(z.max().item<double>(), 1.0);
+    // The exactly-one mass exists too (the stretch beyond 1).
+    EXPECT_GT((z == 1).sum().item<int64_t>(), 0);
+  }
+  EXPECT_NEAR(probabilityNonZero(at::tensor({0.3})).item<double>(), probabilityNonZero(0.3), 1e-6);
+}
+
+TEST(HardConcrete, GradientsReachLogAlpha) {
+  at::manual_seed(2);
+  const at::Tensor log_alpha = at::zeros({1000}, at::TensorOptions().dtype(at::kDouble)).requires_grad_(true);
+  const at::Tensor z = sampleGate(log_alpha, at::rand({1000}, at::TensorOptions().dtype(at::kDouble)));
+  const auto g = torch::autograd::grad({z.sum() + probabilityNonZero(log_alpha).sum()}, {log_alpha})[0];
+  EXPECT_GT(g.abs().sum().item<double>(), 0.0);
+  EXPECT_TRUE(at::isfinite(g).all().item<bool>());
+  // d/dx sigmoid(x - c) at x = 0 is p (1 - p).
+  const double p = probabilityNonZero(0.0);
+  const auto gp = torch::autograd::grad({probabilityNonZero(log_alpha).sum()}, {log_alpha})[0];
+  EXPECT_NEAR(gp[0].item<double>(), p * (1 - p), 1e-12);
+}
+
+TEST(SemanticConfidence, EqualsAHandComputationOnATwoViewToyScene) {
+  // Two cameras at the origin looking down +z, 4x4 images, f = 4: a point (x, y, z) lands on
+  // pixel (4x/z + 2, 4y/z + 2).
+  gaussians::RasterCamera cam;
+  cam.width = cam.height = 4;
+  cam.fx = cam.fy = 4;
+  cam.cx = cam.cy = 2;
+  gaussians::RasterCamera shifted = cam;
+  shifted.tvec = {-1.0, 0.0, 0.0};  // camera centre at x = +1
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  const at::Tensor means = at::tensor({0.f, 0.f, 2.f,     // pixel (2,2) in view 0, (0,2) in view 1
+                                       -0.9f, 0.f, 2.f,   // pixel (0.2,2) in view 0, off-screen in 1
+                                       0.f, 0.f, -1.f},   // behind both
+                                      opts).view({3, 3});
+  const at::Tensor opac = at::tensor({0.5f, 0.8f, 1.f}, opts);
+  at::Tensor m0 = at::zeros({4, 4, 2}, opts), m1 = at::zeros({4, 4, 2}, opts);
+  m0[2][2][0] = 0.6f;
+  m0[2][2][1] = 0.9f;  // max 0.9
+  m0[2][0][1] = 0.4f;  // max 0.4
+  m1[2][0][0] = 0.7f;  // max 0.7
+  const at::Tensor c = semanticConfidence(means, opac, {cam, shifted}, {m0, m1});
+  EXPECT_NEAR(c[0].item<float>(), (0.9f * 0.5f + 0.7f * 0.5f) / 2, 1e-6);
+  EXPECT_NEAR(c[1].item<float>(), 0.4f * 0.8f, 1e-6);
+  EXPECT_EQ(c[2].item<float>(), 0.f);
+}
+
+pcl::PointCloud<GaussianPoint>::Ptr cloudWith(int n, float log_alpha, float confidence) {
+  auto cloud = std::make_shared<pcl::PointCloud<GaussianPoint>>();
+  cloud->resize(n);
+  for (int i = 0; i < n; ++i) {
+    (*cloud)[i].x = static_cast<float>(i);
+    (*cloud)[i].log_alpha = log_alpha;
+    (*cloud)[i].confidence = confidence;
+  }
+  return cloud;
+}
+
+TEST(DropFilters, RemoveAtTheExpectedRateAndBehaveLikePclFilters) {
+  // Choose log_alpha so that P_learned = 0.5; confidence 0.4 -> P_drop = 1.2 * 0.6 * 0.5 = 0.36.
+  const HardConcreteParams hc;
+  const double la = hc.beta * std::log((1.0 / 12) / (11.0 / 12));  // P_nonzero = 0.5
+  const auto cloud = cloudWith(40000, static_cast<float>(la), 0.4f);
+  SemanticDrop<GaussianPoint> drop(true);
+  drop.setInputCloud(cloud);
+  drop.setBaseRate(1.2);
+  drop.setSeed(7);
+  EXPECT_NEAR(drop.dropProbability((*cloud)[0]), 0.36, 1e-6);
+  pcl::Indices kept, kept_again, removed_set;
+  drop.filter(kept);
+  const pcl::Indices removed = *drop.getRemovedIndices();
+  EXPECT_NEAR(removed.size() / 40000.0, 0.36, 0.01);
+  drop.filter(kept_again);
+  EXPECT_EQ(kept, kept_again);  // seeded
+  EXPECT_EQ(kept.size() + removed.size(), 40000u);
+  std::set<int> all(kept.begin(), kept.end());
+  for (int i : removed) EXPECT_TRUE(all.insert(i).second) << "index " << i << " both kept and removed";
+  drop.setNegative(true);
+  drop.filter(removed_set);
+  EXPECT_EQ(removed_set, removed);
+
+  ConfidenceDrop<GaussianPoint> semantic_only;
+  semantic_only.setInputCloud(cloud);
+  EXPECT_NEAR(semantic_only.dropProbability((*cloud)[0]), 0.6, 1e-6);
+  HardConcreteDrop<GaussianPoint> structure_only;
+  structure_only.setInputCloud(cloud);
+  structure_only.setBaseRate(3.0);
+  EXPECT_NEAR(structure_only.dropProbability((*cloud)[0]), 1.0, 1e-9);  // clamped
+  pcl::PointCloud<GaussianPoint> out;
+  structure_only.filter(out);
+  EXPECT_EQ(out.size(), 0u);
+}
+
+}  // namespace
+}  // namespace sadsplat
