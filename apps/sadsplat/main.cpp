@@ -150,6 +150,10 @@ int main(int argc, char** argv) {
   train->add_option("--seed", train_seed, "random seed (42)");
   train->add_option("--scale", train_scale, "image scale when importing a directory")->capture_default_str();
   train->add_flag("--resume", train_resume, "continue from RUN/checkpoint.bin");
+  std::string train_drop;
+  double train_p_base = -1;
+  train->add_option("--drop", train_drop, "semantic-aware drop: none, semantic, structure or full");
+  train->add_option("--p-base", train_p_base, "base drop rate P_base (1.0)");
 
   auto* evaluate = app.add_subcommand("eval", "Evaluate a training run on its test views");
   std::string eval_run, eval_scene;
@@ -229,6 +233,8 @@ int main(int argc, char** argv) {
       if (train_iterations > 0) config.iterations = train_iterations;
       if (!train_device.empty()) config.device = train_device;
       if (train_seed >= 0) config.seed = static_cast<std::uint64_t>(train_seed);
+      if (!train_drop.empty()) config.drop = train_drop;
+      if (train_p_base >= 0) config.p_base = train_p_base;
       sadsplat::pipeline::TrainRunOptions options;
       options.scene = train_scene;
       options.out = train_out;

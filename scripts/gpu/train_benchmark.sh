@@ -2,7 +2,8 @@
 # Run ON THE GPU MACHINE after scripts/gpu/build.sh: generates a benchmark scene directly at the
 # training resolution (800x450 = half of 1600x900) as a scene cache, trains it with CUDA and
 # evaluates it. Results (metrics, logs, config) go to $OUT.
-#   bash scripts/gpu/train_benchmark.sh KIND SEED [ITERATIONS] [extra train args...]
+#   [TAG=name] bash scripts/gpu/train_benchmark.sh KIND SEED [ITERATIONS] [extra train args...]
+# TAG distinguishes runs of one scene with different train args (e.g. --drop full --p-base 1).
 set -euo pipefail
 kind="$1"; seed="$2"; iterations="${3:-7000}"; shift $(( $# < 3 ? $# : 3 ))
 out="${OUT:-/tmp/sadsplat-gpu-out}"
@@ -14,14 +15,15 @@ mkdir -p "$work"
 cache="$work/${kind}_${seed}_800x450.cache"
 [ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" \
   2>&1 | tee "$out/synth_${kind}_${seed}.log"
-run="$work/run_${kind}_${seed}"
+name="${kind}_${seed}${TAG:+_$TAG}"
+run="$work/run_$name"
 rm -rf "$run"
 "$bin" train "$cache" --device cuda --iterations "$iterations" --out "$run" "$@" \
-  > "$out/train_${kind}_${seed}.log" 2>&1
-tr '\r' '\n' < "$out/train_${kind}_${seed}.log" | tail -3
-"$bin" eval "$run" > "$out/metrics_${kind}_${seed}.json"
-cp "$run/config.json" "$out/config_${kind}_${seed}.json"
-python3 - "$out/metrics_${kind}_${seed}.json" <<'PY'
+  > "$out/train_$name.log" 2>&1
+tr '\r' '\n' < "$out/train_$name.log" | grep -c '^\[drop\]' | sed 's/^/drop events: /'; tr '\r' '\n' < "$out/train_$name.log" | tail -2
+"$bin" eval "$run" > "$out/metrics_$name.json"
+cp "$run/config.json" "$out/config_$name.json"
+python3 - "$out/metrics_$name.json" <<'PY'
 import json, sys
 m = json.load(open(sys.argv[1]))
 print("%s: mIoU %.2f  mAcc %.2f  OA %.2f  PSNR %.2f  SSIM %.3f  gaussians %d  train %.0f s" % (

@@ -7,7 +7,11 @@
 #include <cmath>
 #include <set>
 
+#include "sadsplat/common/error.h"
+
+#include "sadsplat/io/scene_import.h"
 #include "sadsplat/semantic_drop/drop_filters.h"
+#include "sadsplat/semantic_drop/drop_strategy.h"
 #include "sadsplat/semantic_drop/hard_concrete.h"
 #include "sadsplat/semantic_drop/semantic_confidence.h"
 
@@ -114,6 +118,45 @@ TEST(DropFilters, RemoveAtTheExpectedRateAndBehaveLikePclFilters) {
   pcl::PointCloud<GaussianPoint> out;
   structure_only.filter(out);
   EXPECT_EQ(out.size(), 0u);
+}
+
+TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV (scene import)";
+  const io::Scene scene = io::importScene(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene");
+  gaussians::TrainConfig c;
+  c.iterations = 100;
+  c.feature_dim = 8;
+  c.densify_from = 100000;
+  c.checkpoint_interval = 0;
+  c.drop = "full";
+  c.drop_interval = 25;
+  c.log_alpha_init = 0.0;  // P_learned = 0.17: visible drops within 100 iterations
+  gaussians::Trainer trainer(scene, c);
+  trainer.setDropStrategy(makeDropStrategy(c));
+  const auto before = trainer.numGaussians();
+  std::int64_t dropped = 0;
+  for (int i = 0; i < 100; ++i) {
+    const auto stats = trainer.step();
+    dropped += stats.dropped;
+    trainer.checkConsistency();
+  }
+  EXPECT_GT(dropped, 0);
+  EXPECT_EQ(trainer.numGaussians(), before - dropped);
+  // The gates were trained: log_alpha moved away from its initial value.
+  const auto cloud = trainer.toCloud();
+  double moved = 0;
+  for (const auto& p : cloud) moved += std::abs(p.log_alpha);
+  EXPECT_GT(moved / cloud.size(), 1e-3);
+  // Confidence was computed and stored in [0, 1].
+  float max_conf = 0;
+  for (const auto& p : cloud) {
+    EXPECT_GE(p.confidence, 0.f);
+    EXPECT_LE(p.confidence, 1.f);
+    max_conf = std::max(max_conf, p.confidence);
+  }
+  EXPECT_GT(max_conf, 0.f);
+  c.drop = "sometimes";
+  EXPECT_THROW(makeDropStrategy(c), Error);
 }
 
 }  // namespace

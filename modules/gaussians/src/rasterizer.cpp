@@ -350,7 +350,11 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
       projectGaussians(g.means, g.quats, g.log_scales, camera);
   const at::Tensor colors = evaluateSh(g.sh, g.means, camera.centre(), settings.sh_degree);
   const at::Tensor values = at::cat({colors, features, depths.unsqueeze(1)}, 1);
-  const at::Tensor opacities = at::sigmoid(g.opacity_logits);
+  at::Tensor opacities = at::sigmoid(g.opacity_logits);
+  if (g.opacity_gate.defined()) {
+    expectTensor(g.opacity_gate, "opacity_gate", n, {}, g.means);
+    opacities = opacities * g.opacity_gate;
+  }
   auto [image, alpha] = rasterizeToPixels(means2d, conics, opacities, values, radii, depths,
                                           camera.width, camera.height);
   const int64_t C = features.size(1);

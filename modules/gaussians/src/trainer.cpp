@@ -25,10 +25,6 @@ std::uint64_t mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-// A CPU generator for (seed, purpose, iteration): randomness that a resumed run reproduces.
-at::Generator generatorFor(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
-  return at::detail::createCPUGenerator(mix(seed ^ mix(purpose ^ mix(iteration))));
-}
 
 // One optimised tensor with its Adam moments (per-row tensors are resized by densification).
 struct Param {
@@ -41,6 +37,10 @@ struct Param {
 double logit(double p) { return std::log(p / (1 - p)); }
 
 }  // namespace
+
+at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
+  return at::detail::createCPUGenerator(mix(seed ^ mix(purpose ^ mix(iteration))));
+}
 
 at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
                         const at::Tensor& weight, const at::Tensor& bias) {
@@ -83,7 +83,13 @@ std::string TrainConfig::toJson() const {
                       {"seed", seed},
                       {"background", {background[0], background[1], background[2]}},
                       {"device", device},
-                      {"max_gaussians", max_gaussians}};
+                      {"max_gaussians", max_gaussians},
+                      {"drop", drop},
+                      {"p_base", p_base},
+                      {"drop_interval", drop_interval},
+                      {"lambda_l0", lambda_l0},
+                      {"lr_log_alpha", lr_log_alpha},
+                      {"log_alpha_init", log_alpha_init}};
   return j.dump(2) + "\n";
 }
 
@@ -137,6 +143,12 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   for (int k = 0; k < 3; ++k) c.background[k] = d["background"][k];
   c.device = d["device"];
   c.max_gaussians = d["max_gaussians"];
+  c.drop = d["drop"];
+  c.p_base = d["p_base"];
+  c.drop_interval = d["drop_interval"];
+  c.lambda_l0 = d["lambda_l0"];
+  c.lr_log_alpha = d["lr_log_alpha"];
+  c.log_alpha_init = d["log_alpha_init"];
   return c;
 }
 
@@ -154,7 +166,8 @@ struct Trainer::State {
   std::vector<int> train_views, labelled_views;
   // Parameters: means, sh_dc, sh_rest, opacity, scales, quats, features; decoder W, b.
   std::vector<Param> params;
-  at::Tensor log_alpha;  // [N], carried along (trained by the drop, later)
+  at::Tensor confidence;  // [N] last semantic confidence computed by the drop (0 before)
+  std::shared_ptr<const DropStrategy> drop;
   // Densification statistics.
   at::Tensor grad_accum, denom, max_radii;
   std::int64_t adam_step = 0;
@@ -209,8 +222,7 @@ struct Trainer::State {
       at::Tensor kept = t.index_select(0, idx);
       return added > 0 ? at::cat({kept, fill}, 0) : kept;
     };
-    log_alpha = grow(log_alpha, extra.count("log_alpha") ? extra.at("log_alpha")
-                                                           : at::zeros({added}, log_alpha.options()));
+    confidence = grow(confidence, at::zeros({added}, confidence.options()));
     grad_accum = grow(grad_accum, at::zeros({added}, grad_accum.options()));
     denom = grow(denom, at::zeros({added}, denom.options()));
     max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
@@ -234,7 +246,7 @@ struct Trainer::State {
     at::Tensor split_means;
     {
       const at::Tensor s = scales.index_select(0, split_idx).repeat({2, 1});
-      at::Generator gen = generatorFor(config.seed, 7, static_cast<std::uint64_t>(iteration));
+      at::Generator gen = seededGenerator(config.seed, 7, static_cast<std::uint64_t>(iteration));
       const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(device) * s;
       const at::Tensor q = p("quats").value.detach().index_select(0, split_idx).repeat({2, 1});
       const at::Tensor qn = q / q.norm(2, 1, true);
@@ -258,8 +270,6 @@ struct Trainer::State {
       if (q.name == "scales") splitted = splitted - std::log(1.6);
       extra[q.name] = at::cat({cloned, splitted}, 0);
     }
-    extra["log_alpha"] = at::cat({log_alpha.index_select(0, clone_idx),
-                                  log_alpha.index_select(0, split_idx).repeat({2})}, 0);
     // Originals of split Gaussians go; so do transparent (and, later, huge) ones.
     at::Tensor keep = split.logical_not();
     const at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
@@ -363,17 +373,22 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   add("scales", t.log_scales, config.lr_scaling);
   add("quats", t.rotations, config.lr_rotation);
   add("features", t.features, config.lr_feature);
-  at::Generator gen = generatorFor(config.seed, 3, 0);
+  at::Generator gen = seededGenerator(config.seed, 3, 0);
   const double bound = 1.0 / std::sqrt(std::max(1, config.feature_dim));
   add("decoder_w",
       at::empty({s.num_classes, config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),
       config.lr_decoder, false);
   add("decoder_b", at::zeros({s.num_classes}, at::TensorOptions().device(s.device)), config.lr_decoder, false);
-  s.log_alpha = t.log_alpha;
+  add("log_alpha", at::full({s.n()}, config.log_alpha_init, t.means.options()), config.lr_log_alpha);
   const auto fopts = at::TensorOptions().dtype(at::kFloat).device(s.device);
   s.grad_accum = at::zeros({s.n()}, fopts);
   s.denom = at::zeros({s.n()}, fopts);
   s.max_radii = at::zeros({s.n()}, fopts);
+  s.confidence = at::zeros({s.n()}, fopts);
+}
+
+void Trainer::setDropStrategy(std::shared_ptr<const DropStrategy> strategy) {
+  state_->drop = std::move(strategy);
 }
 
 Trainer::~Trainer() = default;
@@ -413,10 +428,12 @@ StepStats Trainer::step() {
   RenderSettings settings;
   settings.sh_degree = s.shDegree();
   settings.background = c.background;
-  const GaussianParams g = s.gaussians();
+  GaussianParams g = s.gaussians();
+  if (s.drop) g.opacity_gate = s.drop->trainingGate(s.p("log_alpha").value, it);
   at::Tensor total;
   double rgb_sum = 0, sem_sum = 0;
   std::vector<RenderResult> renders;
+  std::int64_t dropped = 0;
   for (int v : views) {
     RenderResult r = render(g, s.cameras[v], settings);
     r.means2d.retain_grad();
@@ -437,6 +454,10 @@ StepStats Trainer::step() {
     }
     total = total.defined() ? total + loss : loss;
     renders.push_back(r);
+  }
+  if (s.drop) {
+    const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value);
+    if (reg.defined()) total = total + reg;
   }
   total.backward();
 
@@ -470,6 +491,21 @@ StepStats Trainer::step() {
     }
     s.iteration = it + 1;
     const int done = s.iteration;
+    if (s.drop && s.drop->dropNow(done)) {
+      DropInputs in;
+      in.means = s.p("means").value.detach();
+      in.opacities = at::sigmoid(s.p("opacity").value.detach());
+      in.log_alpha = s.p("log_alpha").value.detach();
+      for (int v : s.labelled_views) {
+        in.cameras.push_back(s.cameras[v]);
+        in.labels.push_back(s.labels[v]);
+      }
+      in.num_classes = s.num_classes;
+      auto [keep, confidence] = s.drop->decide(in, done);
+      s.confidence = confidence.to(s.device).to(at::kFloat);
+      dropped = s.n() - keep.sum().item<std::int64_t>();
+      s.resize(keep.to(s.device), {});
+    }
     if (done <= c.densify_until) {
       if (done > c.densify_from && done % c.densify_interval == 0) {
         s.densifyAndPrune(done > c.opacity_reset_interval);
@@ -488,6 +524,7 @@ StepStats Trainer::step() {
   stats.semantic_loss = sem_sum;
   stats.loss = total.item<double>();
   stats.num_gaussians = s.n();
+  stats.dropped = dropped;
   return stats;
 }
 
@@ -496,7 +533,9 @@ RenderResult Trainer::renderView(const io::View& view) const {
   RenderSettings settings;
   settings.sh_degree = state_->shDegree();
   settings.background = state_->config.background;
-  return render(state_->gaussians(), RasterCamera::fromPinhole(view.camera), settings);
+  GaussianParams g = state_->gaussians();
+  if (state_->drop) g.opacity_gate = state_->drop->evaluationGate(state_->p("log_alpha").value);
+  return render(g, RasterCamera::fromPinhole(view.camera), settings);
 }
 
 at::Tensor Trainer::predictClasses(const RenderResult& r) const {
@@ -518,8 +557,8 @@ pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
   t.log_scales = s.p("scales").value.detach();
   t.rotations = s.p("quats").value.detach();
   t.features = s.p("features").value.detach();
-  t.log_alpha = s.log_alpha;
-  t.confidence = at::zeros_like(s.log_alpha);
+  t.log_alpha = s.p("log_alpha").value.detach();
+  t.confidence = s.confidence;
   t.labels = t.features.size(1) > 0 ? s.decode(t.features).argmax(1)
                                     : at::full({s.n()}, -1, t.means.options().dtype(at::kLong));
   return gaussians::toCloud(t);
@@ -533,7 +572,7 @@ void Trainer::saveCheckpoint(const std::string& path) const {
     a.tensors[q.name + ".m"] = q.m;
     a.tensors[q.name + ".v"] = q.v;
   }
-  a.tensors["log_alpha"] = s.log_alpha;
+  a.tensors["confidence"] = s.confidence;
   a.tensors["grad_accum"] = s.grad_accum;
   a.tensors["denom"] = s.denom;
   a.tensors["max_radii"] = s.max_radii;
@@ -558,7 +597,7 @@ void Trainer::loadCheckpoint(const std::string& path) {
     q.m = a.tensor(q.name + ".m", path).to(s.device).contiguous();
     q.v = a.tensor(q.name + ".v", path).to(s.device).contiguous();
   }
-  s.log_alpha = a.tensor("log_alpha", path).to(s.device);
+  s.confidence = a.tensor("confidence", path).to(s.device);
   s.grad_accum = a.tensor("grad_accum", path).to(s.device);
   s.denom = a.tensor("denom", path).to(s.device);
   s.max_radii = a.tensor("max_radii", path).to(s.device);
@@ -582,7 +621,7 @@ void Trainer::checkConsistency() const {
     expect(q.m, q.name + " Adam m");
     expect(q.v, q.name + " Adam v");
   }
-  expect(s.log_alpha, "log_alpha");
+  expect(s.confidence, "confidence");
   expect(s.grad_accum, "grad_accum");
   expect(s.denom, "denom");
   expect(s.max_radii, "max_radii");

@@ -17,6 +17,7 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/semantic_drop/drop_strategy.h"
 
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/aerial_benchmark.h"
@@ -100,6 +101,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   }
   const io::Scene scene = loadScene(o.scene, o.scale);
   gaussians::Trainer trainer(scene, config);
+  trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   if (o.resume) trainer.loadCheckpoint(checkpoint);
   writeText(o.out + "/config.json", trainer.config().toJson());
   const auto start = Clock::now();
@@ -108,6 +110,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   while (trainer.iteration() < config.iterations) {
     const gaussians::StepStats stats = trainer.step();
     const int it = stats.iteration;
+    if (stats.dropped > 0 && o.progress) {
+      *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
+                  << config.drop << ", P_base " << config.p_base << "), " << stats.num_gaussians
+                  << " left\n";
+    }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = (it - first) / std::max(1e-9, elapsed);
@@ -139,6 +146,7 @@ std::string evalRun(const std::string& run_dir, const std::string& scene_overrid
       io::readWholeFile(run_dir + "/config.json"), run_dir + "/config.json");
   const io::Scene scene = loadScene(scene_path, run_scale);
   gaussians::Trainer trainer(scene, config);
+  trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   trainer.loadCheckpoint(run_dir + "/checkpoint.bin");
   makeDirectory(run_dir + "/panels");
   const eval::EvalResult result = eval::evaluate(trainer, scene, run_dir + "/panels");

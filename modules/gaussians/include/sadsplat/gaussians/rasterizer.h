@@ -46,6 +46,7 @@ struct GaussianParams {
   at::Tensor opacity_logits;  ///< [N]
   at::Tensor sh;              ///< [N, K, 3], K >= (sh_degree + 1)^2
   at::Tensor features;        ///< [N, C] semantic features, C = 0..64+ (may be undefined: C = 0)
+  at::Tensor opacity_gate;    ///< [N] optional factor on the activated opacity (Hard Concrete gate)
 };
 
 /// \brief Rendered images and the per-Gaussian data densification needs.

@@ -54,6 +54,14 @@ struct TrainConfig {
   std::array<float, 3> background{0, 0, 0};
   std::string device = "cpu";      ///< "cpu" or "cuda"
   int max_gaussians = 3000000;     ///< densification stops growing past this
+  // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
+  // strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
+  std::string drop = "none";       ///< none | semantic | structure | full
+  double p_base = 1.0;             ///< paper: P_base = 1.0
+  int drop_interval = 500;         ///< paper: every N = 500 iterations
+  double lambda_l0 = 0.01;         ///< weight of L_L0
+  double lr_log_alpha = 0.01;
+  double log_alpha_init = 3.0;     ///< gates start open: P(z > 0) = 0.99
 
   /// \brief The configuration as JSON text.
   std::string toJson() const;
@@ -72,11 +80,45 @@ struct TrainConfig {
 at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
                         const at::Tensor& weight, const at::Tensor& bias);
 
+/// \brief A CPU generator determined by (seed, purpose, iteration): the trainer's randomness, so
+/// that a resumed run draws the same numbers as an uninterrupted one.
+at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration);
+
+/// \brief What a drop strategy sees when it decides.
+struct DropInputs {
+  at::Tensor means;      ///< [N, 3]
+  at::Tensor opacities;  ///< [N] activated
+  at::Tensor log_alpha;  ///< [N]
+  std::vector<RasterCamera> cameras;  ///< the labelled training views
+  std::vector<at::Tensor> labels;     ///< their label maps [H, W] int64, -1 = none
+  int num_classes = 0;
+};
+
+/// \brief The hook through which the semantic-aware drop (module semantic_drop) acts on
+/// training; the trainer works without one (the baseline).
+class DropStrategy {
+ public:
+  virtual ~DropStrategy() = default;
+  /// \brief Factor on each Gaussian's opacity in the training render of `iteration`
+  /// (undefined: none).
+  virtual at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const = 0;
+  /// \brief Factor on each Gaussian's opacity when rendering for evaluation (undefined: none).
+  virtual at::Tensor evaluationGate(const at::Tensor& log_alpha) const = 0;
+  /// \brief Term added to the training loss (undefined: none).
+  virtual at::Tensor regularisation(const at::Tensor& log_alpha) const = 0;
+  /// \brief Whether to drop once `iterations_done` iterations are done.
+  virtual bool dropNow(int iterations_done) const = 0;
+  /// \brief {keep [N] bool, confidence [N] float} for the current Gaussians.
+  virtual std::pair<at::Tensor, at::Tensor> decide(const DropInputs& inputs,
+                                                   int iterations_done) const = 0;
+};
+
 /// \brief Numbers reported after each step.
 struct StepStats {
   int iteration = 0;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;
   std::int64_t num_gaussians = 0;
+  std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
 };
 
 /// \brief Trains Gaussians on a scene.
@@ -92,6 +134,9 @@ class Trainer {
   ~Trainer();
   Trainer(const Trainer&) = delete;
   Trainer& operator=(const Trainer&) = delete;
+
+  /// \brief Installs the semantic-aware drop (none by default).
+  void setDropStrategy(std::shared_ptr<const DropStrategy> strategy);
 
   /// \brief One optimisation step (render, loss, backward, Adam, densification schedule).
   StepStats step();

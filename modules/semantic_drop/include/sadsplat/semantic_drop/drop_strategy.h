@@ -1,0 +1,24 @@
+#pragma once
+/// \file drop_strategy.h
+/// \brief The semantic-aware drop during training (paper, "Gaussian Point Drop"): Hard Concrete
+/// gates on the opacity, the L0 term, and every N iterations the removal of each Gaussian with
+/// probability P_drop = clamp(P_base (1 - P_conf) P_learned, 0, 1).
+
+#include <memory>
+
+#include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/semantic_drop/hard_concrete.h"
+
+namespace sadsplat {
+namespace semantic_drop {
+
+/// \brief The strategy for `config.drop` (none | semantic | structure | full), or nullptr for
+/// none. "semantic" uses only P_conf, "structure" only the gates (P_learned and L0), "full" both.
+/// Until pseudo-label confidence maps exist, P_conf comes from one-hot maps of the labelled
+/// views, so a Gaussian seen in none of them has P_conf = 0.
+/// \throws sadsplat::Error on an unknown mode or a negative P_base / interval
+std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& config,
+                                                                const HardConcreteParams& hc = {});
+
+}  // namespace semantic_drop
+}  // namespace sadsplat

@@ -1,0 +1,83 @@
+#include "sadsplat/semantic_drop/drop_strategy.h"
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/semantic_drop/semantic_confidence.h"
+
+namespace sadsplat {
+namespace semantic_drop {
+namespace {
+
+class SemanticDropStrategy : public gaussians::DropStrategy {
+ public:
+  SemanticDropStrategy(const gaussians::TrainConfig& c, bool semantic, bool structure,
+                       const HardConcreteParams& hc)
+      : semantic_(semantic), structure_(structure), p_base_(c.p_base), interval_(c.drop_interval),
+        iterations_(c.iterations), lambda_l0_(c.lambda_l0), seed_(c.seed), hc_(hc) {}
+
+  at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
+    if (!structure_) return {};
+    at::Generator gen = gaussians::seededGenerator(seed_, 13, static_cast<std::uint64_t>(iteration));
+    const at::Tensor u = at::empty({log_alpha.size(0)}, at::TensorOptions().dtype(log_alpha.scalar_type()))
+                             .uniform_(0, 1, gen)
+                             .to(log_alpha.device());
+    return sampleGate(log_alpha, u, hc_);
+  }
+
+  at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
+    return structure_ ? deterministicGate(log_alpha, hc_) : at::Tensor();
+  }
+
+  at::Tensor regularisation(const at::Tensor& log_alpha) const override {
+    // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0.
+    return structure_ ? lambda_l0_ * probabilityNonZero(log_alpha, hc_).mean() : at::Tensor();
+  }
+
+  bool dropNow(int done) const override {
+    return interval_ > 0 && done % interval_ == 0 && done < iterations_;
+  }
+
+  std::pair<at::Tensor, at::Tensor> decide(const gaussians::DropInputs& in, int done) const override {
+    const auto opts = in.means.options();
+    at::Tensor confidence = at::zeros({in.means.size(0)}, opts);
+    if (semantic_ && !in.cameras.empty()) {
+      std::vector<at::Tensor> maps;
+      for (const at::Tensor& labels : in.labels) maps.push_back(oneHotConfidence(labels, in.num_classes));
+      confidence = semanticConfidence(in.means, in.opacities, in.cameras, maps);
+    }
+    at::Tensor p_drop = at::full_like(confidence, p_base_);
+    if (semantic_) p_drop = p_drop * (1 - confidence);
+    if (structure_) p_drop = p_drop * (1 - probabilityNonZero(in.log_alpha, hc_));
+    p_drop = p_drop.clamp(0, 1);
+    at::Generator gen = gaussians::seededGenerator(seed_, 17, static_cast<std::uint64_t>(done));
+    const at::Tensor u = at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
+                             .uniform_(0, 1, gen)
+                             .to(in.means.device());
+    return {u >= p_drop, confidence};
+  }
+
+ private:
+  bool semantic_, structure_;
+  double p_base_;
+  int interval_, iterations_;
+  double lambda_l0_;
+  std::uint64_t seed_;
+  HardConcreteParams hc_;
+};
+
+}  // namespace
+
+std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
+                                                                const HardConcreteParams& hc) {
+  if (c.p_base < 0) throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
+  if (c.drop_interval < 1) {
+    throw Error("<config>", "drop_interval", "a positive number of iterations", std::to_string(c.drop_interval));
+  }
+  if (c.drop == "none") return nullptr;
+  if (c.drop == "semantic") return std::make_shared<SemanticDropStrategy>(c, true, false, hc);
+  if (c.drop == "structure") return std::make_shared<SemanticDropStrategy>(c, false, true, hc);
+  if (c.drop == "full") return std::make_shared<SemanticDropStrategy>(c, true, true, hc);
+  throw Error("<config>", "drop", "none, semantic, structure or full", c.drop);
+}
+
+}  // namespace semantic_drop
+}  // namespace sadsplat
