@@ -20,7 +20,7 @@ run="$work/run_$name"
 rm -rf "$run"
 "$bin" train "$cache" --device cuda --iterations "$iterations" --out "$run" "$@" \
   > "$out/train_$name.log" 2>&1
-tr '\r' '\n' < "$out/train_$name.log" | grep -c '^\[drop\]' | sed 's/^/drop events: /'; tr '\r' '\n' < "$out/train_$name.log" | tail -2
+tr '\r' '\n' < "$out/train_$name.log" | { grep -c '^\[drop\]' || true; } | sed 's/^/drop events: /'; tr '\r' '\n' < "$out/train_$name.log" | tail -2
 "$bin" eval "$run" > "$out/metrics_$name.json"
 cp "$run/config.json" "$out/config_$name.json"
 python3 - "$out/metrics_$name.json" <<'PY'
