@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
   auto* extract = app.add_subcommand("extract", "Write the Gaussians of one class");
   std::string extract_in, extract_out, extract_class, extract_classes;
   bool extract_negative = false;
-  extract->add_option("MODEL", extract_in, "input .ply or .pcd")->required();
+  extract->add_option("MODEL", extract_in, "input .ply / .pcd, or a run directory")->required();
   extract->add_option("--class", extract_class, "class name (or id)")->required();
   extract->add_option("--classes", extract_classes, "classes.json or scene cache naming classes");
   extract->add_option("--out", extract_out, "output .ply or .pcd")->required();
@@ -193,6 +193,12 @@ int main(int argc, char** argv) {
     } else if (*convert) {
       saveGaussians(convert_out, loadGaussians(convert_in));
     } else if (*extract) {
+      struct stat st {};
+      if (::stat(extract_in.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+        // A run directory: its model and its class list.
+        if (extract_classes.empty()) extract_classes = extract_in + "/classes.json";
+        extract_in += "/model.ply";
+      }
       auto cloud = std::make_shared<pcl::PointCloud<sadsplat::GaussianPoint>>(loadGaussians(extract_in));
       sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> filter;
       if (extract_classes.empty()) {

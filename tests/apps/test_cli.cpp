@@ -81,6 +81,12 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
     EXPECT_NE(out.find(key), std::string::npos) << key;
   }
   EXPECT_FALSE(test::readFile(run + "/panels/view_002.png").empty());
+  // Per-class extraction straight from the run directory (its model.ply and classes.json).
+  ASSERT_EQ(test::runCommand(kCli + " extract " + run + " --class road --out " + dir.file("road.ply"), &out), 0)
+      << out;
+  std::size_t roads = 0;
+  for (const auto& p : io::readGaussianPly(run + "/model.ply")) roads += p.label == 0;
+  EXPECT_EQ(io::readGaussianPly(dir.file("road.ply")).size(), roads);
   EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out), 1);
   EXPECT_NE(out.find("device"), std::string::npos) << out;
 }

@@ -135,6 +135,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   trainer.saveCheckpoint(checkpoint);
   writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);
   writeModel(o.out, trainer, scene.classes);
+  io::writeClassesJson(o.out + "/classes.json", scene.classes);
   return total;
 }
 
