@@ -59,7 +59,7 @@ struct TrainConfig {
   std::string drop = "none";       ///< none | semantic | structure | full
   double p_base = 1.0;             ///< paper: P_base = 1.0
   int drop_interval = 500;         ///< paper: every N = 500 iterations
-  double lambda_l0 = 0.01;         ///< weight of L_L0
+  double lambda_l0 = 0.1;          ///< weight of L_L0 (chosen on city/country/port, see README)
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;     ///< gates start open: P(z > 0) = 0.99
 
