@@ -2,7 +2,6 @@
 // sadsplat::Error become one message on stderr and exit status 1 (2 for usage errors).
 #include <CLI/CLI.hpp>
 
-#include <sys/stat.h>
 
 #include <chrono>
 #include <cstring>
@@ -13,6 +12,7 @@
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/io/file_info.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
@@ -33,19 +33,15 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 pcl::PointCloud<sadsplat::GaussianPoint> loadGaussians(const std::string& path) {
-  if (endsWith(path, ".pcd")) return sadsplat::io::loadGaussianPcd(path);
+  if (sadsplat::io::endsWith(path, ".pcd")) return sadsplat::io::loadGaussianPcd(path);
   return sadsplat::io::readGaussianPly(path);
 }
 
 void saveGaussians(const std::string& path, const pcl::PointCloud<sadsplat::GaussianPoint>& cloud) {
-  if (endsWith(path, ".pcd")) {
+  if (sadsplat::io::endsWith(path, ".pcd")) {
     sadsplat::io::savePcd(path, cloud);
-  } else if (endsWith(path, ".ply")) {
+  } else if (sadsplat::io::endsWith(path, ".ply")) {
     sadsplat::io::writeGaussianPly(path, cloud);
   } else {
     throw sadsplat::Error(path, "output file name", "a name ending in .ply or .pcd");
@@ -193,8 +189,7 @@ int main(int argc, char** argv) {
     } else if (*convert) {
       saveGaussians(convert_out, loadGaussians(convert_in));
     } else if (*extract) {
-      struct stat st {};
-      if (::stat(extract_in.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+      if (sadsplat::io::isDirectory(extract_in)) {
         // A run directory: its model and its class list.
         if (extract_classes.empty()) extract_classes = extract_in + "/classes.json";
         extract_in += "/model.ply";

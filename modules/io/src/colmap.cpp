@@ -1,7 +1,5 @@
 #include "sadsplat/io/colmap.h"
 
-#include <sys/stat.h>
-
 #include <cmath>
 #include <cstring>
 #include <iomanip>
@@ -11,15 +9,11 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
 
 namespace sadsplat {
 namespace io {
 namespace {
-
-bool fileExists(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
 
 bool knownModel(int id) { return id >= 0 && id <= 4; }
 
@@ -385,15 +379,15 @@ int cameraModelNumParams(CameraModel model) {
 
 ColmapModel readColmapModel(const std::string& dir) {
   ColmapModel model;
-  const bool binary = fileExists(dir + "/cameras.bin") && fileExists(dir + "/images.bin") &&
-                      fileExists(dir + "/points3D.bin");
+  const bool binary = isRegularFile(dir + "/cameras.bin") && isRegularFile(dir + "/images.bin") &&
+                      isRegularFile(dir + "/points3D.bin");
   if (binary) {
     model.cameras = readCamerasBinary(dir + "/cameras.bin");
     model.images = readImagesBinary(dir + "/images.bin");
     model.points = readPointsBinary(dir + "/points3D.bin");
   } else {
     for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
-      if (!fileExists(dir + "/" + name)) {
+      if (!isRegularFile(dir + "/" + name)) {
         throw Error(dir + "/" + name, "file",
                     "a COLMAP model: cameras, images and points3D as .txt or .bin", "missing");
       }

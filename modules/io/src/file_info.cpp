@@ -1,13 +1,12 @@
 #include "sadsplat/io/file_info.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <iomanip>
 #include <limits>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
@@ -16,10 +15,6 @@
 namespace sadsplat {
 namespace io {
 namespace {
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 template <typename Range, typename GetXyz>
 void describeBounds(std::ostream& out, const Range& points, GetXyz xyz) {
@@ -86,9 +81,8 @@ void describeScene(std::ostream& out, const Scene& scene) {
 
 std::string describeFile(const std::string& path) {
   std::ostringstream out;
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw Error(path, "file", "an existing file or directory", "missing");
-  if (S_ISDIR(st.st_mode)) {
+  if (!pathExists(path)) throw Error(path, "file", "an existing file or directory", "missing");
+  if (isDirectory(path)) {
     out << path << ": scene directory\n";
     describeScene(out, importScene(path));
   } else if (isSceneCache(path)) {

@@ -1,7 +1,5 @@
 #include "sadsplat/io/scene_import.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -9,6 +7,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/filesystem.h"
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/calib3d.hpp>
@@ -28,11 +27,6 @@ Scene importScene(const std::string& dir, const ImportOptions&) {
 }
 #else
 namespace {
-
-bool exists(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0;
-}
 
 std::string stem(const std::string& name) {
   const auto slash = name.find_last_of('/');
@@ -134,7 +128,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   if (!(options.scale > 0.0 && options.scale <= 1.0)) {
     throw Error("<import options>", "scale", "a value in (0, 1]", std::to_string(options.scale));
   }
-  if (!exists(dir)) throw Error(dir, "scene directory", "an existing directory", "missing");
+  if (!pathExists(dir)) throw Error(dir, "scene directory", "an existing directory", "missing");
   Scene scene;
   scene.source = dir;
   scene.classes = readClassesJson(dir + "/classes.json");
@@ -143,7 +137,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   for (const auto& c : model.cameras) cameras[c.id] = &c;
 
   SplitInfo split;
-  const bool have_split = exists(dir + "/split.json");
+  const bool have_split = pathExists(dir + "/split.json");
   if (have_split) split = readSplitJson(dir + "/split.json");
   const std::set<std::string> train(split.train.begin(), split.train.end());
   const std::set<std::string> test(split.test.begin(), split.test.end());
@@ -169,7 +163,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
       throw Error(image_path, "image data", "a readable image named in sparse/0/images",
-                  exists(image_path) ? "cannot decode" : "missing");
+                  pathExists(image_path) ? "cannot decode" : "missing");
     }
     if (bgr.cols != static_cast<int>(cam.width) || bgr.rows != static_cast<int>(cam.height)) {
       throw Error(image_path, "size",
@@ -186,7 +180,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
 
     cv::Mat labels;
     const std::string label_path = dir + "/labels/" + stem(im->name) + ".png";
-    if (exists(label_path)) {
+    if (pathExists(label_path)) {
       labels = readLabelMap(label_path, scene.classes);
       if (labels.size() != bgr.size()) {
         throw Error(label_path, "size",

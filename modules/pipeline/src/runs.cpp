@@ -1,7 +1,5 @@
 #include "sadsplat/pipeline/runs.h"
 
-#include <sys/stat.h>
-
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -13,6 +11,7 @@
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/eval/evaluation.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
@@ -29,22 +28,9 @@ namespace pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-bool isDirectory(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-bool exists(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0;
-}
-
-void makeDirectory(const std::string& dir) {
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw Error(dir, "directory", "a directory that can be created", std::strerror(errno));
-  }
-}
+using io::isDirectory;
+using io::makeDirectory;
+using io::pathExists;
 
 void writeText(const std::string& path, const std::string& text) {
   io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
@@ -91,7 +77,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   gaussians::TrainConfig config = config_in;
   double previous_seconds = 0;
   if (o.resume) {
-    if (!exists(checkpoint)) throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
+    if (!pathExists(checkpoint)) throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
     // The run's own configuration wins: resuming continues the same run.
     config = gaussians::TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"),
                                               o.out + "/config.json");

@@ -1,26 +1,18 @@
 #include "sadsplat/synth/scene_writer.h"
 
-#include <sys/stat.h>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <cerrno>
 #include <cstring>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/filesystem.h"
 
 namespace sadsplat {
 namespace synth {
 namespace {
-
-void makeDirectory(const std::string& dir) {
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw Error(dir, "directory", "a directory that can be created", std::strerror(errno));
-  }
-}
 
 void writePng(const std::string& path, const cv::Mat& image) {
   std::vector<std::uint8_t> bytes;
@@ -71,8 +63,8 @@ cv::Mat bgr(const SynthView& v) {
 }  // namespace
 
 void writeScene(const SynthScene& scene, const std::string& dir) {
-  makeDirectory(dir);
-  for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"}) makeDirectory(dir + sub);
+  io::makeDirectory(dir);
+  for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"}) io::makeDirectory(dir + sub);
   io::ColmapModel model;
   io::ColmapCamera cam;
   cam.id = 1;
