@@ -18,6 +18,7 @@
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
 #include "sadsplat/synth/aerial_benchmark.h"
@@ -151,6 +152,26 @@ int main(int argc, char** argv) {
   train->add_option("--drop", train_drop, "semantic-aware drop: none, semantic, structure or full");
   train->add_option("--p-base", train_p_base, "base drop rate P_base (1.0)");
 
+  auto* pseudo = app.add_subcommand(
+      "pseudo-labels", "Write confidence maps and filtered pseudo-labels of the training views into the scene cache");
+  sadsplat::pipeline::PseudoLabelRunOptions pseudo_options;
+  pseudo->add_option("SCENE", pseudo_options.scene, "scene cache (updated in place) or scene directory")->required();
+  pseudo->add_option("--out", pseudo_options.out, "scene cache to write instead");
+  pseudo->add_option("--backend", pseudo_options.backend, "builtin or torchscript")->capture_default_str();
+  pseudo->add_option("--sam", pseudo_options.sam_model, "torchscript: SAM TorchScript file");
+  pseudo->add_option("--clip", pseudo_options.clip_model, "torchscript: CLIP TorchScript file");
+  pseudo->add_option("--report", pseudo_options.report_dir, "write report.json/.txt and overlays here");
+  pseudo->add_option("--filter-k", pseudo_options.filter.filter_k, "thresholds mean + k std (paper: 1)")
+      ->capture_default_str();
+  pseudo->add_option("--region-size", pseudo_options.builtin.superpixels.region_size, "builtin: superpixel size in pixels")
+      ->capture_default_str();
+  std::string pseudo_scale = "log-odds";
+  pseudo->add_option("--filter-scale", pseudo_scale, "TOP1/dTOP measured on the scores (paper) or as log-odds")
+      ->check(CLI::IsMember({"score", "log-odds"}))->capture_default_str();
+  bool pseudo_no_geometry = false;
+  pseudo->add_flag("--no-geometry", pseudo_no_geometry, "builtin: do not use the sparse points' heights");
+  pseudo->add_option("--scale", pseudo_options.scale, "image scale when importing a directory")->capture_default_str();
+
   auto* evaluate = app.add_subcommand("eval", "Evaluate a training run on its test views");
   std::string eval_run, eval_scene;
   evaluate->add_option("RUN", eval_run, "run directory")->required();
@@ -244,6 +265,12 @@ int main(int argc, char** argv) {
       options.progress = &std::cout;
       const double seconds = sadsplat::pipeline::trainRun(options, config);
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
+    } else if (*pseudo) {
+      pseudo_options.builtin.geometry = !pseudo_no_geometry;
+      pseudo_options.filter.scale = pseudo_scale == "log-odds" ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
+                                                               : sadsplat::pseudo_labels::ScoreScale::kScore;
+      pseudo_options.progress = &std::cout;
+      std::cout << sadsplat::pipeline::pseudoLabelRun(pseudo_options);
     } else if (*evaluate) {
       std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
     } else if (*demo) {

@@ -25,6 +25,10 @@ class ByteWriter {
     put<std::uint32_t>(static_cast<std::uint32_t>(s.size()));
     bytes_.append(s);
   }
+  template <typename T>
+  void putArray(const std::vector<T>& v) {
+    bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
   void putBytes(const std::vector<std::uint8_t>& v) {
     bytes_.append(reinterpret_cast<const char*>(v.data()), v.size());
   }
@@ -70,6 +74,14 @@ class ByteReader {
     std::vector<std::uint8_t> v(reinterpret_cast<const std::uint8_t*>(data_ + pos_),
                                 reinterpret_cast<const std::uint8_t*>(data_ + pos_ + n));
     pos_ += n;
+    return v;
+  }
+  template <typename T>
+  std::vector<T> getArray(std::size_t n, const char* field) {
+    if (n > remaining() / sizeof(T)) need(remaining() + 1, field);
+    std::vector<T> v(n);
+    std::memcpy(v.data(), data_ + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
     return v;
   }
   ByteReader subReader(std::size_t n, const std::string& context) {
@@ -155,6 +167,23 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
     c.putBytes(v.mask.pixels);
     if (!v.labels.empty()) c.putBytes(v.labels.pixels);
     payload.putChunk("VIEW", c);
+    if (!v.pseudo.empty()) {
+      // Pseudo-labels follow their view as a chunk of their own, so readers that predate them
+      // skip them (the format version stays 1).
+      const ViewPseudoLabels& p = v.pseudo;
+      p.validate(path + " (view " + v.name + ")", pixels);
+      ByteWriter q;
+      q.putString(v.name);
+      q.putString(p.backend);
+      q.put<std::uint32_t>(static_cast<std::uint32_t>(p.num_targets));
+      q.put<std::uint32_t>(static_cast<std::uint32_t>(p.num_classes));
+      q.put<std::uint32_t>(static_cast<std::uint32_t>(p.feature_dim));
+      q.putArray(p.region);
+      q.putArray(p.scores);
+      q.putArray(p.features);
+      q.putBytes(p.kept);
+      payload.putChunk("PSLB", q);
+    }
   }
   {
     ByteWriter c;
@@ -277,6 +306,27 @@ Scene readSceneCache(const std::string& path) {
         }
         for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
       }
+    } else if (tag == "PSLB") {
+      const std::string name = c.getString("view name");
+      if (scene.views.empty() || scene.views.back().name != name) {
+        throw Error(path, "chunk PSLB view", "the view read just before it", name);
+      }
+      View& v = scene.views.back();
+      ViewPseudoLabels& p = v.pseudo;
+      p.backend = c.getString("backend");
+      p.num_targets = static_cast<int>(c.get<std::uint32_t>("target count"));
+      p.num_classes = static_cast<int>(c.get<std::uint32_t>("class count"));
+      p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
+      const std::size_t pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
+      p.region = c.getArray<std::int32_t>(pixels, "region map");
+      p.scores = c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
+      p.features = c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.feature_dim, "features");
+      p.kept = c.getBytes(p.num_targets, "kept flags");
+      if (p.num_classes != static_cast<int>(scene.classes.size())) {
+        throw Error(path, "view " + name + " pseudo-labels class count",
+                    std::to_string(scene.classes.size()), std::to_string(p.num_classes));
+      }
+      p.validate(path + " (view " + name + ")", pixels);
     }
     // Unknown chunks are skipped: later versions may add chunks readers can ignore.
   }

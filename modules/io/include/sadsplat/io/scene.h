@@ -39,6 +39,33 @@ struct Image8 {
   }
 };
 
+/// \brief Pseudo-labels of one view (paper, "Pseudo-Label Generation Module"), stored compactly:
+/// the view is split into targets (regions); each target carries its class scores, its feature
+/// and whether the TOP1 / dTOP / entropy filter kept it. The confidence map (H x W x C) is the
+/// target's scores at the target's pixels and 0 outside any target; the pseudo-label map is the
+/// argmax of a kept target's scores; the pseudo-feature map is a kept target's feature.
+struct ViewPseudoLabels {
+  std::string backend;               ///< "builtin" or "torchscript" (informational)
+  std::vector<std::int32_t> region;  ///< per pixel (row-major): target id, or -1 for none
+  int num_targets = 0;
+  int num_classes = 0;
+  std::vector<float> scores;         ///< num_targets x num_classes, each row a distribution
+  int feature_dim = 0;
+  std::vector<float> features;       ///< num_targets x feature_dim
+  std::vector<std::uint8_t> kept;    ///< num_targets: 1 = passed the filter
+
+  bool empty() const { return region.empty(); }
+  /// \brief Class of the kept target at each pixel, or -1 (not kept, no target).
+  std::vector<std::int16_t> labelMap() const;
+  /// \brief The confidence map's maximum over classes at each pixel (0 outside any target).
+  std::vector<float> maxScoreMap() const;
+  /// \brief The dense confidence map, H x W x C floats (pixel-major).
+  std::vector<float> confidenceMap() const;
+  /// \brief Checks sizes and ranges against a view of `pixels` pixels.
+  /// \throws sadsplat::Error naming `origin` and the field
+  void validate(const std::string& origin, std::size_t pixels) const;
+};
+
 /// \brief One posed image of the scene.
 struct View {
   std::string name;       ///< image file name, relative to images/
@@ -49,7 +76,14 @@ struct View {
   bool train = false;     ///< in the training set
   bool test = false;      ///< in the test set
   bool labelled = false;  ///< a training view whose label map supervises training
+  ViewPseudoLabels pseudo;  ///< empty until `sadsplat pseudo-labels` ran on the scene
 };
+
+/// \brief The class ids that supervise the semantic loss on a view, -1 = none: on a labelled view
+/// its ground truth (ground truth always wins over pseudo-labels, also where it says "ignore"),
+/// otherwise the kept pseudo-labels if `use_pseudo` and the view has them, otherwise all -1.
+/// Pixels outside the view's mask are -1.
+std::vector<std::int16_t> supervisionLabels(const View& view, bool use_pseudo = true);
 
 /// \brief One sparse (SfM) point.
 struct ScenePoint {

@@ -1,0 +1,112 @@
+#include "sadsplat/pipeline/pseudo_label_run.h"
+
+#include <chrono>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/scene_cache.h"
+#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pseudo_labels/quality_report.h"
+#include "sadsplat/pseudo_labels/torchscript_scorer.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#endif
+
+namespace sadsplat {
+namespace pipeline {
+namespace {
+
+#if SADSPLAT_HAVE_OPENCV
+// Image | pseudo-labels (class colours where kept, grey where a target was filtered out) |
+// ground truth where the view has it.
+void writeOverlay(const std::string& path, const io::View& v, const std::vector<ClassInfo>& classes) {
+  const int W = v.camera.width, H = v.camera.height;
+  const bool gt = !v.labels.empty();
+  cv::Mat out(H, W * (gt ? 3 : 2), CV_8UC3, cv::Scalar(0, 0, 0));
+  const std::vector<std::int16_t> label = v.pseudo.labelMap();
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      const std::uint8_t* p = &v.rgb.pixels[3 * i];
+      out.at<cv::Vec3b>(y, x) = cv::Vec3b(p[2], p[1], p[0]);
+      cv::Vec3b c(0, 0, 0);
+      if (label[i] >= 0) {
+        const auto& k = classes[label[i]].color;
+        c = cv::Vec3b(k[2] / 2 + p[2] / 2, k[1] / 2 + p[1] / 2, k[0] / 2 + p[0] / 2);
+      } else if (v.pseudo.region[i] >= 0) {
+        const std::uint8_t g = static_cast<std::uint8_t>((p[0] + p[1] + p[2]) / 9);
+        c = cv::Vec3b(g, g, g);
+      }
+      out.at<cv::Vec3b>(y, W + x) = c;
+      if (gt) {
+        const int l = v.labels.pixels[i];
+        if (l < static_cast<int>(classes.size())) {
+          const auto& k = classes[l].color;
+          out.at<cv::Vec3b>(y, 2 * W + x) = cv::Vec3b(k[2], k[1], k[0]);
+        }
+      }
+    }
+  }
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", out, png);
+  io::writeFileAtomically(path, [&](std::ostream& o) {
+    o.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
+#endif
+
+}  // namespace
+
+std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
+  const bool input_is_cache = !io::isDirectory(o.scene);
+  const std::string out = o.out.empty() ? (input_is_cache ? o.scene : "") : o.out;
+  if (out.empty()) {
+    throw Error(o.scene, "--out", "a scene cache file to write (the input is a scene directory)");
+  }
+  io::Scene scene = loadScene(o.scene, o.scale);
+  pseudo_labels::TargetScorer::Ptr scorer;
+  if (o.backend == "builtin") {
+    scorer = pseudo_labels::makeBuiltinScorer(o.builtin);
+  } else if (o.backend == "torchscript") {
+    if (o.sam_model.empty() || o.clip_model.empty()) {
+      throw Error("<command line>", "--backend torchscript", "--sam FILE and --clip FILE");
+    }
+    scorer = pseudo_labels::makeTorchScriptScorer(o.sam_model, o.clip_model);
+  } else {
+    throw Error("<command line>", "--backend", "builtin or torchscript", o.backend);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  pseudo_labels::ProgressFn progress;
+  if (o.progress) progress = [&](const std::string& line) { *o.progress << "  " << line << "\n" << std::flush; };
+  const pseudo_labels::PseudoLabelSummary s = pseudo_labels::generatePseudoLabels(scene, *scorer, o.filter, progress);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  io::writeSceneCache(out, scene);
+  if (o.progress) {
+    *o.progress << s.backend << ": " << s.views << " training views, " << s.targets << " targets, "
+                << s.kept_targets << " kept (TOP1 > " << s.statistics.top1_mean + o.filter.filter_k * s.statistics.top1_std
+                << ", dTOP > " << s.statistics.delta_top_mean + o.filter.filter_k * s.statistics.delta_top_std
+                << ", entropy < " << s.statistics.entropy_mean + o.filter.filter_k * s.statistics.entropy_std
+                << ") in " << seconds << " s; wrote " << out << "\n";
+  }
+  if (o.report_dir.empty()) return "";
+  io::makeDirectory(o.report_dir);
+  const pseudo_labels::PseudoLabelQuality q = pseudo_labels::evaluatePseudoLabels(scene);
+  const std::string text = q.toText();
+  io::writeFileAtomically(o.report_dir + "/report.json", [&](std::ostream& f) { f << q.toJson(); });
+  io::writeFileAtomically(o.report_dir + "/report.txt", [&](std::ostream& f) { f << text; });
+#if SADSPLAT_HAVE_OPENCV
+  io::makeDirectory(o.report_dir + "/overlays");
+  int written = 0;
+  for (const io::View& v : scene.views) {
+    if (v.pseudo.empty() || written >= 6) continue;
+    writeOverlay(o.report_dir + "/overlays/" + v.name + ".png", v, scene.classes);
+    ++written;
+  }
+#endif
+  return text;
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat

@@ -1,0 +1,78 @@
+#pragma once
+/// \file generator.h
+/// \brief `sadsplat pseudo-labels`: splits every training view into targets, scores each target
+/// against every class with a backend, applies the TOP1 / dTOP / entropy filter over all targets
+/// of the training set, and stores the result in each view's io::ViewPseudoLabels.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sadsplat/io/scene.h"
+#include "sadsplat/pseudo_labels/few_shot_classifier.h"
+#include "sadsplat/pseudo_labels/superpixels.h"
+#include "sadsplat/pseudo_labels/target_filter.h"
+
+namespace sadsplat {
+namespace pseudo_labels {
+
+/// \brief The targets of one view with their class scores and features.
+struct ViewTargets {
+  Segmentation segmentation;
+  std::vector<float> scores;    ///< num_regions x C, rows are distributions
+  int feature_dim = 0;
+  std::vector<float> features;  ///< num_regions x feature_dim
+};
+
+/// \brief Progress lines ("view 12/67 ..."); may be empty.
+using ProgressFn = std::function<void(const std::string&)>;
+
+/// \brief A mask generator + region scorer (the two halves of the paper's preprocessing).
+class TargetScorer {
+ public:
+  using Ptr = std::shared_ptr<TargetScorer>;
+  virtual ~TargetScorer() = default;
+  virtual std::string name() const = 0;
+  /// \brief Targets and scores for the views `views` (indices into scene.views).
+  virtual std::vector<ViewTargets> score(const io::Scene& scene, const std::vector<int>& views,
+                                         const ProgressFn& progress) = 0;
+};
+
+/// \brief Options of the built-in backend.
+struct BuiltinOptions {
+  SlicOptions superpixels;
+  ClassifierOptions classifier;
+  bool geometry = true;         ///< use the sparse points' heights as a descriptor
+  double min_purity = 0.7;      ///< a labelled region trains the scorer if this share agrees
+};
+
+/// \brief The built-in backend: SLIC targets, few-shot classifier fitted on the labelled views.
+/// \throws sadsplat::Error (from score) if no labelled view has labels
+TargetScorer::Ptr makeBuiltinScorer(const BuiltinOptions& options = {});
+
+/// \brief Options of a pseudo-label run.
+struct PseudoLabelOptions {
+  double filter_k = 1.0;  ///< thresholds mean + k std (paper: 1)
+  /// Where TOP1 / dTOP are measured. Both backends score with softmax probabilities; on the
+  /// log-odds scale dTOP = log(p1 / p2) is, for CLIP, logit_scale * (cos1 - cos2): the paper's
+  /// dTOP on cosine similarities up to a factor, which the mean + k std rule ignores.
+  ScoreScale scale = ScoreScale::kLogOdds;
+};
+
+/// \brief What a run did.
+struct PseudoLabelSummary {
+  std::string backend;
+  int views = 0;
+  std::size_t targets = 0, kept_targets = 0;
+  TargetStatistics statistics;
+};
+
+/// \brief Runs `scorer` on every training view of `scene`, filters, and fills `view.pseudo`
+/// of those views (other views' pseudo-labels are cleared).
+PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
+                                        const PseudoLabelOptions& options = {},
+                                        const ProgressFn& progress = {});
+
+}  // namespace pseudo_labels
+}  // namespace sadsplat
