@@ -46,6 +46,46 @@ TEST_F(TrainerTest, RgbLossFallsOnTheTinyScene) {
   EXPECT_EQ(trainer.iteration(), 240);
 }
 
+// Pseudo-labels supervise the unlabelled training views: give every unlabelled training view of
+// the tiny scene one kept target per class (from its label map) and count the steps with a
+// semantic loss; with no extra labelled render (semantic_interval 0) only the drawn view counts.
+TEST_F(TrainerTest, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
+  int unlabelled = 0;
+  for (io::View& v : scene_.views) {
+    if (!v.train || v.labelled) continue;
+    ++unlabelled;
+    io::ViewPseudoLabels& p = v.pseudo;
+    p.num_classes = static_cast<int>(scene_.classes.size());
+    p.num_targets = p.num_classes;
+    p.region.resize(v.labels.pixels.size());
+    for (std::size_t i = 0; i < p.region.size(); ++i) {
+      p.region[i] = v.labels.pixels[i] == io::kIgnoreLabel ? -1 : v.labels.pixels[i];
+    }
+    p.scores.assign(p.num_targets * p.num_classes, 0.0f);
+    for (int t = 0; t < p.num_targets; ++t) p.scores[t * p.num_classes + t] = 1.0f;
+    p.kept.assign(p.num_targets, 1);
+  }
+  ASSERT_GT(unlabelled, 0);
+  auto steps_with_semantic_loss = [&](bool use_pseudo, int* pseudo_views) {
+    TrainConfig c = small(24);
+    c.semantic_interval = 0;
+    c.use_pseudo_labels = use_pseudo;
+    Trainer trainer(scene_, c);
+    int n = 0;
+    for (int i = 0; i < 24; ++i) {
+      const auto stats = trainer.step();
+      n += stats.semantic_loss > 0;
+      *pseudo_views = stats.pseudo_labelled_views;
+    }
+    return n;
+  };
+  int pseudo_views = -1;
+  EXPECT_EQ(steps_with_semantic_loss(true, &pseudo_views), 24);
+  EXPECT_EQ(pseudo_views, unlabelled);
+  EXPECT_LT(steps_with_semantic_loss(false, &pseudo_views), 24);
+  EXPECT_EQ(pseudo_views, 0);
+}
+
 TEST(SemanticLoss, UnsupervisedPixelsGiveNoGradientAndNoValue) {
   at::manual_seed(3);
   const auto opts = at::TensorOptions().dtype(at::kDouble);

@@ -72,6 +72,50 @@ TEST(SemanticConfidence, EqualsAHandComputationOnATwoViewToyScene) {
   EXPECT_NEAR(c[0].item<float>(), (0.9f * 0.5f + 0.7f * 0.5f) / 2, 1e-6);
   EXPECT_NEAR(c[1].item<float>(), 0.4f * 0.8f, 1e-6);
   EXPECT_EQ(c[2].item<float>(), 0.f);
+  // Maps that already hold the maximum over classes give the same; `seen` marks visibility.
+  at::Tensor seen;
+  const at::Tensor c2 = semanticConfidence(means, opac, {cam, shifted},
+                                           {std::get<0>(m0.max(2)), std::get<0>(m1.max(2))}, &seen);
+  EXPECT_TRUE(at::allclose(c, c2));
+  EXPECT_TRUE(seen[0].item<bool>());
+  EXPECT_TRUE(seen[1].item<bool>());
+  EXPECT_FALSE(seen[2].item<bool>());
+}
+
+// 400 Gaussians: the first half in front of the camera on a confidence-1 map with open gates
+// (P_drop = 0), the second half behind it with closed gates (P_drop = clamp(P_base, 0, 1) = 1).
+TEST(DropStrategy, DecisionCountsTheReasonsOfTheRemovals) {
+  gaussians::RasterCamera cam;
+  cam.width = cam.height = 4;
+  cam.fx = cam.fy = 4;
+  cam.cx = cam.cy = 2;
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  gaussians::DropInputs in;
+  in.means = at::zeros({400, 3}, opts);
+  in.means.select(1, 2).slice(0, 0, 200).fill_(2.0f);
+  in.means.select(1, 2).slice(0, 200, 400).fill_(-2.0f);
+  in.opacities = at::ones({400}, opts);
+  in.log_alpha = at::full({400}, 20.0f, opts);
+  in.log_alpha.slice(0, 200, 400).fill_(-20.0f);
+  in.cameras = {cam};
+  in.confidence_maps = {at::ones({4, 4}, opts)};
+  gaussians::TrainConfig c;
+  c.drop = "full";
+  c.p_base = 1.5;
+  const gaussians::DropDecision d = makeDropStrategy(c)->decide(in, 500);
+  EXPECT_TRUE(d.keep.slice(0, 0, 200).all().item<bool>());
+  EXPECT_FALSE(d.keep.slice(0, 200, 400).any().item<bool>());
+  EXPECT_EQ(d.removed, 200);
+  EXPECT_EQ(d.removed_low_confidence, 200);
+  EXPECT_EQ(d.removed_unseen, 200);
+  EXPECT_EQ(d.removed_closed_gate, 200);
+  EXPECT_NEAR(d.confidence[0].item<float>(), 1.0f, 1e-6);
+  // Structure only: the semantic reasons are not counted.
+  c.drop = "structure";
+  const gaussians::DropDecision s = makeDropStrategy(c)->decide(in, 500);
+  EXPECT_EQ(s.removed, 200);
+  EXPECT_EQ(s.removed_low_confidence, 0);
+  EXPECT_EQ(s.removed_closed_gate, 200);
 }
 
 pcl::PointCloud<GaussianPoint>::Ptr cloudWith(int n, float log_alpha, float confidence) {

@@ -62,6 +62,8 @@ std::string TrainConfig::toJson() const {
                       {"lambda_rgb", lambda_rgb},
                       {"lambda_semantic", lambda_semantic},
                       {"semantic_interval", semantic_interval},
+                      {"use_pseudo_labels", use_pseudo_labels},
+                      {"lambda_pseudo", lambda_pseudo},
                       {"lr_position_init", lr_position_init},
                       {"lr_position_final", lr_position_final},
                       {"lr_sh_dc", lr_sh_dc},
@@ -121,6 +123,8 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.lambda_rgb = d["lambda_rgb"];
   c.lambda_semantic = d["lambda_semantic"];
   c.semantic_interval = d["semantic_interval"];
+  c.use_pseudo_labels = d["use_pseudo_labels"];
+  c.lambda_pseudo = d["lambda_pseudo"];
   c.lr_position_init = d["lr_position_init"];
   c.lr_position_final = d["lr_position_final"];
   c.lr_sh_dc = d["lr_sh_dc"];
@@ -163,6 +167,9 @@ struct Trainer::State {
   std::vector<at::Tensor> images;  // [H, W, 3] float in [0, 1]
   std::vector<at::Tensor> masks;   // [H, W] float, 1 = valid pixel
   std::vector<at::Tensor> labels;  // [H, W] int64, -1 = not supervised (empty if unlabelled)
+  std::vector<double> semantic_weight;       // per view: lambda_semantic (GT) or lambda_pseudo
+  std::vector<at::Tensor> confidence_maps;   // [H, W] max class confidence (empty if none)
+  int pseudo_labelled_views = 0;
   std::vector<int> train_views, labelled_views;
   // Parameters: means, sh_dc, sh_rest, opacity, scales, quats, features; decoder W, b.
   std::vector<Param> params;
@@ -315,6 +322,8 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
       s.images.emplace_back();
       s.masks.emplace_back();
       s.labels.emplace_back();
+      s.semantic_weight.push_back(0.0);
+      s.confidence_maps.emplace_back();
       continue;
     }
     const int H = v.camera.height, W = v.camera.width;
@@ -328,16 +337,34 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
                           .div(255.0);
     s.images.push_back(rgb.to(s.device));
     s.masks.push_back(mask.to(s.device));
-    at::Tensor labels;
-    if (v.labelled && !v.labels.empty()) {
-      labels = at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
-                             at::TensorOptions().dtype(at::kByte))
+    // Semantic supervision (ground truth wins, then kept pseudo-labels) and the confidence map
+    // of the drop (1 on ground-truth pixels, else the pseudo-label backend's max class score).
+    at::Tensor labels, confidence;
+    const bool gt = v.labelled && !v.labels.empty();
+    const std::vector<std::int16_t> sup = io::supervisionLabels(v, config.use_pseudo_labels);
+    if (std::any_of(sup.begin(), sup.end(), [](std::int16_t l) { return l >= 0; })) {
+      labels = at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W}, at::TensorOptions().dtype(at::kShort))
                    .to(at::kLong);
-      labels = at::where((labels == io::kIgnoreLabel) | (mask.to(at::kCPU) < 0.5),
-                         at::full_like(labels, -1), labels);
-      s.labelled_views.push_back(static_cast<int>(i));
+      if (gt) {
+        s.labelled_views.push_back(static_cast<int>(i));
+      } else {
+        ++s.pseudo_labelled_views;
+      }
+    }
+    if (!v.pseudo.empty()) {
+      const std::vector<float> best = v.pseudo.maxScoreMap();
+      confidence = at::from_blob(const_cast<float*>(best.data()), {H, W}, at::kFloat).clone();
+    }
+    if (gt) {
+      const at::Tensor gt_valid = (at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
+                                                 at::TensorOptions().dtype(at::kByte)) != io::kIgnoreLabel) &
+                                  (mask >= 0.5);
+      confidence = at::where(gt_valid, at::ones({H, W}),
+                             confidence.defined() ? confidence : at::zeros({H, W}));
     }
     s.labels.push_back(labels.defined() ? labels.to(s.device) : labels);
+    s.semantic_weight.push_back(gt ? config.lambda_semantic : config.lambda_pseudo);
+    s.confidence_maps.push_back(confidence.defined() ? confidence.to(s.device) : confidence);
     s.train_views.push_back(static_cast<int>(i));
   }
   if (s.train_views.empty()) throw Error(scene.source, "split", "at least one training view");
@@ -434,6 +461,7 @@ StepStats Trainer::step() {
   double rgb_sum = 0, sem_sum = 0;
   std::vector<RenderResult> renders;
   std::int64_t dropped = 0;
+  DropDecision decision;
   for (int v : views) {
     RenderResult r = render(g, s.cameras[v], settings);
     r.means2d.retain_grad();
@@ -444,12 +472,12 @@ StepStats Trainer::step() {
     at::Tensor loss = c.lambda_rgb * rgb_loss;
     rgb_sum += rgb_loss.item<double>();
     const at::Tensor& labels = s.labels[v];
-    if (labels.defined() && c.lambda_semantic > 0 && c.feature_dim > 0) {
+    if (labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
       // class-score space of the built-in backend), averaged over supervised pixels only.
       const at::Tensor sem =
           semanticLoss(r.features, labels, s.p("decoder_w").value, s.p("decoder_b").value);
-      loss = loss + c.lambda_semantic * sem;
+      loss = loss + s.semantic_weight[v] * sem;
       sem_sum += sem.item<double>();
     }
     total = total.defined() ? total + loss : loss;
@@ -496,15 +524,15 @@ StepStats Trainer::step() {
       in.means = s.p("means").value.detach();
       in.opacities = at::sigmoid(s.p("opacity").value.detach());
       in.log_alpha = s.p("log_alpha").value.detach();
-      for (int v : s.labelled_views) {
+      for (int v : s.train_views) {
+        if (!s.confidence_maps[v].defined()) continue;
         in.cameras.push_back(s.cameras[v]);
-        in.labels.push_back(s.labels[v]);
+        in.confidence_maps.push_back(s.confidence_maps[v]);
       }
-      in.num_classes = s.num_classes;
-      auto [keep, confidence] = s.drop->decide(in, done);
-      s.confidence = confidence.to(s.device).to(at::kFloat);
-      dropped = s.n() - keep.sum().item<std::int64_t>();
-      s.resize(keep.to(s.device), {});
+      decision = s.drop->decide(in, done);
+      s.confidence = decision.confidence.to(s.device).to(at::kFloat);
+      dropped = s.n() - decision.keep.sum().item<std::int64_t>();
+      s.resize(decision.keep.to(s.device), {});
     }
     if (done <= c.densify_until) {
       if (done > c.densify_from && done % c.densify_interval == 0) {
@@ -525,6 +553,8 @@ StepStats Trainer::step() {
   stats.loss = total.item<double>();
   stats.num_gaussians = s.n();
   stats.dropped = dropped;
+  stats.drop = decision;
+  stats.pseudo_labelled_views = s.pseudo_labelled_views;
   return stats;
 }
 

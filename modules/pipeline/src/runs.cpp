@@ -86,6 +86,19 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     previous_seconds = run.value("train_seconds", 0.0);
   }
   const io::Scene scene = loadScene(o.scene, o.scale);
+  if (o.progress) {
+    int labelled = 0, pseudo = 0;
+    for (const io::View& v : scene.views) {
+      if (!v.train) continue;
+      if (v.labelled && !v.labels.empty()) ++labelled;
+      else if (!v.pseudo.empty()) ++pseudo;
+    }
+    *o.progress << "semantic supervision: " << labelled << " labelled views, "
+                << (config.use_pseudo_labels ? pseudo : 0) << " pseudo-labelled views"
+                << (pseudo == 0 ? " (run `sadsplat pseudo-labels` on the scene cache to add them)" : "")
+                << "; drop " << config.drop << " with confidence maps of "
+                << (pseudo > 0 ? "the pseudo-label backend + ground truth" : "the ground truth only") << "\n";
+  }
   gaussians::Trainer trainer(scene, config);
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   if (o.resume) trainer.loadCheckpoint(checkpoint);
@@ -97,9 +110,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     const gaussians::StepStats stats = trainer.step();
     const int it = stats.iteration;
     if (stats.dropped > 0 && o.progress) {
+      const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
                   << config.drop << ", P_base " << config.p_base << "), " << stats.num_gaussians
-                  << " left\n";
+                  << " left; of the removed: " << d.removed_low_confidence << " with P_conf < 0.5 ("
+                  << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
+                  << " with P_nonzero < 0.5\n";
     }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();

@@ -36,23 +36,33 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     return interval_ > 0 && done % interval_ == 0 && done < iterations_;
   }
 
-  std::pair<at::Tensor, at::Tensor> decide(const gaussians::DropInputs& in, int done) const override {
+  gaussians::DropDecision decide(const gaussians::DropInputs& in, int done) const override {
     const auto opts = in.means.options();
     at::Tensor confidence = at::zeros({in.means.size(0)}, opts);
+    at::Tensor seen = at::zeros({in.means.size(0)}, opts.dtype(at::kBool));
     if (semantic_ && !in.cameras.empty()) {
-      std::vector<at::Tensor> maps;
-      for (const at::Tensor& labels : in.labels) maps.push_back(oneHotConfidence(labels, in.num_classes));
-      confidence = semanticConfidence(in.means, in.opacities, in.cameras, maps);
+      confidence = semanticConfidence(in.means, in.opacities, in.cameras, in.confidence_maps, &seen);
     }
+    const at::Tensor p_nonzero = probabilityNonZero(in.log_alpha, hc_);
     at::Tensor p_drop = at::full_like(confidence, p_base_);
     if (semantic_) p_drop = p_drop * (1 - confidence);
-    if (structure_) p_drop = p_drop * (1 - probabilityNonZero(in.log_alpha, hc_));
+    if (structure_) p_drop = p_drop * (1 - p_nonzero);
     p_drop = p_drop.clamp(0, 1);
     at::Generator gen = gaussians::seededGenerator(seed_, 17, static_cast<std::uint64_t>(done));
     const at::Tensor u = at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
                              .uniform_(0, 1, gen)
                              .to(in.means.device());
-    return {u >= p_drop, confidence};
+    gaussians::DropDecision d;
+    d.keep = u >= p_drop;
+    d.confidence = confidence;
+    const at::Tensor removed = d.keep.logical_not();
+    d.removed = removed.sum().item<std::int64_t>();
+    if (semantic_) {
+      d.removed_low_confidence = (removed & (confidence < 0.5)).sum().item<std::int64_t>();
+      d.removed_unseen = (removed & seen.logical_not()).sum().item<std::int64_t>();
+    }
+    if (structure_) d.removed_closed_gate = (removed & (p_nonzero < 0.5)).sum().item<std::int64_t>();
+    return d;
   }
 
  private:

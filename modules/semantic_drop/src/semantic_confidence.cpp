@@ -8,7 +8,7 @@ namespace semantic_drop {
 
 at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opacities,
                               const std::vector<gaussians::RasterCamera>& cameras,
-                              const std::vector<at::Tensor>& confidence_maps) {
+                              const std::vector<at::Tensor>& confidence_maps, at::Tensor* seen) {
   if (cameras.size() != confidence_maps.size()) {
     throw Error("<semantic confidence>", "confidence maps", "one per camera");
   }
@@ -17,9 +17,9 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
   for (std::size_t v = 0; v < cameras.size(); ++v) {
     const auto& cam = cameras[v];
     const at::Tensor& map = confidence_maps[v];
-    if (map.dim() != 3 || map.size(0) != cam.height || map.size(1) != cam.width) {
+    if ((map.dim() != 3 && map.dim() != 2) || map.size(0) != cam.height || map.size(1) != cam.width) {
       throw Error("<semantic confidence>", "confidence map " + std::to_string(v),
-                  "[H, W, C] with the camera's " + std::to_string(cam.width) + "x" +
+                  "[H, W, C] or [H, W] with the camera's " + std::to_string(cam.width) + "x" +
                       std::to_string(cam.height));
     }
     const double q[4] = {cam.qvec[0], cam.qvec[1], cam.qvec[2], cam.qvec[3]};
@@ -33,11 +33,13 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
     const at::Tensor w = cam.fy * p.select(1, 1) / z + cam.cy;
     const at::Tensor visible = (z > cam.near_plane) & (u >= 0) & (u < cam.width) & (w >= 0) & (w < cam.height);
     const at::Tensor pixel = (w.clamp(0, cam.height - 1).floor() * cam.width + u.clamp(0, cam.width - 1).floor()).to(at::kLong);
-    const at::Tensor best = std::get<0>(map.to(opts.dtype()).max(2)).reshape({-1});
+    const at::Tensor m = map.to(means.device(), opts.dtype().toScalarType());
+    const at::Tensor best = (m.dim() == 3 ? std::get<0>(m.max(2)) : m).reshape({-1});
     const at::Tensor value = best.index_select(0, pixel) * opacities;
     sum += at::where(visible, value, at::zeros_like(value));
     count += visible.to(opts.dtype());
   }
+  if (seen != nullptr) *seen = count > 0;
   return at::where(count > 0, sum / count.clamp_min(1), at::zeros_like(sum));
 }
 

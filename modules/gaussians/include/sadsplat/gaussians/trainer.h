@@ -32,6 +32,10 @@ struct TrainConfig {
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;
+  /// Supervise the unlabelled training views with the scene's kept pseudo-labels (written by
+  /// `sadsplat pseudo-labels`; without them this does nothing). Ground truth always wins.
+  bool use_pseudo_labels = true;
+  double lambda_pseudo = 1.0;    ///< weight of the semantic loss on pseudo-labelled views
   double lr_position_init = 1.6e-4;   ///< times the scene extent
   double lr_position_final = 1.6e-6;  ///< times the scene extent
   double lr_sh_dc = 2.5e-3;
@@ -89,9 +93,20 @@ struct DropInputs {
   at::Tensor means;      ///< [N, 3]
   at::Tensor opacities;  ///< [N] activated
   at::Tensor log_alpha;  ///< [N]
-  std::vector<RasterCamera> cameras;  ///< the labelled training views
-  std::vector<at::Tensor> labels;     ///< their label maps [H, W] int64, -1 = none
-  int num_classes = 0;
+  /// The training views with a confidence map: every view with pseudo-labels, and the labelled
+  /// views (where their ground truth has a class the confidence is 1).
+  std::vector<RasterCamera> cameras;
+  std::vector<at::Tensor> confidence_maps;  ///< [H, W] max class confidence per pixel, per camera
+};
+
+/// \brief A drop decision and why Gaussians went.
+struct DropDecision {
+  at::Tensor keep;        ///< [N] bool
+  at::Tensor confidence;  ///< [N] P_confidence (0 where the semantic term is off)
+  std::int64_t removed = 0;
+  std::int64_t removed_low_confidence = 0;  ///< of the removed: P_confidence < 0.5
+  std::int64_t removed_closed_gate = 0;     ///< of the removed: P_nonzero < 0.5
+  std::int64_t removed_unseen = 0;          ///< of the removed: centre in no confidence map
 };
 
 /// \brief The hook through which the semantic-aware drop (module semantic_drop) acts on
@@ -108,9 +123,8 @@ class DropStrategy {
   virtual at::Tensor regularisation(const at::Tensor& log_alpha) const = 0;
   /// \brief Whether to drop once `iterations_done` iterations are done.
   virtual bool dropNow(int iterations_done) const = 0;
-  /// \brief {keep [N] bool, confidence [N] float} for the current Gaussians.
-  virtual std::pair<at::Tensor, at::Tensor> decide(const DropInputs& inputs,
-                                                   int iterations_done) const = 0;
+  /// \brief Which Gaussians to keep, their confidence and the reasons of the removals.
+  virtual DropDecision decide(const DropInputs& inputs, int iterations_done) const = 0;
 };
 
 /// \brief Numbers reported after each step.
@@ -119,6 +133,8 @@ struct StepStats {
   double loss = 0, rgb_loss = 0, semantic_loss = 0;
   std::int64_t num_gaussians = 0;
   std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
+  DropDecision drop;         ///< the decision behind `dropped` (tensors undefined if none)
+  int pseudo_labelled_views = 0;  ///< training views supervised by pseudo-labels
 };
 
 /// \brief Trains Gaussians on a scene.

@@ -19,11 +19,13 @@ namespace semantic_drop {
 /// \param[in] means [N, 3] centres
 /// \param[in] opacities [N] activated opacities in [0, 1]
 /// \param[in] cameras one per confidence map
-/// \param[in] confidence_maps [H, W, C] per camera, matching its size
+/// \param[in] confidence_maps [H, W, C] class scores per camera, matching its size, or [H, W]
+///            maps that already hold the maximum over classes
+/// \param[out] seen if given, [N] bool: visible in at least one of the views
 /// \throws sadsplat::Error on mismatched sizes
 at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opacities,
                               const std::vector<gaussians::RasterCamera>& cameras,
-                              const std::vector<at::Tensor>& confidence_maps);
+                              const std::vector<at::Tensor>& confidence_maps, at::Tensor* seen = nullptr);
 
 /// \brief One-hot confidence maps [H, W, C] from a label map (the stand-in for the pseudo-label
 /// backend's maps: 1 for the labelled class, 0 elsewhere and on ignored pixels).
