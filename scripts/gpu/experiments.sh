@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# Run ON THE GPU MACHINE: the drop and pseudo-label experiments of one benchmark scene, several
+# trainings at once on the one GPU (timings from such runs are not clean single-run times).
+#   bash scripts/gpu/experiments.sh KIND SEED [JOBS=5] [DEADLINE_S=540] [RUN ...]
+# Builds build-gpu/ if missing, generates the scene at 800x450 as a cache, runs
+# `sadsplat pseudo-labels` on it (report kept), then trains + evaluates each RUN (default: all
+# below, most important first) with 7000 iterations. No run starts after DEADLINE_S seconds and
+# every run is stopped at it, so a device call returns in time with what finished.
+# Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
+#        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without).
+# $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
+# summary_KIND_SEED.txt.
+set -uo pipefail
+kind="$1"; seed="$2"; jobs="${3:-5}"; deadline="${4:-540}"; shift $(( $# < 4 ? $# : 4 ))
+runs=("$@")
+[ ${#runs[@]} -gt 0 ] || runs=(none_nopl full_p1_pl none_pl full_p1_nopl structure_p1_pl semantic_p1_pl
+                                full_p0_pl full_p2_pl full_p0.5_pl full_p1.5_pl)
+start=$(date +%s)
+out="${OUT:-/tmp/sadsplat-gpu-out}"
+mkdir -p "$out"
+[ -x build-gpu/bin/sadsplat ] || bash scripts/gpu/build.sh > /tmp/sadsplat-build.log 2>&1 || { tail -30 /tmp/sadsplat-build.log; exit 1; }
+export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
+bin=build-gpu/bin/sadsplat
+work=/tmp/sadsplat-exp/${kind}_${seed}
+res=$work/results
+mkdir -p "$res"
+cache="$work/scene.cache"
+[ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" > "$res/synth.log" 2>&1
+[ -f "$work/scene_pl.cache" ] || /usr/bin/time -v "$bin" pseudo-labels "$cache" --out "$work/scene_pl.cache" \
+  --report "$res/pseudo_report" > "$res/pseudo_labels.log" 2>&1
+echo "prepared in $(( $(date +%s) - start )) s"
+
+train_one() {
+  local name="$1" left="$2"
+  local args=() scene="$cache"
+  case "$name" in *_pl) scene="$work/scene_pl.cache" ;; esac
+  case "$name" in
+    none_*) args=(--drop none) ;;
+    full_p*) local p=${name#full_p}; p=${p%_pl}; p=${p%_nopl}; args=(--drop full --p-base "$p") ;;
+    semantic_p1_*) args=(--drop semantic --p-base 1) ;;
+    structure_p1_*) args=(--drop structure --p-base 1) ;;
+    *) echo "unknown run $name"; return 1 ;;
+  esac
+  timeout "$left" "$bin" train "$scene" --device cuda --iterations 7000 --out "$work/run_$name" "${args[@]}" \
+    > "$res/train_$name.log" 2>&1 || { echo "$name: train stopped (rc $?)"; return 1; }
+  "$bin" eval "$work/run_$name" > "$res/metrics_$name.json" 2> "$res/eval_$name.log"
+  cp "$work/run_$name/config.json" "$res/config_$name.json"
+}
+
+for name in "${runs[@]}"; do
+  now=$(( $(date +%s) - start ))
+  [ "$now" -lt "$deadline" ] || { echo "$name: not started (deadline)"; continue; }
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+  now=$(( $(date +%s) - start ))
+  [ "$now" -lt "$deadline" ] || { echo "$name: not started (deadline)"; continue; }
+  train_one "$name" $(( deadline - now )) &
+done
+wait
+
+python3 - "$res" "$kind" "$seed" > "$out/summary_${kind}_${seed}.txt" <<'PY'
+import glob, json, os, sys
+res, kind, seed = sys.argv[1:]
+print(f"{kind} seed {seed}, 800x450, 7000 iterations, H100, several runs at once")
+rows = []
+for f in sorted(glob.glob(os.path.join(res, "metrics_*.json"))):
+    name = os.path.basename(f)[8:-5]
+    try:
+        m = json.load(open(f))
+    except Exception as e:
+        print(name, "unreadable", e); continue
+    rows.append((name, m))
+    print("%-16s mIoU %6.2f  mAcc %6.2f  OA %6.2f  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.0f s" % (
+        name, 100*m['miou'], 100*m['macc'], 100*m['oacc'], m['psnr'], m['ssim'], m['num_gaussians'], m['train_seconds']))
+rep = os.path.join(res, "pseudo_report", "report.txt")
+if os.path.exists(rep):
+    print(open(rep).read())
+PY
+grep -h 'builtin:\|Elapsed\|Maximum resident' "$res/pseudo_labels.log" >> "$out/summary_${kind}_${seed}.txt" || true
+for f in "$res"/train_*.log; do tr '\r' '\n' < "$f" | grep '^\[drop\]\|semantic supervision' | tail -3 | sed "s|^|$(basename "$f"): |"; done \
+  >> "$out/summary_${kind}_${seed}.txt"
+tar -czf "$out/results_${kind}_${seed}.tar.gz" -C "$work" results
+cat "$out/summary_${kind}_${seed}.txt"
+echo "total $(( $(date +%s) - start )) s"
