@@ -145,7 +145,10 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                       static_cast<int>(width), static_cast<int>(height));
     }
     ctx->save_for_backward({m2, co, op, val});
-    ctx->saved_data["alpha"] = r.alpha;
+    // alpha is also an output: keeping the output itself in saved_data would make a reference
+    // cycle output -> grad_fn -> ctx -> output and leak every graph (~8 MB per 800x450 render
+    // on the GPU). The backward only needs the values.
+    ctx->saved_data["alpha"] = r.alpha.detach();
     ctx->saved_data["last"] = r.last;
     ctx->saved_data["tile_ranges"] = r.binning.tile_ranges;
     ctx->saved_data["gaussian_ids"] = r.binning.gaussian_ids;
