@@ -179,7 +179,6 @@ class TorchScriptScorer : public TargetScorer {
     for (std::size_t i = 0; i < vt.segmentation.region.size(); ++i) {
       vt.segmentation.region[i] = rp[i] >= 0 ? remap[rp[i]] : -1;
     }
-    const int C = static_cast<int>(text.size(0));
     vt.feature_dim = static_cast<int>(text.size(1));
     if (next == 0) return vt;
 
@@ -213,7 +212,6 @@ class TorchScriptScorer : public TargetScorer {
     const at::Tensor feats = image_emb.cpu().contiguous();
     vt.scores.assign(probs.data_ptr<float>(), probs.data_ptr<float>() + probs.numel());
     vt.features.assign(feats.data_ptr<float>(), feats.data_ptr<float>() + feats.numel());
-    (void)C;
     return vt;
   }
 
