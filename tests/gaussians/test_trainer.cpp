@@ -127,6 +127,49 @@ TEST_F(TrainerTest, DensificationAndPruningKeepTensorsAndOptimiserStateConsisten
   EXPECT_EQ(trainer.toCloud().size(), static_cast<std::size_t>(trainer.numGaussians()));
 }
 
+// A drop strategy whose evaluation gate is closed for every Gaussian at an even index (and that
+// never drops on its own): what the trainer does with closed gates, isolated.
+class EvenGatesClosed : public gaussians::DropStrategy {
+ public:
+  at::Tensor trainingGate(const at::Tensor&, int) const override { return {}; }
+  at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
+    return (at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 2).to(log_alpha.dtype());
+  }
+  at::Tensor regularisation(const at::Tensor&) const override { return {}; }
+  bool dropNow(int) const override { return false; }
+  gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
+};
+
+TEST_F(TrainerTest, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
+  TrainConfig c = small(30);
+  c.densify_from = 5;
+  c.densify_interval = 10;
+  c.densify_until = 15;
+  c.densify_grad_threshold = 1e9;  // no clones or splits: only pruning
+  c.opacity_reset_interval = 0;
+  // Without a drop strategy nothing is transparent enough to be pruned.
+  Trainer plain(scene_, c);
+  const std::int64_t n0 = plain.numGaussians();
+  for (int i = 0; i < 30; ++i) EXPECT_EQ(plain.step().removed_closed_gates, 0);
+  EXPECT_EQ(plain.numGaussians(), n0);
+
+  Trainer gated(scene_, c);
+  gated.setDropStrategy(std::make_shared<EvenGatesClosed>());
+  std::int64_t after_densify = -1;
+  gaussians::StepStats last;
+  for (int i = 0; i < 30; ++i) {
+    last = gated.step();
+    gated.checkConsistency();
+    if (last.iteration == 10) after_densify = last.num_gaussians;
+    if (last.iteration < 30) EXPECT_EQ(last.removed_closed_gates, 0);
+  }
+  EXPECT_EQ(after_densify, n0 / 2) << "densification prunes by opacity x evaluation gate";
+  const std::int64_t n1 = n0 / 2;
+  EXPECT_EQ(last.removed_closed_gates, n1 - n1 / 2);
+  EXPECT_EQ(gated.numGaussians(), n1 / 2);
+  EXPECT_EQ(gated.toCloud().size(), static_cast<std::size_t>(n1 / 2));
+}
+
 TEST_F(TrainerTest, ResumeFromACheckpointIsExact) {
   TrainConfig c = small(40);
   c.densify_from = 5;

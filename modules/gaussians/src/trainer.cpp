@@ -235,6 +235,16 @@ struct Trainer::State {
     max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
   }
 
+  // Activated opacity times the drop's evaluation gate (when there is one).
+  at::Tensor effectiveOpacity() const {
+    at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
+    if (drop) {
+      const at::Tensor gate = drop->evaluationGate(p("log_alpha").value.detach());
+      if (gate.defined()) opacity = opacity * gate;
+    }
+    return opacity;
+  }
+
   void densifyAndPrune(bool prune_big) {
     const double threshold = config.densify_grad_threshold;
     const at::Tensor avg = grad_accum / denom.clamp_min(1);
@@ -277,9 +287,10 @@ struct Trainer::State {
       if (q.name == "scales") splitted = splitted - std::log(1.6);
       extra[q.name] = at::cat({cloned, splitted}, 0);
     }
-    // Originals of split Gaussians go; so do transparent (and, later, huge) ones.
+    // Originals of split Gaussians go; so do transparent (and, later, huge) ones. Transparent
+    // means the opacity a Gaussian renders with at evaluation: times its deterministic gate.
     at::Tensor keep = split.logical_not();
-    const at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
+    const at::Tensor opacity = effectiveOpacity();
     at::Tensor remove = opacity < config.min_opacity;
     if (prune_big) {
       remove = remove | (max_radii > config.max_screen_radius) | (max_scale > 0.1 * extent);
@@ -460,7 +471,7 @@ StepStats Trainer::step() {
   at::Tensor total;
   double rgb_sum = 0, sem_sum = 0;
   std::vector<RenderResult> renders;
-  std::int64_t dropped = 0;
+  std::int64_t dropped = 0, closed_at_end = 0;
   DropDecision decision;
   for (int v : views) {
     RenderResult r = render(g, s.cameras[v], settings);
@@ -534,6 +545,16 @@ StepStats Trainer::step() {
       dropped = s.n() - decision.keep.sum().item<std::int64_t>();
       s.resize(decision.keep.to(s.device), {});
     }
+    if (s.drop && done == c.iterations) {
+      // Gaussians whose evaluation gate is closed (z = 0) render nothing: removing them at the
+      // end changes no render and shrinks the model.
+      const at::Tensor gate = s.drop->evaluationGate(s.p("log_alpha").value.detach());
+      if (gate.defined()) {
+        const at::Tensor open = gate > 0;
+        closed_at_end = s.n() - open.sum().item<std::int64_t>();
+        if (closed_at_end > 0) s.resize(open, {});
+      }
+    }
     if (done <= c.densify_until) {
       if (done > c.densify_from && done % c.densify_interval == 0) {
         s.densifyAndPrune(done > c.opacity_reset_interval);
@@ -553,6 +574,7 @@ StepStats Trainer::step() {
   stats.loss = total.item<double>();
   stats.num_gaussians = s.n();
   stats.dropped = dropped;
+  stats.removed_closed_gates = closed_at_end;
   stats.drop = decision;
   stats.pseudo_labelled_views = s.pseudo_labelled_views;
   return stats;

@@ -117,6 +117,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
                   << " with P_nonzero < 0.5\n";
     }
+    if (stats.removed_closed_gates > 0 && o.progress) {
+      *o.progress << "\n[drop] end of training: removed " << stats.removed_closed_gates
+                  << " Gaussians with a closed gate (they render nothing), " << stats.num_gaussians << " left\n";
+    }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = (it - first) / std::max(1e-9, elapsed);

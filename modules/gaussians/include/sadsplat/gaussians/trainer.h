@@ -134,6 +134,9 @@ struct StepStats {
   std::int64_t num_gaussians = 0;
   std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
   DropDecision drop;         ///< the decision behind `dropped` (tensors undefined if none)
+  /// After the last iteration: Gaussians removed because their evaluation gate is closed (z = 0,
+  /// they render nothing).
+  std::int64_t removed_closed_gates = 0;
   int pseudo_labelled_views = 0;  ///< training views supervised by pseudo-labels
 };
 
@@ -154,7 +157,9 @@ class Trainer {
   /// \brief Installs the semantic-aware drop (none by default).
   void setDropStrategy(std::shared_ptr<const DropStrategy> strategy);
 
-  /// \brief One optimisation step (render, loss, backward, Adam, densification schedule).
+  /// \brief One optimisation step (render, loss, backward, Adam, densification schedule). With a
+  /// drop strategy, densification prunes by the opacity a Gaussian renders with at evaluation
+  /// (opacity x deterministic gate), and the last step removes the Gaussians whose gate is closed.
   StepStats step();
   /// \brief Iterations done so far.
   int iteration() const;
