@@ -7,7 +7,8 @@
 # below, most important first) with 7000 iterations. No run starts after DEADLINE_S seconds and
 # every run is stopped at it, so a device call returns in time with what finished.
 # Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
-#        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without).
+#        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
+#        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X.
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
 # summary_KIND_SEED.txt.
 set -uo pipefail
@@ -38,10 +39,14 @@ train_one() {
   local args=() scene="$cache"
   case "$name" in *_pl) scene="$work/scene_pl.cache" ;; esac
   case "$name" in
-    none_*) args=(--drop none) ;;
-    full_p*) local p=${name#full_p}; p=${p%_pl}; p=${p%_nopl}; args=(--drop full --p-base "$p") ;;
-    semantic_p1_*) args=(--drop semantic --p-base 1) ;;
-    structure_p1_*) args=(--drop structure --p-base 1) ;;
+    *_lambda*) local l0=${name#*_lambda}; l0=${l0%%_*}
+           echo "{\"lambda_l0\": $l0}" > "$work/config_$name.json"; args=(--config "$work/config_$name.json") ;;
+  esac
+  case "$name" in
+    none_*) args+=(--drop none) ;;
+    full_p*) local p=${name#full_p}; p=${p%%_*}; args+=(--drop full --p-base "$p") ;;
+    semantic_p1_*) args+=(--drop semantic --p-base 1) ;;
+    structure_p1_*) args+=(--drop structure --p-base 1) ;;
     *) echo "unknown run $name"; return 1 ;;
   esac
   timeout "$left" "$bin" train "$scene" --device cuda --iterations 7000 --out "$work/run_$name" "${args[@]}" \
