@@ -201,6 +201,9 @@ TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
   EXPECT_GT(max_conf, 0.f);
   c.drop = "sometimes";
   EXPECT_THROW(makeDropStrategy(c), Error);
+  c.drop = "full";
+  c.lambda_l0 = -0.1;
+  EXPECT_THROW(makeDropStrategy(c), Error);
 }
 
 }  // namespace

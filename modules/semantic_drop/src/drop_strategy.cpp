@@ -79,6 +79,9 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
                                                                 const HardConcreteParams& hc) {
   if (c.p_base < 0) throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
+  if (!(c.lambda_l0 >= 0)) {
+    throw Error("<config>", "lambda_l0", "a non-negative weight", std::to_string(c.lambda_l0));
+  }
   if (c.drop_interval < 1) {
     throw Error("<config>", "drop_interval", "a positive number of iterations", std::to_string(c.drop_interval));
   }
