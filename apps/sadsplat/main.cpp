@@ -179,11 +179,14 @@ int main(int argc, char** argv) {
   evaluate->add_option("RUN", eval_run, "run directory")->required();
   evaluate->add_option("--scene", eval_scene, "scene to evaluate on (default: the run's)");
 
-  auto* demo = app.add_subcommand("demo", "Generate the demo city, train on CPU, evaluate");
+  auto* demo = app.add_subcommand(
+      "demo", "Generate the demo city, pseudo-label it, train on CPU with the semantic-aware drop, evaluate");
   std::string demo_out = "out/demo";
   int demo_iterations = 600;
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
   demo->add_option("--iterations", demo_iterations, "training iterations")->capture_default_str();
+  bool demo_baseline = false;
+  demo->add_flag("--baseline", demo_baseline, "no pseudo-labels and no drop (the paper's Net-1)");
 
   auto* synth_cmd = app.add_subcommand("synth", "Generate a procedural aerial benchmark scene");
   SynthArgs synth_args;
@@ -277,7 +280,7 @@ int main(int argc, char** argv) {
     } else if (*evaluate) {
       std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
     } else if (*demo) {
-      return sadsplat::pipeline::runDemo(demo_out, demo_iterations, std::cout);
+      return sadsplat::pipeline::runDemo(demo_out, demo_iterations, std::cout, demo_baseline);
     }
   } catch (const sadsplat::Error& e) {
     std::cerr << "sadsplat: error: " << e.what() << "\n";

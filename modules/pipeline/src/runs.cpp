@@ -16,6 +16,7 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
 #if SADSPLAT_HAVE_OPENCV
@@ -167,29 +168,48 @@ std::string evalRun(const std::string& run_dir, const std::string& scene_overrid
   return text;
 }
 
-int runDemo(const std::string& out_dir, int iterations, std::ostream& out) {
+int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool baseline) {
 #if SADSPLAT_HAVE_OPENCV
   makeDirectory(out_dir);
   const auto start = Clock::now();
   const std::string scene_dir = out_dir + "/city_demo";
-  out << "[1/3] generating the demo city scene (" << scene_dir << ")\n";
+  out << "[1/4] generating the demo city scene (" << scene_dir << ")\n";
   const auto scene = synth::generate(synth::SynthOptions::demo(synth::SceneKind::kCity, 0));
   synth::writeScene(scene, scene_dir);
   out << "      " << scene.views.size() << " views 320x180, " << scene.points.size()
       << " sparse points, " << std::fixed << std::setprecision(1) << scene.seconds << " s\n";
-  out << "[2/3] training " << iterations << " iterations on the CPU\n";
+  std::string train_scene = scene_dir;
+  if (baseline) {
+    out << "[2/4] pseudo-labels: skipped (--baseline)\n";
+  } else {
+    out << "[2/4] pseudo-labels of the unlabelled training views (built-in backend)\n";
+    PseudoLabelRunOptions p;
+    p.scene = scene_dir;
+    p.scale = 1.0;
+    p.out = out_dir + "/city_demo.cache";
+    p.report_dir = out_dir + "/pseudo_labels";
+    p.progress = &out;
+    pseudoLabelRun(p);
+    train_scene = p.out;
+  }
+  out << "[3/4] training " << iterations << " iterations on the CPU ("
+      << (baseline ? "baseline: no pseudo-labels, no drop" : "pseudo-labels + full semantic-aware drop") << ")\n";
   gaussians::TrainConfig config;
   config.iterations = iterations;
   config.sh_increase_interval = std::max(1, iterations / 4);
   config.densify_from = std::min(config.densify_from, iterations / 10);
   config.opacity_reset_interval = std::max(iterations, config.opacity_reset_interval);
+  if (!baseline) {
+    config.drop = "full";
+    config.drop_interval = std::min(config.drop_interval, std::max(1, iterations / 4));
+  }
   TrainRunOptions o;
-  o.scene = scene_dir;
+  o.scene = train_scene;
   o.out = out_dir + "/run";
   o.scale = 1.0;
   o.progress = &out;
   const double seconds = trainRun(o, config);
-  out << "[3/3] evaluating the test views\n";
+  out << "[4/4] evaluating the test views\n";
   const auto metrics = nlohmann::json::parse(evalRun(o.out));
   out << "\n| metric | value |\n|---|---|\n" << std::setprecision(2)
       << "| mIoU | " << 100 * metrics["miou"].get<double>() << " % |\n"

@@ -39,9 +39,11 @@ double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& co
 std::string evalRun(const std::string& run_dir, const std::string& scene_override = "",
                     double scale = 0.5);
 
-/// \brief `sadsplat demo`: generates the small city scene, trains on CPU, evaluates, prints a
-/// table to `out`. Returns 0 on success.
-int runDemo(const std::string& out_dir, int iterations, std::ostream& out);
+/// \brief `sadsplat demo`: generates the small city scene, writes its pseudo-labels (built-in
+/// backend, report in OUT/pseudo_labels), trains on CPU with the full semantic-aware drop,
+/// evaluates, prints a table to `out`. `baseline` skips pseudo-labels and drop (the paper's
+/// Net-1). Returns 0 on success.
+int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool baseline = false);
 
 }  // namespace pipeline
 }  // namespace sadsplat
