@@ -113,7 +113,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
-                  << config.drop << ", P_base " << config.p_base << "), " << stats.num_gaussians
+                  << config.drop << ", P_base " << std::defaultfloat << config.p_base << "), " << stats.num_gaussians
                   << " left; of the removed: " << d.removed_low_confidence << " with P_conf < 0.5 ("
                   << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
                   << " with P_nonzero < 0.5\n";
@@ -176,8 +176,8 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   out << "[1/4] generating the demo city scene (" << scene_dir << ")\n";
   const auto scene = synth::generate(synth::SynthOptions::demo(synth::SceneKind::kCity, 0));
   synth::writeScene(scene, scene_dir);
-  out << "      " << scene.views.size() << " views 320x180, " << scene.points.size()
-      << " sparse points, " << std::fixed << std::setprecision(1) << scene.seconds << " s\n";
+  out << "      " << scene.views.size() << " views 320x180, " << scene.points.size() << " sparse points, "
+      << formatSeconds(scene.seconds) << "\n";
   std::string train_scene = scene_dir;
   if (baseline) {
     out << "[2/4] pseudo-labels: skipped (--baseline)\n";
@@ -211,7 +211,7 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   const double seconds = trainRun(o, config);
   out << "[4/4] evaluating the test views\n";
   const auto metrics = nlohmann::json::parse(evalRun(o.out));
-  out << "\n| metric | value |\n|---|---|\n" << std::setprecision(2)
+  out << "\n| metric | value |\n|---|---|\n" << std::fixed << std::setprecision(2)
       << "| mIoU | " << 100 * metrics["miou"].get<double>() << " % |\n"
       << "| mAcc | " << 100 * metrics["macc"].get<double>() << " % |\n"
       << "| overall accuracy | " << 100 * metrics["oacc"].get<double>() << " % |\n"
