@@ -1,6 +1,7 @@
 // The CLI: subcommands listed, info summaries, clear errors with non-zero exits, demo.
 #include <gtest/gtest.h>
 
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_import.h"
 #include "test_support/test_support.h"
@@ -38,7 +39,7 @@ TEST(Cli, BadInputGivesOneMessageAndNonZeroExit) {
   EXPECT_NE(test::runCommand(kCli + " frobnicate", &out), 0);
 }
 
-TEST(Cli, ImportInfoExtractAndDemoWorkOnTheFixture) {
+TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {
   if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
   test::TempDir dir;
   std::string out;
@@ -89,6 +90,27 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   EXPECT_EQ(io::readGaussianPly(dir.file("road.ply")).size(), roads);
   EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out), 1);
   EXPECT_NE(out.find("device"), std::string::npos) << out;
+}
+
+// The demo end to end, shortened: pseudo-labels are written and used, the drop acts, the run is
+// evaluated; --baseline skips both.
+TEST(Cli, DemoRunsTheMethodAndTheBaseline) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  test::TempDir dir;
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " demo --iterations 20 --out " + dir.file("full"), &out), 0) << out;
+  EXPECT_NE(out.find("60 pseudo-labelled views"), std::string::npos) << out;
+  EXPECT_NE(out.find("[drop] iteration 5: removed"), std::string::npos) << out;
+  EXPECT_NE(out.find("| mIoU |"), std::string::npos) << out;
+  EXPECT_TRUE(io::pathExists(dir.file("full/pseudo_labels/report.json")));
+  EXPECT_TRUE(io::pathExists(dir.file("full/run/metrics.json")));
+  EXPECT_TRUE(io::pathExists(dir.file("full/run/model.ply")));
+
+  ASSERT_EQ(test::runCommand(kCli + " demo --baseline --iterations 10 --out " + dir.file("base"), &out), 0) << out;
+  EXPECT_NE(out.find("pseudo-labels: skipped (--baseline)"), std::string::npos) << out;
+  EXPECT_EQ(out.find("[drop]"), std::string::npos) << out;
+  EXPECT_FALSE(io::pathExists(dir.file("base/pseudo_labels")));
+  EXPECT_TRUE(io::pathExists(dir.file("base/run/metrics.json")));
 }
 
 }  // namespace
