@@ -170,6 +170,13 @@ int main(int argc, char** argv) {
   std::string pseudo_scale = "log-odds";
   pseudo->add_option("--filter-scale", pseudo_scale, "TOP1/dTOP measured on the scores (paper) or as log-odds")
       ->check(CLI::IsMember({"score", "log-odds"}))->capture_default_str();
+  std::string pseudo_targets = "slic";
+  pseudo->add_option("--targets", pseudo_targets, "builtin: mask generator, slic (equal-size superpixels) or graph")
+      ->check(CLI::IsMember({"slic", "graph"}))->capture_default_str();
+  pseudo->add_option("--graph-k", pseudo_options.builtin.graph.k, "builtin, graph: merge threshold scale k")
+      ->capture_default_str();
+  pseudo->add_option("--graph-min-size", pseudo_options.builtin.graph.min_size, "builtin, graph: smallest target in pixels")
+      ->capture_default_str();
   bool pseudo_no_geometry = false;
   pseudo->add_flag("--no-geometry", pseudo_no_geometry, "builtin: do not use the sparse points' heights");
   pseudo->add_option("--scale", pseudo_options.scale, "image scale when importing a directory")->capture_default_str();
@@ -273,6 +280,8 @@ int main(int argc, char** argv) {
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
     } else if (*pseudo) {
       pseudo_options.builtin.geometry = !pseudo_no_geometry;
+      pseudo_options.builtin.targets =
+          pseudo_targets == "graph" ? sadsplat::pseudo_labels::MaskGenerator::kGraph : sadsplat::pseudo_labels::MaskGenerator::kSlic;
       pseudo_options.filter.scale = pseudo_scale == "log-odds" ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
                                                                : sadsplat::pseudo_labels::ScoreScale::kScore;
       pseudo_options.progress = &std::cout;

@@ -36,7 +36,8 @@ class BuiltinScorer : public TargetScorer {
     at::parallel_for(0, static_cast<std::int64_t>(all.size()), 1, [&](std::int64_t b, std::int64_t e) {
       for (std::int64_t k = b; k < e; ++k) {
         const io::View& v = scene.views[all[k]];
-        segs[k] = slicSuperpixels(v.rgb, v.mask, options_.superpixels);
+        segs[k] = options_.targets == MaskGenerator::kGraph ? graphSegmentation(v.rgb, v.mask, options_.graph)
+                                                             : slicSuperpixels(v.rgb, v.mask, options_.superpixels);
         desc[k] = regionFeatures(scene, v, segs[k], g);
         const int n = ++done;
         if (progress && (n % 10 == 0 || n == static_cast<int>(all.size()))) {

@@ -11,6 +11,7 @@
 
 #include "sadsplat/io/scene.h"
 #include "sadsplat/pseudo_labels/few_shot_classifier.h"
+#include "sadsplat/pseudo_labels/graph_segmentation.h"
 #include "sadsplat/pseudo_labels/superpixels.h"
 #include "sadsplat/pseudo_labels/target_filter.h"
 
@@ -39,9 +40,17 @@ class TargetScorer {
                                          const ProgressFn& progress) = 0;
 };
 
+/// \brief The built-in backend's mask generator.
+enum class MaskGenerator {
+  kSlic,   ///< SLIC superpixels: equal-size targets
+  kGraph,  ///< graph-based segmentation: large targets in homogeneous areas
+};
+
 /// \brief Options of the built-in backend.
 struct BuiltinOptions {
+  MaskGenerator targets = MaskGenerator::kSlic;
   SlicOptions superpixels;
+  GraphSegmentationOptions graph;
   ClassifierOptions classifier;
   bool geometry = true;         ///< use the sparse points' heights as a descriptor
   double min_purity = 0.7;      ///< a labelled region trains the scorer if this share agrees
