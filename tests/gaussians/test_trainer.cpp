@@ -6,7 +6,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/trainer.h"
-#include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/scene_cache.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -15,26 +15,37 @@ namespace {
 using gaussians::Trainer;
 using gaussians::TrainConfig;
 
-const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+// The fixture scene as a cache (data/tiny_scene.cache, checked against a fresh import in
+// test_io), so these tests need no OpenCV and run on the GPU build too.
+const std::string kSceneCache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
 
 class TrainerTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV (scene import)";
-    scene_ = io::importScene(kScene);
-  }
-  static TrainConfig small(int iterations) {
+  void SetUp() override { scene_ = io::readSceneCache(kSceneCache); }
+  static TrainConfig small(int iterations, const std::string& device = "cpu") {
     TrainConfig c;
     c.iterations = iterations;
     c.feature_dim = 8;
     c.densify_from = 100000;  // off unless a test turns it on
     c.checkpoint_interval = 0;
+    c.device = device;
     return c;
   }
   io::Scene scene_;
 };
 
-TEST_F(TrainerTest, RgbLossFallsOnTheTinyScene) {
+// The tests that run on every device of the build: CPU, and CUDA where there is one.
+class TrainerOnDevice : public TrainerTest, public ::testing::WithParamInterface<std::string> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == "cuda" && !at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+    TrainerTest::SetUp();
+  }
+  TrainConfig small(int iterations) const { return TrainerTest::small(iterations, GetParam()); }
+};
+INSTANTIATE_TEST_SUITE_P(Devices, TrainerOnDevice, ::testing::Values("cpu", "cuda"));
+
+TEST_P(TrainerOnDevice, RgbLossFallsOnTheTinyScene) {
   Trainer trainer(scene_, small(240));
   double first = 0, last = 0;
   for (int i = 0; i < 240; ++i) {
@@ -49,7 +60,7 @@ TEST_F(TrainerTest, RgbLossFallsOnTheTinyScene) {
 // Pseudo-labels supervise the unlabelled training views: give every unlabelled training view of
 // the tiny scene one kept target per class (from its label map) and count the steps with a
 // semantic loss; with no extra labelled render (semantic_interval 0) only the drawn view counts.
-TEST_F(TrainerTest, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
+TEST_P(TrainerOnDevice, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
   int unlabelled = 0;
   for (io::View& v : scene_.views) {
     if (!v.train || v.labelled) continue;
@@ -108,7 +119,7 @@ TEST(SemanticLoss, UnsupervisedPixelsGiveNoGradientAndNoValue) {
   EXPECT_GT(grad[1][2].abs().sum().item<double>(), 0.0);
 }
 
-TEST_F(TrainerTest, DensificationAndPruningKeepTensorsAndOptimiserStateConsistent) {
+TEST_P(TrainerOnDevice, DensificationAndPruningKeepTensorsAndOptimiserStateConsistent) {
   TrainConfig c = small(120);
   c.densify_from = 10;
   c.densify_interval = 20;
@@ -140,7 +151,7 @@ class EvenGatesClosed : public gaussians::DropStrategy {
   gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
 };
 
-TEST_F(TrainerTest, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
+TEST_P(TrainerOnDevice, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
   TrainConfig c = small(30);
   c.densify_from = 5;
   c.densify_interval = 10;

@@ -6,6 +6,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/scene_cache.h"
+#include "sadsplat/io/scene_import.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -89,6 +90,32 @@ TEST(SceneCache, RoundTripIsExact) {
   ASSERT_EQ(back.points.size(), 2u);
   EXPECT_EQ(back.points[1].xyz, scene.points[1].xyz);
   EXPECT_EQ(back.points[1].rgb, scene.points[1].rgb);
+}
+
+// data/tiny_scene.cache lets builds without OpenCV (the GPU machine) train on the fixture; it
+// must stay what `sadsplat import data/tiny_scene --scale 1` gives.
+TEST(SceneCache, CommittedTinySceneCacheMatchesAFreshImport) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  const std::string data = SADSPLAT_TEST_DATA_DIR;
+  const io::Scene fresh = io::importScene(data + "/tiny_scene");
+  const io::Scene cached = io::readSceneCache(data + "/tiny_scene.cache");
+  ASSERT_EQ(fresh.views.size(), cached.views.size());
+  ASSERT_EQ(fresh.classes.size(), cached.classes.size());
+  for (std::size_t i = 0; i < fresh.views.size(); ++i) {
+    const auto &a = fresh.views[i], &b = cached.views[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.camera.fx, b.camera.fx);
+    EXPECT_EQ(a.camera.qvec, b.camera.qvec);
+    EXPECT_EQ(a.camera.tvec, b.camera.tvec);
+    EXPECT_EQ(a.rgb.pixels, b.rgb.pixels) << a.name;
+    EXPECT_EQ(a.mask.pixels, b.mask.pixels) << a.name;
+    EXPECT_EQ(a.labels.pixels, b.labels.pixels) << a.name;
+    EXPECT_EQ(a.train, b.train);
+    EXPECT_EQ(a.test, b.test);
+    EXPECT_EQ(a.labelled, b.labelled);
+  }
+  ASSERT_EQ(fresh.points.size(), cached.points.size());
+  for (std::size_t i = 0; i < fresh.points.size(); ++i) EXPECT_EQ(fresh.points[i].xyz, cached.points[i].xyz);
 }
 
 TEST(SceneCache, DamagedFilesAreRejectedWithTheReason) {

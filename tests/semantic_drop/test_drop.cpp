@@ -9,7 +9,7 @@
 
 #include "sadsplat/common/error.h"
 
-#include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/scene_cache.h"
 #include "sadsplat/semantic_drop/drop_filters.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 #include "sadsplat/semantic_drop/hard_concrete.h"
@@ -165,8 +165,7 @@ TEST(DropFilters, RemoveAtTheExpectedRateAndBehaveLikePclFilters) {
 }
 
 TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
-  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV (scene import)";
-  const io::Scene scene = io::importScene(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene");
+  const io::Scene scene = io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
   gaussians::TrainConfig c;
   c.iterations = 100;
   c.feature_dim = 8;
