@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
 #include <cstdio>
+#include <thread>
 #include <vector>
 
 #if SADSPLAT_HAVE_CUDA
@@ -31,7 +31,8 @@ void synchronize(const at::Device& device) {
 }
 
 // Gaussians uniformly in the camera frustum between depths 2 and 10.
-GaussianParams randomInFrustum(int64_t n, int64_t features, const sadsplat::gaussians::RasterCamera& cam,
+GaussianParams randomInFrustum(int64_t n, int64_t features,
+                               const sadsplat::gaussians::RasterCamera& cam,
                                const at::Device& device) {
   at::manual_seed(0);
   const auto opts = at::TensorOptions().dtype(at::kFloat);
@@ -83,7 +84,8 @@ int main(int argc, char** argv) {
   using Clock = std::chrono::steady_clock;
   std::printf("device=%s threads=%d image=%dx%d repeats=%d\n", device_name.c_str(),
               at::get_num_threads(), width, height, repeats);
-  std::printf("| gaussians | features | tile hits / gaussian | forward ms | forward+backward ms |\n");
+  std::printf(
+      "| gaussians | features | tile hits / gaussian | forward ms | forward+backward ms |\n");
   std::printf("|---|---|---|---|---|\n");
   for (int64_t n : counts) {
     for (int64_t c : feature_dims) {

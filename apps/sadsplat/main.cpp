@@ -2,7 +2,6 @@
 // sadsplat::Error become one message on stderr and exit status 1 (2 for usage errors).
 #include <CLI/CLI.hpp>
 
-
 #include <chrono>
 #include <cstring>
 #include <iostream>
@@ -11,13 +10,13 @@
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
+#include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/file_info.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
-#include "sadsplat/io/atomic_file.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
@@ -116,7 +115,8 @@ int main(int argc, char** argv) {
   sadsplat::io::ImportOptions import_options;
   import->add_option("SCENE", import_dir, "scene directory")->required();
   import->add_option("--out", import_out, "scene cache file to write")->required();
-  import->add_option("--scale", import_options.scale, "image scale in (0, 1]")->capture_default_str();
+  import->add_option("--scale", import_options.scale, "image scale in (0, 1]")
+      ->capture_default_str();
   import->add_option("--max-width", import_options.max_width, "cap on image width (0 = none)");
 
   auto* convert = app.add_subcommand("convert", "Convert a Gaussian cloud between .ply and .pcd");
@@ -145,49 +145,75 @@ int main(int argc, char** argv) {
   train->add_option("--iterations", train_iterations, "iterations (paper: 7000)");
   train->add_option("--device", train_device, "cpu or cuda");
   train->add_option("--seed", train_seed, "random seed (42)");
-  train->add_option("--scale", train_scale, "image scale when importing a directory")->capture_default_str();
+  train->add_option("--scale", train_scale, "image scale when importing a directory")
+      ->capture_default_str();
   train->add_flag("--resume", train_resume, "continue from RUN/checkpoint.bin");
   std::string train_drop;
   double train_p_base = -1;
   train->add_option("--drop", train_drop, "semantic-aware drop: none, semantic, structure or full");
   train->add_option("--p-base", train_p_base, "base drop rate P_base (1.0)");
   double train_lambda_l0 = -1;
-  train->add_option("--lambda-l0", train_lambda_l0, "weight of the L0 sparsity loss (0.2; 0.1 renders 1.0-1.4 dB better and keeps ~1.7x more)");
+  train->add_option(
+      "--lambda-l0", train_lambda_l0,
+      "weight of the L0 sparsity loss (0.2; 0.1 renders 1.0-1.4 dB better and keeps ~1.7x more)");
 
-  auto* pseudo = app.add_subcommand(
-      "pseudo-labels", "Write confidence maps and filtered pseudo-labels of the training views into the scene cache");
+  auto* pseudo = app.add_subcommand("pseudo-labels",
+                                    "Write confidence maps and filtered pseudo-labels of the "
+                                    "training views into the scene cache");
   sadsplat::pipeline::PseudoLabelRunOptions pseudo_options;
-  pseudo->add_option("SCENE", pseudo_options.scene, "scene cache (updated in place) or scene directory")->required();
+  pseudo
+      ->add_option("SCENE", pseudo_options.scene,
+                   "scene cache (updated in place) or scene directory")
+      ->required();
   pseudo->add_option("--out", pseudo_options.out, "scene cache to write instead");
-  pseudo->add_option("--backend", pseudo_options.backend, "builtin or torchscript")->capture_default_str();
+  pseudo->add_option("--backend", pseudo_options.backend, "builtin or torchscript")
+      ->capture_default_str();
   pseudo->add_option("--sam", pseudo_options.sam_model, "torchscript: SAM TorchScript file");
   pseudo->add_option("--clip", pseudo_options.clip_model, "torchscript: CLIP TorchScript file");
-  pseudo->add_option("--report", pseudo_options.report_dir, "write report.json/.txt and overlays here");
-  pseudo->add_option("--filter-k", pseudo_options.filter.filter_k, "thresholds mean + k std (paper: 1)")
+  pseudo->add_option("--report", pseudo_options.report_dir,
+                     "write report.json/.txt and overlays here");
+  pseudo
+      ->add_option("--filter-k", pseudo_options.filter.filter_k,
+                   "thresholds mean + k std (paper: 1)")
       ->capture_default_str();
-  pseudo->add_option("--region-size", pseudo_options.builtin.superpixels.region_size, "builtin: superpixel size in pixels")
+  pseudo
+      ->add_option("--region-size", pseudo_options.builtin.superpixels.region_size,
+                   "builtin: superpixel size in pixels")
       ->capture_default_str();
   std::string pseudo_scale = "log-odds";
-  pseudo->add_option("--filter-scale", pseudo_scale, "TOP1/dTOP measured on the scores (paper) or as log-odds")
-      ->check(CLI::IsMember({"score", "log-odds"}))->capture_default_str();
-  std::string pseudo_targets = "slic";
-  pseudo->add_option("--targets", pseudo_targets, "builtin: mask generator, slic (equal-size superpixels) or graph")
-      ->check(CLI::IsMember({"slic", "graph"}))->capture_default_str();
-  pseudo->add_option("--graph-k", pseudo_options.builtin.graph.k, "builtin, graph: merge threshold scale k")
+  pseudo
+      ->add_option("--filter-scale", pseudo_scale,
+                   "TOP1/dTOP measured on the scores (paper) or as log-odds")
+      ->check(CLI::IsMember({"score", "log-odds"}))
       ->capture_default_str();
-  pseudo->add_option("--graph-min-size", pseudo_options.builtin.graph.min_size, "builtin, graph: smallest target in pixels")
+  std::string pseudo_targets = "slic";
+  pseudo
+      ->add_option("--targets", pseudo_targets,
+                   "builtin: mask generator, slic (equal-size superpixels) or graph")
+      ->check(CLI::IsMember({"slic", "graph"}))
+      ->capture_default_str();
+  pseudo
+      ->add_option("--graph-k", pseudo_options.builtin.graph.k,
+                   "builtin, graph: merge threshold scale k")
+      ->capture_default_str();
+  pseudo
+      ->add_option("--graph-min-size", pseudo_options.builtin.graph.min_size,
+                   "builtin, graph: smallest target in pixels")
       ->capture_default_str();
   bool pseudo_no_geometry = false;
-  pseudo->add_flag("--no-geometry", pseudo_no_geometry, "builtin: do not use the sparse points' heights");
-  pseudo->add_option("--scale", pseudo_options.scale, "image scale when importing a directory")->capture_default_str();
+  pseudo->add_flag("--no-geometry", pseudo_no_geometry,
+                   "builtin: do not use the sparse points' heights");
+  pseudo->add_option("--scale", pseudo_options.scale, "image scale when importing a directory")
+      ->capture_default_str();
 
   auto* evaluate = app.add_subcommand("eval", "Evaluate a training run on its test views");
   std::string eval_run, eval_scene;
   evaluate->add_option("RUN", eval_run, "run directory")->required();
   evaluate->add_option("--scene", eval_scene, "scene to evaluate on (default: the run's)");
 
-  auto* demo = app.add_subcommand(
-      "demo", "Generate the demo city, pseudo-label it, train on CPU with the semantic-aware drop, evaluate");
+  auto* demo = app.add_subcommand("demo",
+                                  "Generate the demo city, pseudo-label it, train on CPU with the "
+                                  "semantic-aware drop, evaluate");
   std::string demo_out = "out/demo";
   int demo_iterations = 600;
   demo->add_option("--out", demo_out, "output directory")->capture_default_str();
@@ -204,7 +230,8 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--width", synth_args.width, "image width (1600)");
   synth_cmd->add_option("--height", synth_args.height, "image height (900)");
   synth_cmd->add_option("--points", synth_args.points, "sparse points to keep");
-  synth_cmd->add_option("--labelled", synth_args.labelled, "labelled views (0,7,28)")->delimiter(',');
+  synth_cmd->add_option("--labelled", synth_args.labelled, "labelled views (0,7,28)")
+      ->delimiter(',');
   synth_cmd->add_option("--out", synth_args.out, "scene directory to write (PNG, needs OpenCV)");
   synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
@@ -227,7 +254,8 @@ int main(int argc, char** argv) {
         if (extract_classes.empty()) extract_classes = extract_in + "/classes.json";
         extract_in += "/model.ply";
       }
-      auto cloud = std::make_shared<pcl::PointCloud<sadsplat::GaussianPoint>>(loadGaussians(extract_in));
+      auto cloud =
+          std::make_shared<pcl::PointCloud<sadsplat::GaussianPoint>>(loadGaussians(extract_in));
       sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> filter;
       if (extract_classes.empty()) {
         std::size_t used = 0;
@@ -238,7 +266,8 @@ int main(int argc, char** argv) {
           used = 0;
         }
         if (used != extract_class.size()) {
-          throw sadsplat::Error(extract_class, "--class", "a class id, or --classes FILE to use names");
+          throw sadsplat::Error(extract_class, "--class",
+                                "a class id, or --classes FILE to use names");
         }
         filter.setClassId(static_cast<std::uint32_t>(id));
       } else {
@@ -280,10 +309,12 @@ int main(int argc, char** argv) {
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
     } else if (*pseudo) {
       pseudo_options.builtin.geometry = !pseudo_no_geometry;
-      pseudo_options.builtin.targets =
-          pseudo_targets == "graph" ? sadsplat::pseudo_labels::MaskGenerator::kGraph : sadsplat::pseudo_labels::MaskGenerator::kSlic;
-      pseudo_options.filter.scale = pseudo_scale == "log-odds" ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
-                                                               : sadsplat::pseudo_labels::ScoreScale::kScore;
+      pseudo_options.builtin.targets = pseudo_targets == "graph"
+                                           ? sadsplat::pseudo_labels::MaskGenerator::kGraph
+                                           : sadsplat::pseudo_labels::MaskGenerator::kSlic;
+      pseudo_options.filter.scale = pseudo_scale == "log-odds"
+                                        ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
+                                        : sadsplat::pseudo_labels::ScoreScale::kScore;
       pseudo_options.progress = &std::cout;
       std::cout << sadsplat::pipeline::pseudoLabelRun(pseudo_options);
     } else if (*evaluate) {

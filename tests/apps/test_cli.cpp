@@ -43,8 +43,10 @@ TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {
   if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
   test::TempDir dir;
   std::string out;
-  ASSERT_EQ(test::runCommand(kCli + " import " + kScene + " --scale 0.5 --out " +
-                             dir.file("s.cache"), &out), 0) << out;
+  ASSERT_EQ(test::runCommand(
+                kCli + " import " + kScene + " --scale 0.5 --out " + dir.file("s.cache"), &out),
+            0)
+      << out;
   ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("s.cache"), &out), 0) << out;
   EXPECT_NE(out.find("views: 8 (train 6, test 2, labelled 2)"), std::string::npos) << out;
   EXPECT_NE(out.find("image size: 32x24"), std::string::npos) << out;
@@ -52,15 +54,20 @@ TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {
 
   auto cloud = test::randomGaussians(40, 52, 3);
   io::writeGaussianPly(dir.file("m.ply"), cloud);
-  ASSERT_EQ(test::runCommand(kCli + " extract " + dir.file("m.ply") + " --class building --classes " +
-                             dir.file("s.cache") + " --out " + dir.file("b.ply"), &out), 0) << out;
+  ASSERT_EQ(
+      test::runCommand(kCli + " extract " + dir.file("m.ply") + " --class building --classes " +
+                           dir.file("s.cache") + " --out " + dir.file("b.ply"),
+                       &out),
+      0)
+      << out;
   std::size_t buildings = 0;
   for (const auto& p : cloud) buildings += p.label == 2;
   EXPECT_EQ(io::readGaussianPly(dir.file("b.ply")).size(), buildings);
   EXPECT_EQ(test::runCommand(kCli + " extract " + dir.file("m.ply") + " --class water --classes " +
-                             dir.file("s.cache") + " --out " + dir.file("w.ply"), &out), 1);
+                                 dir.file("s.cache") + " --out " + dir.file("w.ply"),
+                             &out),
+            1);
   EXPECT_NE(out.find("one of: road, grass, building"), std::string::npos) << out;
-
 }
 
 TEST(Cli, TrainEvalAndResumeOnTheFixture) {
@@ -68,27 +75,37 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   test::TempDir dir;
   std::string out;
   const std::string run = dir.file("run");
-  ASSERT_EQ(test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 30 --out " + run, &out), 0)
+  ASSERT_EQ(
+      test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 30 --out " + run, &out),
+      0)
       << out;
   for (const char* f : {"model.ply", "config.json", "run.json", "checkpoint.bin"}) {
     EXPECT_FALSE(test::readFile(run + "/" + f).empty()) << f;
   }
-  ASSERT_EQ(test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 40 --resume --out " + run, &out), 0)
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " train " + kScene + " --scale 1 --iterations 40 --resume --out " + run, &out),
+      0)
       << out;
   EXPECT_NE(out.find("[40/40]"), std::string::npos) << out;
   ASSERT_EQ(test::runCommand(kCli + " eval " + run, &out), 0) << out;
-  for (const char* key : {"\"miou\"", "\"macc\"", "\"oacc\"", "\"per_class_iou\"", "\"psnr\"", "\"ssim\"",
-                          "\"num_gaussians\"", "\"iterations\": 40", "\"train_seconds\"", "\"device\""}) {
+  for (const char* key :
+       {"\"miou\"", "\"macc\"", "\"oacc\"", "\"per_class_iou\"", "\"psnr\"", "\"ssim\"",
+        "\"num_gaussians\"", "\"iterations\": 40", "\"train_seconds\"", "\"device\""}) {
     EXPECT_NE(out.find(key), std::string::npos) << key;
   }
   EXPECT_FALSE(test::readFile(run + "/panels/view_002.png").empty());
   // Per-class extraction straight from the run directory (its model.ply and classes.json).
-  ASSERT_EQ(test::runCommand(kCli + " extract " + run + " --class road --out " + dir.file("road.ply"), &out), 0)
+  ASSERT_EQ(test::runCommand(
+                kCli + " extract " + run + " --class road --out " + dir.file("road.ply"), &out),
+            0)
       << out;
   std::size_t roads = 0;
   for (const auto& p : io::readGaussianPly(run + "/model.ply")) roads += p.label == 0;
   EXPECT_EQ(io::readGaussianPly(dir.file("road.ply")).size(), roads);
-  EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out), 1);
+  EXPECT_EQ(test::runCommand(
+                kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out),
+            1);
   EXPECT_NE(out.find("device"), std::string::npos) << out;
 }
 
@@ -98,7 +115,8 @@ TEST(Cli, DemoRunsTheMethodAndTheBaseline) {
   if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
   test::TempDir dir;
   std::string out;
-  ASSERT_EQ(test::runCommand(kCli + " demo --iterations 20 --out " + dir.file("full"), &out), 0) << out;
+  ASSERT_EQ(test::runCommand(kCli + " demo --iterations 20 --out " + dir.file("full"), &out), 0)
+      << out;
   EXPECT_NE(out.find("60 pseudo-labelled views"), std::string::npos) << out;
   EXPECT_NE(out.find("[drop] iteration 5: removed"), std::string::npos) << out;
   EXPECT_NE(out.find("| mIoU |"), std::string::npos) << out;
@@ -106,7 +124,10 @@ TEST(Cli, DemoRunsTheMethodAndTheBaseline) {
   EXPECT_TRUE(io::pathExists(dir.file("full/run/metrics.json")));
   EXPECT_TRUE(io::pathExists(dir.file("full/run/model.ply")));
 
-  ASSERT_EQ(test::runCommand(kCli + " demo --baseline --iterations 10 --out " + dir.file("base"), &out), 0) << out;
+  ASSERT_EQ(
+      test::runCommand(kCli + " demo --baseline --iterations 10 --out " + dir.file("base"), &out),
+      0)
+      << out;
   EXPECT_NE(out.find("pseudo-labels: skipped (--baseline)"), std::string::npos) << out;
   EXPECT_EQ(out.find("[drop]"), std::string::npos) << out;
   EXPECT_FALSE(io::pathExists(dir.file("base/pseudo_labels")));

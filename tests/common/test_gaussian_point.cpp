@@ -20,9 +20,9 @@ TEST(GaussianPoint, RegistersTheDocumentedFieldsInOrder) {
   std::vector<std::pair<std::string, std::uint32_t>> got;
   for (const auto& f : fields) got.emplace_back(f.name, f.count);
   const std::vector<std::pair<std::string, std::uint32_t>> want = {
-      {"x", 1},       {"y", 1},        {"z", 1},       {"nx", 1},        {"ny", 1},
-      {"nz", 1},      {"f_dc", 3},     {"f_rest", 45}, {"opacity", 1},   {"scale", 3},
-      {"rot", 4},     {"feature", 32}, {"log_alpha", 1}, {"confidence", 1}, {"label", 1}};
+      {"x", 1},   {"y", 1},        {"z", 1},         {"nx", 1},         {"ny", 1},
+      {"nz", 1},  {"f_dc", 3},     {"f_rest", 45},   {"opacity", 1},    {"scale", 3},
+      {"rot", 4}, {"feature", 32}, {"log_alpha", 1}, {"confidence", 1}, {"label", 1}};
   EXPECT_EQ(got, want);
   EXPECT_EQ(fields.back().datatype, pcl::PCLPointField::UINT32);
 }

@@ -17,7 +17,8 @@ TEST(ConfusionMatrix, MetricsMatchAHandComputedExample) {
   EXPECT_EQ(cm.at(0, 0), 2);
   EXPECT_EQ(cm.at(0, 1), 1);
   EXPECT_EQ(cm.at(1, 0), 1);
-  // IoU: class 0: 2 / (2 + 1 + 1) = 0.5; class 1: 1 / (1 + 1 + 1) = 1/3; class 2: 1; class 3: absent.
+  // IoU: class 0: 2 / (2 + 1 + 1) = 0.5; class 1: 1 / (1 + 1 + 1) = 1/3; class 2: 1; class 3:
+  // absent.
   const auto iou = cm.perClassIou();
   EXPECT_DOUBLE_EQ(iou[0], 0.5);
   EXPECT_DOUBLE_EQ(iou[1], 1.0 / 3.0);

@@ -178,15 +178,17 @@ TEST(Rasterizer, CulledAndDegenerateGaussiansGiveZerosNotNaNs) {
   const RasterCamera cam = frontCamera(20, 20, 20.0);
   const auto opts = at::TensorOptions().dtype(at::kFloat);
   GaussianParams g;
-  g.means = at::tensor({0.0f, 0.0f, -3.0f,     // behind the camera
-                        0.0f, 0.0f, 0.001f,    // in front of the near plane
-                        500.0f, 0.0f, 3.0f,    // far off-screen
-                        0.0f, 0.0f, 3.0f,      // zero quaternion
-                        0.1f, 0.0f, 3.0f,      // infinite scale
-                        0.0f, 0.1f, 3.0f},     // vanishing scale: only the dilation is left
-                       opts).reshape({6, 3});
+  g.means = at::tensor({0.0f, 0.0f, -3.0f,   // behind the camera
+                        0.0f, 0.0f, 0.001f,  // in front of the near plane
+                        500.0f, 0.0f, 3.0f,  // far off-screen
+                        0.0f, 0.0f, 3.0f,    // zero quaternion
+                        0.1f, 0.0f, 3.0f,    // infinite scale
+                        0.0f, 0.1f, 3.0f},   // vanishing scale: only the dilation is left
+                       opts)
+                .reshape({6, 3});
   g.quats = at::tensor({1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f,
-                        0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f}, opts)
+                        0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f},
+                       opts)
                 .reshape({6, 4});
   g.log_scales = at::full({6, 3}, -2.0f, opts);
   g.log_scales[4].fill_(1000.0f);
@@ -241,8 +243,8 @@ TEST(Rasterizer, TiledRenderEqualsABruteForceComposite) {
   const RasterCamera cam = frontCamera(45, 35, 30.0);
   auto g = randomScene(40, 2, 5, 0.8);
   const auto proj = gaussians::projectGaussians(g.means, g.quats, g.log_scales, cam);
-  const at::Tensor values = at::cat({at::rand({40, 3}, g.means.options()), g.features,
-                                     proj[2].unsqueeze(1)}, 1);
+  const at::Tensor values =
+      at::cat({at::rand({40, 3}, g.means.options()), g.features, proj[2].unsqueeze(1)}, 1);
   const at::Tensor opac = at::sigmoid(g.opacity_logits);
   const auto out =
       gaussians::rasterizeToPixels(proj[0], proj[1], opac, values, proj[3], proj[2], 45, 35);
@@ -306,19 +308,23 @@ TEST(Rasterizer, RenderGraphIsFreedWithItsOutputs) {
   const RasterCamera cam = frontCamera(32, 32, 30.0);
   auto g = randomScene(10, 0, 8);
   g.means.requires_grad_(true);
-  c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl> alpha{c10::intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>()};
+  c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl> alpha{
+      c10::intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>()};
   c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl> features = alpha;
   {
     const auto r = gaussians::render(g, cam);
-    alpha = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(r.alpha.getIntrusivePtr());
-    features = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(r.features.getIntrusivePtr());
+    alpha = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(
+        r.alpha.getIntrusivePtr());
+    features = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(
+        r.features.getIntrusivePtr());
     (r.rgb.sum() + r.alpha.sum()).backward();
   }
   EXPECT_TRUE(alpha.expired());
   EXPECT_TRUE(features.expired());
   {
     const auto r = gaussians::render(g, cam);  // no backward: the graph must go as well
-    alpha = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(r.alpha.getIntrusivePtr());
+    alpha = c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl>(
+        r.alpha.getIntrusivePtr());
   }
   EXPECT_TRUE(alpha.expired());
 }

@@ -53,8 +53,8 @@ TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {
   const GaussianParams cpu = scene(3000, C, 17 + C);
   GaussianParams cuda;
   at::Tensor GaussianParams::*const members[] = {
-      &GaussianParams::means, &GaussianParams::quats, &GaussianParams::log_scales,
-      &GaussianParams::opacity_logits, &GaussianParams::sh, &GaussianParams::features};
+      &GaussianParams::means,          &GaussianParams::quats, &GaussianParams::log_scales,
+      &GaussianParams::opacity_logits, &GaussianParams::sh,    &GaussianParams::features};
   const char* names[] = {"means", "quats", "log_scales", "opacity_logits", "sh", "features"};
   GaussianParams a = cpu;
   std::vector<at::Tensor> ta, tb;
@@ -70,8 +70,10 @@ TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {
   const int64_t radius_mismatches = (ra.radii != rb.radii.cpu()).sum().item<int64_t>();
   EXPECT_LE(radius_mismatches, 3);
   EXPECT_GT((ra.radii > 0).sum().item<int64_t>(), 1000);
-  const double e_rgb = relativeError(rb.rgb, ra.rgb), e_feat = C ? relativeError(rb.features, ra.features) : 0,
-               e_alpha = relativeError(rb.alpha, ra.alpha), e_depth = relativeError(rb.depth, ra.depth);
+  const double e_rgb = relativeError(rb.rgb, ra.rgb),
+               e_feat = C ? relativeError(rb.features, ra.features) : 0,
+               e_alpha = relativeError(rb.alpha, ra.alpha),
+               e_depth = relativeError(rb.depth, ra.depth);
   std::cout << "C=" << C << " forward rel. error: rgb " << e_rgb << " features " << e_feat
             << " alpha " << e_alpha << " depth " << e_depth << "\n";
   EXPECT_LT(e_rgb, 1e-4);

@@ -12,8 +12,8 @@
 namespace sadsplat {
 namespace {
 
-using gaussians::Trainer;
 using gaussians::TrainConfig;
+using gaussians::Trainer;
 
 // The fixture scene as a cache (data/tiny_scene.cache, checked against a fresh import in
 // test_io), so these tests need no OpenCV and run on the GPU build too.
@@ -101,7 +101,8 @@ TEST(SemanticLoss, UnsupervisedPixelsGiveNoGradientAndNoValue) {
   at::manual_seed(3);
   const auto opts = at::TensorOptions().dtype(at::kDouble);
   at::Tensor features = at::randn({2, 3, 4}, opts).requires_grad_(true);
-  const at::Tensor labels = at::tensor({1, -1, 0, -1, -1, 2}, at::TensorOptions().dtype(at::kLong)).view({2, 3});
+  const at::Tensor labels =
+      at::tensor({1, -1, 0, -1, -1, 2}, at::TensorOptions().dtype(at::kLong)).view({2, 3});
   const at::Tensor W = at::randn({3, 4}, opts), b = at::randn({3}, opts);
   const at::Tensor loss = gaussians::semanticLoss(features, labels, W, b);
   // By hand: mean over the three supervised pixels of 1 - logit[c] / |logit|.
@@ -144,7 +145,8 @@ class EvenGatesClosed : public gaussians::DropStrategy {
  public:
   at::Tensor trainingGate(const at::Tensor&, int) const override { return {}; }
   at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
-    return (at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 2).to(log_alpha.dtype());
+    return (at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 2)
+        .to(log_alpha.dtype());
   }
   at::Tensor regularisation(const at::Tensor&) const override { return {}; }
   bool dropNow(int) const override { return false; }
@@ -172,7 +174,9 @@ TEST_P(TrainerOnDevice, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
     last = gated.step();
     gated.checkConsistency();
     if (last.iteration == 10) after_densify = last.num_gaussians;
-    if (last.iteration < 30) EXPECT_EQ(last.removed_closed_gates, 0);
+    if (last.iteration < 30) {
+      EXPECT_EQ(last.removed_closed_gates, 0);
+    }
   }
   EXPECT_EQ(after_densify, n0 / 2) << "densification prunes by opacity x evaluation gate";
   const std::int64_t n1 = n0 / 2;

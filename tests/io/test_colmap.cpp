@@ -36,7 +36,8 @@ void expectSameModel(const io::ColmapModel& a, const io::ColmapModel& b) {
   }
 }
 
-void expectError(const std::string& dir, const std::string& file_suffix, const std::string& needle) {
+void expectError(const std::string& dir, const std::string& file_suffix,
+                 const std::string& needle) {
   try {
     io::readColmapModel(dir);
     FAIL() << "expected an error containing " << needle;
@@ -48,7 +49,8 @@ void expectError(const std::string& dir, const std::string& file_suffix, const s
 
 TEST(Colmap, TextAndIndependentlyWrittenBinaryAgree) {
   const auto text = io::readColmapModel(kScene + "/sparse/0");
-  const auto binary = io::readColmapModel(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene_colmap_bin");
+  const auto binary =
+      io::readColmapModel(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene_colmap_bin");
   EXPECT_EQ(text.images.size(), 8u);
   EXPECT_EQ(text.points.size(), 400u);
   EXPECT_EQ(text.cameras[0].model, io::CameraModel::kPinhole);

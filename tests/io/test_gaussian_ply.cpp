@@ -57,8 +57,9 @@ TEST(GaussianPly, RoundTripIsBitExact) {
 TEST(GaussianPly, WritesTheStandardLayoutThenSemanticProperties) {
   test::TempDir dir;
   writeGaussianPly(dir.file("a.ply"), test::randomGaussians(3, 1));
-  std::string want = "ply\nformat binary_little_endian 1.0\ncomment written by sadsplat\n"
-                     "element vertex 3\n";
+  std::string want =
+      "ply\nformat binary_little_endian 1.0\ncomment written by sadsplat\n"
+      "element vertex 3\n";
   for (const char* n : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"}) {
     want += std::string("property float ") + n + "\n";
   }
@@ -138,8 +139,8 @@ TEST(GaussianPly, ReadsBigEndianAndSkipsElementsBeforeTheVertices) {
   std::string bytes =
       "ply\nformat binary_big_endian 1.0\nelement meta 1\nproperty list uchar short ids\n"
       "element vertex 1\n";
-  const char* names[] = {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0",
-                         "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"};
+  const char* names[] = {"x",       "y",       "z",       "f_dc_0", "f_dc_1", "f_dc_2", "opacity",
+                         "scale_0", "scale_1", "scale_2", "rot_0",  "rot_1",  "rot_2",  "rot_3"};
   for (const char* n : names) bytes += std::string("property float ") + n + "\n";
   bytes += "end_header\n";
   bytes += std::string("\x02\x00\x01\x00\x02", 5);  // meta: list of two shorts
@@ -218,7 +219,8 @@ TEST(GaussianPly, PclPlyReaderAcceptsOurFiles) {
 TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
   std::string probe;
   if (test::runCommand("/usr/bin/python3 -c 'import open3d'", &probe) != 0) {
-    GTEST_SKIP() << "Debian's python3-open3d is not installed (scripts/setup_debian.sh installs it)";
+    GTEST_SKIP()
+        << "Debian's python3-open3d is not installed (scripts/setup_debian.sh installs it)";
   }
   test::TempDir dir;
   auto cloud = test::randomGaussians(6, 9);
@@ -230,7 +232,9 @@ TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
       "float(pc.point.feature_31[4][0].item()), float(pc.point.f_rest_44[0][0].item()))\n";
   test::writeFile(dir.file("probe.py"), script);
   std::string out;
-  ASSERT_EQ(test::runCommand("/usr/bin/python3 " + dir.file("probe.py") + " " + dir.file("a.ply"), &out), 0)
+  ASSERT_EQ(
+      test::runCommand("/usr/bin/python3 " + dir.file("probe.py") + " " + dir.file("a.ply"), &out),
+      0)
       << out;
   std::istringstream in(out.substr(out.find_last_of('\n', out.size() - 2) + 1));
   std::size_t n = 0;

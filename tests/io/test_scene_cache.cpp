@@ -115,7 +115,8 @@ TEST(SceneCache, CommittedTinySceneCacheMatchesAFreshImport) {
     EXPECT_EQ(a.labelled, b.labelled);
   }
   ASSERT_EQ(fresh.points.size(), cached.points.size());
-  for (std::size_t i = 0; i < fresh.points.size(); ++i) EXPECT_EQ(fresh.points[i].xyz, cached.points[i].xyz);
+  for (std::size_t i = 0; i < fresh.points.size(); ++i)
+    EXPECT_EQ(fresh.points[i].xyz, cached.points[i].xyz);
 }
 
 TEST(SceneCache, DamagedFilesAreRejectedWithTheReason) {

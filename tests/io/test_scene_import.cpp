@@ -100,12 +100,18 @@ TEST_F(SceneImport, MapsColourLabelMapsThroughThePalette) {
   const std::string py =
       "import zlib, struct, sys\n"
       "w, h = 64, 48\n"
-      "rows = b''.join(b'\\x00' + (bytes([0,0,0]) * w if y == 0 else bytes([220,20,60]) * w) for y in range(h))\n"
+      "rows = b''.join(b'\\x00' + (bytes([0,0,0]) * w if y == 0 else bytes([220,20,60]) * w) for y "
+      "in range(h))\n"
       "c = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d))\n"
-      "open(sys.argv[1], 'wb').write(b'\\x89PNG\\r\\n\\x1a\\n' + c(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0)) + c(b'IDAT', zlib.compress(rows)) + c(b'IEND', b''))\n";
+      "open(sys.argv[1], 'wb').write(b'\\x89PNG\\r\\n\\x1a\\n' + c(b'IHDR', "
+      "struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0)) + c(b'IDAT', zlib.compress(rows)) + "
+      "c(b'IEND', b''))\n";
   test::writeFile(tmp_.file("png.py"), py);
-  ASSERT_EQ(test::runCommand("/usr/bin/python3 " + tmp_.file("png.py") + " " + dir +
-                             "/labels/view_000.png", &out), 0) << out;
+  ASSERT_EQ(
+      test::runCommand(
+          "/usr/bin/python3 " + tmp_.file("png.py") + " " + dir + "/labels/view_000.png", &out),
+      0)
+      << out;
   const io::Scene scene = io::importScene(dir);
   EXPECT_EQ(scene.views[0].labels.at(5, 0), io::kIgnoreLabel);
   EXPECT_EQ(scene.views[0].labels.at(5, 1), 2);
@@ -151,10 +157,12 @@ TEST_F(SceneImport, BadInputsNameTheFileAndTheField) {
   }
   {
     const std::string dir = copy();
-    test::writeFile(dir + "/split.json", "{\"train\": [\"view_000.png\"], \"test\": [\"nope.png\"]}");
-    expectError(dir, "split.json", "nope.png");
     test::writeFile(dir + "/split.json",
-                    "{\"train\": [\"view_000.png\"], \"test\": [], \"labelled\": [\"view_001.png\"]}");
+                    "{\"train\": [\"view_000.png\"], \"test\": [\"nope.png\"]}");
+    expectError(dir, "split.json", "nope.png");
+    test::writeFile(
+        dir + "/split.json",
+        "{\"train\": [\"view_000.png\"], \"test\": [], \"labelled\": [\"view_001.png\"]}");
     expectError(dir, "split.json", "also in \"train\"");
     test::runCommand("rm -rf '" + dir + "'");
   }

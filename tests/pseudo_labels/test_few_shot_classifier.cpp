@@ -61,7 +61,8 @@ TEST(FewShotClassifier, ProbabilitiesAreCalibratedOnOverlappingClasses) {
   double conf = 0, acc = 0;
   for (int i = 0; i < 3000; ++i) {
     int best = 0;
-    for (int k = 1; k < 3; ++k) if (p[i * 3 + k] > p[i * 3 + best]) best = k;
+    for (int k = 1; k < 3; ++k)
+      if (p[i * 3 + k] > p[i * 3 + best]) best = k;
     conf += p[i * 3 + best] / 3000;
     acc += (best == yt[i]) / 3000.0;
   }
@@ -74,7 +75,7 @@ TEST(FewShotClassifier, ProbabilitiesAreCalibratedOnOverlappingClasses) {
 
 TEST(FewShotClassifier, BadInputIsAnError) {
   sp::FewShotClassifier c;
-  EXPECT_THROW(c.predictProbabilities({1, 2}), sadsplat::Error);  // not fitted
+  EXPECT_THROW(c.predictProbabilities({1, 2}), sadsplat::Error);          // not fitted
   EXPECT_THROW(c.fit({1, 2, 3}, 2, {0, 1}, {0, 0}, 2), sadsplat::Error);  // sizes
   EXPECT_THROW(c.fit({1, 2}, 1, {0, 2}, {0, 0}, 2), sadsplat::Error);     // label out of range
   EXPECT_THROW(c.fit({1, 2}, 1, {0, 1}, {0, 0}, 1), sadsplat::Error);     // one class

@@ -51,7 +51,8 @@ TEST(PseudoLabelGenerator, BuiltinFillsEveryTrainingViewWithValidMaps) {
   const sp::PseudoLabelQuality q = sp::evaluatePseudoLabels(scene);
   EXPECT_EQ(q.views, 3);
   EXPECT_GT(q.coverage, 0.05);
-  EXPECT_GE(q.precision, 0.97) << "argmax accuracy " << q.argmax_accuracy << ", coverage " << q.coverage;
+  EXPECT_GE(q.precision, 0.97) << "argmax accuracy " << q.argmax_accuracy << ", coverage "
+                               << q.coverage;
 }
 
 TEST(PseudoLabelGenerator, GroundTruthOverridesPseudoLabels) {
@@ -99,8 +100,8 @@ TEST(PseudoLabelQuality, HandComputedPrecisionCoverageAndReliability) {
   p.region = {0, 0, 1, 1};
   p.num_targets = 2;
   p.num_classes = 3;
-  p.scores = {0.95f, 0.05f, 0.0f,   // target 0: class 0, kept, both pixels right
-              0.10f, 0.85f, 0.05f}; // target 1: class 1, kept: right on pixel 2, wrong on 3
+  p.scores = {0.95f, 0.05f, 0.0f,    // target 0: class 0, kept, both pixels right
+              0.10f, 0.85f, 0.05f};  // target 1: class 1, kept: right on pixel 2, wrong on 3
   p.kept = {1, 1};
   const sp::PseudoLabelQuality q = sp::evaluatePseudoLabels(scene);
   EXPECT_EQ(q.gt_pixels, 4u);
@@ -111,7 +112,7 @@ TEST(PseudoLabelQuality, HandComputedPrecisionCoverageAndReliability) {
   EXPECT_DOUBLE_EQ(q.classes[2].coverage, 1.0);  // its pixel was kept (with a wrong label)
   EXPECT_EQ(q.reliability[9].pixels, 2u);        // TOP1 0.95
   EXPECT_DOUBLE_EQ(q.reliability[9].accuracy, 1.0);
-  EXPECT_EQ(q.reliability[8].pixels, 2u);        // TOP1 0.85
+  EXPECT_EQ(q.reliability[8].pixels, 2u);  // TOP1 0.85
   EXPECT_DOUBLE_EQ(q.reliability[8].accuracy, 0.5);
   p.kept = {1, 0};
   const sp::PseudoLabelQuality q2 = sp::evaluatePseudoLabels(scene);

@@ -16,8 +16,10 @@ Image8 twoColourImage(int W, int H, int edge_x) {
     for (int x = 0; x < W; ++x) {
       std::uint8_t* p = &im.pixels[3 * (static_cast<std::size_t>(y) * W + x)];
       const int n = ((x * 7 + y * 13) % 5) - 2;
-      if (x < edge_x) p[0] = 220 + n, p[1] = 30 + n, p[2] = 30;
-      else p[0] = 30, p[1] = 30 + n, p[2] = 220 + n;
+      if (x < edge_x)
+        p[0] = 220 + n, p[1] = 30 + n, p[2] = 30;
+      else
+        p[0] = 30, p[1] = 30 + n, p[2] = 220 + n;
     }
   }
   return im;

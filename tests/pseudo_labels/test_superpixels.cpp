@@ -15,8 +15,10 @@ Image8 twoColourImage(int W, int H) {
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
       std::uint8_t* p = &im.pixels[3 * (static_cast<std::size_t>(y) * W + x)];
-      if (x < 37) p[0] = 220, p[1] = 30, p[2] = 30;
-      else p[0] = 30, p[1] = 30, p[2] = 220;
+      if (x < 37)
+        p[0] = 220, p[1] = 30, p[2] = 30;
+      else
+        p[0] = 30, p[1] = 30, p[2] = 220;
     }
   }
   return im;

@@ -31,7 +31,8 @@ TEST(TargetFilter, EntropyNormalisesScoresAndHandlesAllZero) {
 // entropy = {0.2, 1.0, 0.8, 0.1}: mean 0.525, std 0.38324             -> threshold 0.90824
 // Kept: only target 3 (0.95 > 0.929, 0.9 > 0.859, 0.1 < 0.908). Target 0 fails TOP1 and dTOP.
 TEST(TargetFilter, HandComputedKeepDecisions) {
-  std::vector<sp::TargetMeasures> t = {{0.9, 0.8, 0.2}, {0.5, 0.1, 1.0}, {0.6, 0.3, 0.8}, {0.95, 0.9, 0.1}};
+  std::vector<sp::TargetMeasures> t = {
+      {0.9, 0.8, 0.2}, {0.5, 0.1, 1.0}, {0.6, 0.3, 0.8}, {0.95, 0.9, 0.1}};
   const sp::TargetStatistics s = sp::targetStatistics(t);
   EXPECT_NEAR(s.top1_mean, 0.7375, 1e-12);
   EXPECT_NEAR(s.top1_std, 0.191621, 1e-6);

@@ -71,24 +71,28 @@ TEST(TorchScriptScorer, CliRunsTheBackendOnACache) {
   sadsplat::test::TempDir dir;
   io::writeSceneCache(dir.file("toy.cache"), sadsplat::test::toyPseudoLabelScene());
   std::string output;
-  const int rc = sadsplat::test::runCommand(std::string(SADSPLAT_CLI) + " pseudo-labels " + dir.file("toy.cache") +
-                                                " --backend torchscript --sam " + kSam + " --clip " + kClip +
-                                                " --report " + dir.file("report"),
-                                            &output);
+  const int rc =
+      sadsplat::test::runCommand(std::string(SADSPLAT_CLI) + " pseudo-labels " +
+                                     dir.file("toy.cache") + " --backend torchscript --sam " +
+                                     kSam + " --clip " + kClip + " --report " + dir.file("report"),
+                                 &output);
   // SAM's default thresholds (pred IoU 0.88) reject most of the tiny model's masks; what passes
   // still makes a valid cache and report.
   ASSERT_EQ(rc, 0) << output;
   const io::Scene back = io::readSceneCache(dir.file("toy.cache"));
   EXPECT_FALSE(back.views[0].pseudo.empty());
   EXPECT_EQ(back.views[0].pseudo.backend, "torchscript");
-  EXPECT_NE(sadsplat::test::readFile(dir.file("report/report.json")).find("precision"), std::string::npos);
+  EXPECT_NE(sadsplat::test::readFile(dir.file("report/report.json")).find("precision"),
+            std::string::npos);
 }
 
 TEST(TorchScriptScorer, BadModelFilesGiveClearErrors) {
   sadsplat::test::TempDir dir;
-  EXPECT_NE(errorOf([&] { sp::makeTorchScriptScorer(dir.file("nope.pt"), kClip); }).find("nope.pt"), std::string::npos);
+  EXPECT_NE(errorOf([&] { sp::makeTorchScriptScorer(dir.file("nope.pt"), kClip); }).find("nope.pt"),
+            std::string::npos);
   sadsplat::test::writeFile(dir.file("text.pt"), "not a model");
-  const std::string garbage = errorOf([&] { sp::makeTorchScriptScorer(dir.file("text.pt"), kClip); });
+  const std::string garbage =
+      errorOf([&] { sp::makeTorchScriptScorer(dir.file("text.pt"), kClip); });
   EXPECT_NE(garbage.find("text.pt"), std::string::npos) << garbage;
   EXPECT_NE(garbage.find("TorchScript"), std::string::npos) << garbage;
   // The SAM file where the CLIP file belongs: its methods are missing.

@@ -10,7 +10,8 @@
 namespace sadsplat {
 namespace test {
 
-inline io::Scene toyPseudoLabelScene(int views = 5, int W = 64, int H = 48, std::uint64_t seed = 1) {
+inline io::Scene toyPseudoLabelScene(int views = 5, int W = 64, int H = 48,
+                                     std::uint64_t seed = 1) {
   io::Scene scene;
   scene.source = "<toy scene>";
   const char* names[3] = {"red", "green", "blue"};

@@ -37,9 +37,12 @@ TEST(HardConcrete, EmpiricalNonZeroProbabilityMatchesTheClosedForm) {
 
 TEST(HardConcrete, GradientsReachLogAlpha) {
   at::manual_seed(2);
-  const at::Tensor log_alpha = at::zeros({1000}, at::TensorOptions().dtype(at::kDouble)).requires_grad_(true);
-  const at::Tensor z = sampleGate(log_alpha, at::rand({1000}, at::TensorOptions().dtype(at::kDouble)));
-  const auto g = torch::autograd::grad({z.sum() + probabilityNonZero(log_alpha).sum()}, {log_alpha})[0];
+  const at::Tensor log_alpha =
+      at::zeros({1000}, at::TensorOptions().dtype(at::kDouble)).requires_grad_(true);
+  const at::Tensor z =
+      sampleGate(log_alpha, at::rand({1000}, at::TensorOptions().dtype(at::kDouble)));
+  const auto g =
+      torch::autograd::grad({z.sum() + probabilityNonZero(log_alpha).sum()}, {log_alpha})[0];
   EXPECT_GT(g.abs().sum().item<double>(), 0.0);
   EXPECT_TRUE(at::isfinite(g).all().item<bool>());
   // d/dx sigmoid(x - c) at x = 0 is p (1 - p).
@@ -58,10 +61,11 @@ TEST(SemanticConfidence, EqualsAHandComputationOnATwoViewToyScene) {
   gaussians::RasterCamera shifted = cam;
   shifted.tvec = {-1.0, 0.0, 0.0};  // camera centre at x = +1
   const auto opts = at::TensorOptions().dtype(at::kFloat);
-  const at::Tensor means = at::tensor({0.f, 0.f, 2.f,     // pixel (2,2) in view 0, (0,2) in view 1
-                                       -0.9f, 0.f, 2.f,   // pixel (0.2,2) in view 0, off-screen in 1
-                                       0.f, 0.f, -1.f},   // behind both
-                                      opts).view({3, 3});
+  const at::Tensor means = at::tensor({0.f, 0.f, 2.f,    // pixel (2,2) in view 0, (0,2) in view 1
+                                       -0.9f, 0.f, 2.f,  // pixel (0.2,2) in view 0, off-screen in 1
+                                       0.f, 0.f, -1.f},  // behind both
+                                      opts)
+                               .view({3, 3});
   const at::Tensor opac = at::tensor({0.5f, 0.8f, 1.f}, opts);
   at::Tensor m0 = at::zeros({4, 4, 2}, opts), m1 = at::zeros({4, 4, 2}, opts);
   m0[2][2][0] = 0.6f;
@@ -147,7 +151,8 @@ TEST(DropFilters, RemoveAtTheExpectedRateAndBehaveLikePclFilters) {
   EXPECT_EQ(kept, kept_again);  // seeded
   EXPECT_EQ(kept.size() + removed.size(), 40000u);
   std::set<int> all(kept.begin(), kept.end());
-  for (int i : removed) EXPECT_TRUE(all.insert(i).second) << "index " << i << " both kept and removed";
+  for (int i : removed)
+    EXPECT_TRUE(all.insert(i).second) << "index " << i << " both kept and removed";
   drop.setNegative(true);
   drop.filter(removed_set);
   EXPECT_EQ(removed_set, removed);
@@ -165,7 +170,8 @@ TEST(DropFilters, RemoveAtTheExpectedRateAndBehaveLikePclFilters) {
 }
 
 TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
-  const io::Scene scene = io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
+  const io::Scene scene =
+      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
   gaussians::TrainConfig c;
   c.iterations = 100;
   c.feature_dim = 8;

@@ -88,7 +88,8 @@ TEST(AerialBenchmark, RaysHitTheGroundAndObjectsExactly) {
     if (world.objects()[i].hi[2] > world.objects()[tallest].hi[2]) tallest = i;
   }
   const auto& ob = world.objects()[tallest];
-  const float top[3] = {0.5f * (ob.lo[0] + ob.hi[0]), 0.5f * (ob.lo[1] + ob.hi[1]), ob.hi[2] + 10.f};
+  const float top[3] = {0.5f * (ob.lo[0] + ob.hi[0]), 0.5f * (ob.lo[1] + ob.hi[1]),
+                        ob.hi[2] + 10.f};
   ASSERT_TRUE(world.trace(top, down, 1e4f, &hit));
   EXPECT_NEAR(hit.t, 10.f, 1e-3f);
   EXPECT_EQ(hit.cls, ob.cls);
@@ -115,9 +116,10 @@ TEST(AerialBenchmark, SparsePointsProjectOntoTheirSurfaceInTheWrittenFiles) {
     for (const auto& [image_id, idx] : p.track) {
       const auto& im = model.images[image_id - 1];
       const double w = im.qvec[0], x = im.qvec[1], y = im.qvec[2], z = im.qvec[3];
-      const double R[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                           2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                           2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+      const double R[9] = {
+          1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
       double c[3];
       for (int r = 0; r < 3; ++r) {
         c[r] = R[3 * r] * p.xyz[0] + R[3 * r + 1] * p.xyz[1] + R[3 * r + 2] * p.xyz[2] + im.tvec[r];

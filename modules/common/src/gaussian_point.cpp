@@ -26,8 +26,7 @@
 namespace sadsplat {
 
 GaussianPoint::GaussianPoint()
-    : nx(0.f), ny(0.f), nz(0.f), opacity(0.f), log_alpha(0.f), confidence(0.f),
-      label(kUnlabelled) {
+    : nx(0.f), ny(0.f), nz(0.f), opacity(0.f), log_alpha(0.f), confidence(0.f), label(kUnlabelled) {
   x = y = z = 0.f;
   data[3] = 1.f;
   for (float& v : f_dc) v = 0.f;

@@ -22,7 +22,9 @@ cv::Mat classImage(const std::vector<std::uint8_t>& ids, int W, int H,
   for (int i = 0; i < W * H; ++i) {
     const auto id = ids[i];
     cv::Vec3b c(0, 0, 0);
-    if (id < classes.size()) c = {classes[id].color[0], classes[id].color[1], classes[id].color[2]};  // RGB; the panel is converted to BGR once
+    if (id < classes.size())
+      c = {classes[id].color[0], classes[id].color[1],
+           classes[id].color[2]};  // RGB; the panel is converted to BGR once
     out.at<cv::Vec3b>(i / W, i % W) = c;
   }
   return out;
@@ -32,7 +34,8 @@ void writePanel(const std::string& path, const io::View& view, const at::Tensor&
                 const std::vector<std::uint8_t>& pred, const std::vector<ClassInfo>& classes) {
   const int W = view.camera.width, H = view.camera.height;
   cv::Mat image(H, W, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.pixels.data()));
-  const at::Tensor bytes = render_rgb.clamp(0, 1).mul(255).round().to(at::kByte).to(at::kCPU).contiguous();
+  const at::Tensor bytes =
+      render_rgb.clamp(0, 1).mul(255).round().to(at::kByte).to(at::kCPU).contiguous();
   cv::Mat render(H, W, CV_8UC3, bytes.data_ptr<std::uint8_t>());
   cv::Mat error(H, W, CV_8UC3);
   for (int i = 0; i < W * H; ++i) {
@@ -74,8 +77,8 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     }
     result.confusion.add(labels.data(), pred.data_ptr<std::int64_t>(), labels.size());
     const int W = view.camera.width, H = view.camera.height;
-    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(view.rgb.pixels.data()), {H, W, 3},
-                                        at::TensorOptions().dtype(at::kByte))
+    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(view.rgb.pixels.data()),
+                                        {H, W, 3}, at::TensorOptions().dtype(at::kByte))
                               .to(at::kFloat)
                               .div(255.0)
                               .to(r.rgb.device());

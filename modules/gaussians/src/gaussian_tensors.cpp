@@ -172,7 +172,8 @@ pcl::PointCloud<GaussianPoint> toCloud(const GaussianTensors& tensors) {
     }
     p.opacity = o[i];
     for (int k = 0; k < 4; ++k) p.rot[k] = q[i * 4 + k];
-    for (int k = 0; k < kFeatureDim; ++k) p.feature[k] = k < feature_dim ? f[i * feature_dim + k] : 0.f;
+    for (int k = 0; k < kFeatureDim; ++k)
+      p.feature[k] = k < feature_dim ? f[i * feature_dim + k] : 0.f;
     p.log_alpha = la[i];
     p.confidence = cf[i];
     if (lb[i] < -1 || lb[i] >= static_cast<int64_t>(kUnlabelled)) {

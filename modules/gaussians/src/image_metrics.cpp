@@ -21,8 +21,8 @@ at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
   const at::Tensor sxx = blur(x * x) - mx * mx, syy = blur(y * y) - my * my;
   const at::Tensor sxy = blur(x * y) - mx * my;
   const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
-  const at::Tensor map = ((2 * mx * my + c1) * (2 * sxy + c2)) /
-                         ((mx * mx + my * my + c1) * (sxx + syy + c2));
+  const at::Tensor map =
+      ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2));
   return map.mean();
 }
 

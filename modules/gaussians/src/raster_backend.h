@@ -81,11 +81,13 @@ std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::
 
 #if SADSPLAT_COMPILE_CUDA
 ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
-                                    const at::Tensor& log_scales, const CameraParams& cam, void* stream);
+                                    const at::Tensor& log_scales, const CameraParams& cam,
+                                    void* stream);
 ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& quats,
                                     const at::Tensor& log_scales, const at::Tensor& radii,
                                     const CameraParams& cam, const at::Tensor& g_means2d,
-                                    const at::Tensor& g_conics, const at::Tensor& g_depths, void* stream);
+                                    const at::Tensor& g_conics, const at::Tensor& g_depths,
+                                    void* stream);
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const at::Tensor& radii, const at::Tensor& depths, int width,

@@ -17,7 +17,6 @@ namespace gaussians {
 namespace raster {
 namespace {
 
-
 // Grain sizes for at::parallel_for.
 constexpr int64_t kGaussianGrain = 2048;
 
@@ -79,8 +78,8 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
       for (int64_t i = begin; i < end; ++i) {
         if (r[i] <= 0) continue;
-        projectGaussianBackward(m + 3 * i, q + 4 * i, s + 3 * i, c, gm2 + 2 * i, gco + 3 * i,
-                                gd[i], gm + 3 * i, gq + 4 * i, gs + 3 * i);
+        projectGaussianBackward(m + 3 * i, q + 4 * i, s + 3 * i, c, gm2 + 2 * i, gco + 3 * i, gd[i],
+                                gm + 3 * i, gq + 4 * i, gs + 3 * i);
       }
     });
   });
@@ -97,7 +96,8 @@ at::Tensor shForwardCpu(const at::Tensor& sh, const at::Tensor& means,
     const scalar_t* m = means.data_ptr<scalar_t>();
     scalar_t* c = colors.data_ptr<scalar_t>();
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
-      for (int64_t i = begin; i < end; ++i) shColor(s + i * K * 3, degree, m + 3 * i, cam, c + 3 * i);
+      for (int64_t i = begin; i < end; ++i)
+        shColor(s + i * K * 3, degree, m + 3 * i, cam, c + 3 * i);
     });
   });
   return colors;
@@ -312,8 +312,8 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
               g_a *= trans;
               g_a += galpha[pix] * final_trans / (T(1) - alpha);
               last_alpha = alpha;
-              pixelAlphaBackward(m2 + 2 * g, co + 3 * g, op[g], fx, fy, G, clamped, g_a, gb,
-                                 gb + 2, gb + 5);
+              pixelAlphaBackward(m2 + 2 * g, co + 3 * g, op[g], fx, fy, G, clamped, g_a, gb, gb + 2,
+                                 gb + 5);
             }
           }
         }

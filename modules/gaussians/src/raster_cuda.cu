@@ -17,7 +17,6 @@ namespace {
 constexpr int kBlock = kTileSize * kTileSize;  // threads per tile block
 constexpr int kThreads1d = 256;
 
-
 void check(const at::Tensor& t, const char* name) {
   if (!t.is_cuda() || t.scalar_type() != at::kFloat || !t.is_contiguous()) {
     throw Error("<render>", name, "a contiguous float32 CUDA tensor",
@@ -56,19 +55,16 @@ __global__ void projectForwardKernel(int64_t n, const float* __restrict__ means,
   radii[i] = p.radius;
 }
 
-__global__ void projectBackwardKernel(int64_t n, const float* __restrict__ means,
-                                      const float* __restrict__ quats,
-                                      const float* __restrict__ log_scales,
-                                      const int* __restrict__ radii, Camera<float> cam,
-                                      const float* __restrict__ g_means2d,
-                                      const float* __restrict__ g_conics,
-                                      const float* __restrict__ g_depths, float* g_means,
-                                      float* g_quats, float* g_log_scales) {
+__global__ void projectBackwardKernel(
+    int64_t n, const float* __restrict__ means, const float* __restrict__ quats,
+    const float* __restrict__ log_scales, const int* __restrict__ radii, Camera<float> cam,
+    const float* __restrict__ g_means2d, const float* __restrict__ g_conics,
+    const float* __restrict__ g_depths, float* g_means, float* g_quats, float* g_log_scales) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n || radii[i] <= 0) return;
-  projectGaussianBackward(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam,
-                          g_means2d + 2 * i, g_conics + 3 * i, g_depths[i], g_means + 3 * i,
-                          g_quats + 4 * i, g_log_scales + 3 * i);
+  projectGaussianBackward(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam, g_means2d + 2 * i,
+                          g_conics + 3 * i, g_depths[i], g_means + 3 * i, g_quats + 4 * i,
+                          g_log_scales + 3 * i);
 }
 
 // ---- spherical harmonics ---------------------------------------------------------------------
@@ -150,9 +146,9 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii, const a
     return b;
   }
   at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
-  countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
-      n, means2d.data_ptr<float>(), radii.data_ptr<int>(), tiles_x, tiles_y,
-      counts.data_ptr<int64_t>());
+  countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(n, means2d.data_ptr<float>(),
+                                                            radii.data_ptr<int>(), tiles_x, tiles_y,
+                                                            counts.data_ptr<int64_t>());
   checkLaunch("countTilesKernel");
   const at::Tensor offsets = counts.cumsum(0);
   const int64_t m = offsets[n - 1].item<int64_t>();
@@ -226,14 +222,14 @@ __global__ void __launch_bounds__(kBlock)
   for (int batch = start; batch < stop; batch += kBlock) {
     if (__syncthreads_count(done) == kBlock) break;
     const int k = batch + threadIdx.x;
-    if (k < stop) stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
+    if (k < stop)
+      stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
     __syncthreads();
     const int count = min(kBlock, stop - batch);
     for (int j = 0; j < count && !done; ++j) {
       float G;
       bool clamped;
-      const float alpha =
-          pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
+      const float alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
       if (alpha == 0.f) continue;
       const float next = trans * (1.f - alpha);
       if (next < float(kMinTransmittance)) {
@@ -354,8 +350,8 @@ __global__ void __launch_bounds__(kBlock)
           }
           g_a = g_a * trans + ga_out * final_trans / (1.f - alpha);
           last_alpha = alpha;
-          pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a,
-                             g_mean, g_conic, &g_op);
+          pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a, g_mean,
+                             g_conic, &g_op);
         }
         const float s0 = warpSum(g_mean[0]), s1 = warpSum(g_mean[1]);
         const float s2 = warpSum(g_conic[0]), s3 = warpSum(g_conic[1]), s4 = warpSum(g_conic[2]);
@@ -402,12 +398,24 @@ int channelCapacity(int64_t D) {
 
 #define SADSPLAT_FOR_CHANNEL_CAPACITY(D, LAUNCH) \
   switch (channelCapacity(D)) {                  \
-    case 4: LAUNCH(4); break;                    \
-    case 8: LAUNCH(8); break;                    \
-    case 16: LAUNCH(16); break;                  \
-    case 36: LAUNCH(36); break;                  \
-    case 68: LAUNCH(68); break;                  \
-    default: LAUNCH(132); break;                 \
+    case 4:                                      \
+      LAUNCH(4);                                 \
+      break;                                     \
+    case 8:                                      \
+      LAUNCH(8);                                 \
+      break;                                     \
+    case 16:                                     \
+      LAUNCH(16);                                \
+      break;                                     \
+    case 36:                                     \
+      LAUNCH(36);                                \
+      break;                                     \
+    case 68:                                     \
+      LAUNCH(68);                                \
+      break;                                     \
+    default:                                     \
+      LAUNCH(132);                               \
+      break;                                     \
   }
 
 // Launches a backward kernel with `smem` bytes of dynamic shared memory (raising the kernel's
@@ -416,8 +424,7 @@ template <typename Kernel, typename... Args>
 void launchBackward(Kernel kernel, int blocks, std::size_t smem, cudaStream_t stream,
                     Args... args) {
   // Static shared memory plus `smem` exceeds the 48 KiB default: opt in to more.
-  cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                       static_cast<int>(smem));
+  cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, static_cast<int>(smem));
   kernel<<<blocks, kBlock, smem, stream>>>(args...);
 }
 
@@ -517,11 +524,11 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
   out.binning = binGaussians(means2d, radii, depths, width, height, stream);
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
-#define SADSPLAT_LAUNCH_FORWARD(CH)                                                          \
-  rasterizeForwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                               \
-      width, height, tiles_x, static_cast<int>(D), out.binning.tile_ranges.data_ptr<int>(),   \
-      out.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                    \
-      conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),        \
+#define SADSPLAT_LAUNCH_FORWARD(CH)                                                         \
+  rasterizeForwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                             \
+      width, height, tiles_x, static_cast<int>(D), out.binning.tile_ranges.data_ptr<int>(), \
+      out.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                  \
+      conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),      \
       out.image.data_ptr<float>(), out.alpha.data_ptr<float>(), out.last.data_ptr<int>())
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_FORWARD)
 #undef SADSPLAT_LAUNCH_FORWARD
@@ -546,14 +553,15 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   g.values = at::zeros_like(values);
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
-#define SADSPLAT_LAUNCH_BACKWARD(CH)                                                         \
-  launchBackward(rasterizeBackwardKernel<CH>, num_tiles, gpix_bytes, stream,                  \
-      width, height, tiles_x, static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),   \
-      fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                    \
-      conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),        \
-      fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(),       \
-      g_alpha.data_ptr<float>(), g.means2d.data_ptr<float>(), g.conics.data_ptr<float>(),     \
-      g.opacities.data_ptr<float>(), g.values.data_ptr<float>())
+#define SADSPLAT_LAUNCH_BACKWARD(CH)                                                               \
+  launchBackward(rasterizeBackwardKernel<CH>, num_tiles, gpix_bytes, stream, width, height,        \
+                 tiles_x, static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),            \
+                 fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),              \
+                 conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),  \
+                 fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(), \
+                 g_alpha.data_ptr<float>(), g.means2d.data_ptr<float>(),                           \
+                 g.conics.data_ptr<float>(), g.opacities.data_ptr<float>(),                        \
+                 g.values.data_ptr<float>())
   const std::size_t gpix_bytes = sizeof(float) * kBlock * static_cast<std::size_t>(D);
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_BACKWARD)
 #undef SADSPLAT_LAUNCH_BACKWARD

@@ -20,9 +20,9 @@ namespace sadsplat {
 namespace gaussians {
 namespace {
 
+using raster::CameraParams;
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
-using raster::CameraParams;
 
 raster::CameraParams toParams(const RasterCamera& c) {
   CameraParams p;
@@ -178,15 +178,15 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     } else {
       g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
     }
-    return {g.means2d, g.conics, g.opacities, g.values,
+    return {g.means2d,    g.conics,     g.opacities,  g.values,
             at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };
 
 struct ShFunction : public torch::autograd::Function<ShFunction> {
   // camera: centre x, y, z and the SH degree.
-  static variable_list forward(AutogradContext* ctx, const at::Tensor& sh,
-                               const at::Tensor& means, const std::vector<double>& camera) {
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& sh, const at::Tensor& means,
+                               const std::vector<double>& camera) {
     const at::Tensor s = sh.contiguous(), m = means.contiguous();
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
@@ -249,8 +249,7 @@ void expectTensor(const at::Tensor& t, const char* name, int64_t n, std::vector<
 
 void validateCamera(const RasterCamera& c) {
   if (c.width <= 0 || c.height <= 0 || !(c.fx > 0) || !(c.fy > 0) || !(c.near_plane > 0)) {
-    throw Error("<render>", "camera",
-                "positive width, height, focal lengths and near plane",
+    throw Error("<render>", "camera", "positive width, height, focal lengths and near plane",
                 std::to_string(c.width) + "x" + std::to_string(c.height) +
                     " fx=" + std::to_string(c.fx) + " fy=" + std::to_string(c.fy));
   }
@@ -294,9 +293,9 @@ at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
                     " coefficients for SH degree " + std::to_string(degree),
                 std::to_string(sh.size(1)));
   }
-  return ShFunction::apply(sh, means,
-                           std::vector<double>{camera_centre[0], camera_centre[1],
-                                               camera_centre[2], double(degree)})[0];
+  return ShFunction::apply(
+      sh, means,
+      std::vector<double>{camera_centre[0], camera_centre[1], camera_centre[2], double(degree)})[0];
 }
 
 std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Tensor& quats,
@@ -340,17 +339,16 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   expectTensor(g.opacity_logits, "opacity_logits", n, {}, g.means);
   expectTensor(g.sh, "sh", n, {-1, 3}, g.means);
   if (g.sh.size(1) < coefficients) {
-    throw Error("<render>", "sh", "at least " + std::to_string(coefficients) +
-                                      " coefficients for SH degree " +
-                                      std::to_string(settings.sh_degree),
+    throw Error("<render>", "sh",
+                "at least " + std::to_string(coefficients) + " coefficients for SH degree " +
+                    std::to_string(settings.sh_degree),
                 std::to_string(g.sh.size(1)));
   }
   const at::Tensor features =
       g.features.defined() ? g.features : at::zeros({n, 0}, g.means.options());
   expectTensor(features, "features", n, {-1}, g.means);
 
-  auto [means2d, conics, depths, radii] =
-      projectGaussians(g.means, g.quats, g.log_scales, camera);
+  auto [means2d, conics, depths, radii] = projectGaussians(g.means, g.quats, g.log_scales, camera);
   const at::Tensor colors = evaluateSh(g.sh, g.means, camera.centre(), settings.sh_degree);
   const at::Tensor values = at::cat({colors, features, depths.unsqueeze(1)}, 1);
   at::Tensor opacities = at::sigmoid(g.opacity_logits);
@@ -361,10 +359,10 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   auto [image, alpha] = rasterizeToPixels(means2d, conics, opacities, values, radii, depths,
                                           camera.width, camera.height);
   const int64_t C = features.size(1);
-  const at::Tensor background = at::tensor(
-      {double(settings.background[0]), double(settings.background[1]),
-       double(settings.background[2])},
-      g.means.options());
+  const at::Tensor background =
+      at::tensor({double(settings.background[0]), double(settings.background[1]),
+                  double(settings.background[2])},
+                 g.means.options());
   RenderResult result;
   result.rgb = image.slice(2, 0, 3) + (1.0 - alpha).unsqueeze(2) * background;
   result.features = image.slice(2, 3, 3 + C);

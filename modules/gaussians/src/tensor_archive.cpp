@@ -43,13 +43,15 @@ class Reader {
 
 const at::Tensor& TensorArchive::tensor(const std::string& name, const std::string& file) const {
   const auto it = tensors.find(name);
-  if (it == tensors.end()) throw Error(file, "tensor " + name, "present in the checkpoint", "missing");
+  if (it == tensors.end())
+    throw Error(file, "tensor " + name, "present in the checkpoint", "missing");
   return it->second;
 }
 
 double TensorArchive::number(const std::string& name, const std::string& file) const {
   const auto it = numbers.find(name);
-  if (it == numbers.end()) throw Error(file, "number " + name, "present in the checkpoint", "missing");
+  if (it == numbers.end())
+    throw Error(file, "number " + name, "present in the checkpoint", "missing");
   return it->second;
 }
 

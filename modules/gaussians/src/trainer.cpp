@@ -25,7 +25,6 @@ std::uint64_t mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-
 // One optimised tensor with its Adam moments (per-row tensors are resized by densification).
 struct Param {
   std::string name;
@@ -106,7 +105,8 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   TrainConfig c;
   nlohmann::json defaults = nlohmann::json::parse(c.toJson());
   for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!defaults.contains(it.key())) throw Error(origin, it.key(), "a known configuration key", "unknown");
+    if (!defaults.contains(it.key()))
+      throw Error(origin, it.key(), "a known configuration key", "unknown");
     if (it.value().type() != defaults[it.key()].type() &&
         !(it.value().is_number() && defaults[it.key()].is_number())) {
       throw Error(origin, it.key(), std::string("a ") + defaults[it.key()].type_name(),
@@ -164,11 +164,11 @@ struct Trainer::State {
   int num_classes = 0;
   // Scene data on the device.
   std::vector<RasterCamera> cameras;
-  std::vector<at::Tensor> images;  // [H, W, 3] float in [0, 1]
-  std::vector<at::Tensor> masks;   // [H, W] float, 1 = valid pixel
-  std::vector<at::Tensor> labels;  // [H, W] int64, -1 = not supervised (empty if unlabelled)
-  std::vector<double> semantic_weight;       // per view: lambda_semantic (GT) or lambda_pseudo
-  std::vector<at::Tensor> confidence_maps;   // [H, W] max class confidence (empty if none)
+  std::vector<at::Tensor> images;       // [H, W, 3] float in [0, 1]
+  std::vector<at::Tensor> masks;        // [H, W] float, 1 = valid pixel
+  std::vector<at::Tensor> labels;       // [H, W] int64, -1 = not supervised (empty if unlabelled)
+  std::vector<double> semantic_weight;  // per view: lambda_semantic (GT) or lambda_pseudo
+  std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (empty if none)
   int pseudo_labelled_views = 0;
   std::vector<int> train_views, labelled_views;
   // Parameters: means, sh_dc, sh_rest, opacity, scales, quats, features; decoder W, b.
@@ -267,12 +267,14 @@ struct Trainer::State {
       const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(device) * s;
       const at::Tensor q = p("quats").value.detach().index_select(0, split_idx).repeat({2, 1});
       const at::Tensor qn = q / q.norm(2, 1, true);
-      const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2), z = qn.select(1, 3);
-      const at::Tensor R = at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                                      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                                      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
-                                     1)
-                             .view({-1, 3, 3});
+      const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2),
+                       z = qn.select(1, 3);
+      const at::Tensor R =
+          at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                     2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                     2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+                    1)
+              .view({-1, 3, 3});
       split_means = at::bmm(R, noise.unsqueeze(2)).squeeze(2) +
                     p("means").value.detach().index_select(0, split_idx).repeat({2, 1});
     }
@@ -354,7 +356,8 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
     const bool gt = v.labelled && !v.labels.empty();
     const std::vector<std::int16_t> sup = io::supervisionLabels(v, config.use_pseudo_labels);
     if (std::any_of(sup.begin(), sup.end(), [](std::int16_t l) { return l >= 0; })) {
-      labels = at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W}, at::TensorOptions().dtype(at::kShort))
+      labels = at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W},
+                             at::TensorOptions().dtype(at::kShort))
                    .to(at::kLong);
       if (gt) {
         s.labelled_views.push_back(static_cast<int>(i));
@@ -367,9 +370,10 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
       confidence = at::from_blob(const_cast<float*>(best.data()), {H, W}, at::kFloat).clone();
     }
     if (gt) {
-      const at::Tensor gt_valid = (at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
-                                                 at::TensorOptions().dtype(at::kByte)) != io::kIgnoreLabel) &
-                                  (mask >= 0.5);
+      const at::Tensor gt_valid =
+          (at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
+                         at::TensorOptions().dtype(at::kByte)) != io::kIgnoreLabel) &
+          (mask >= 0.5);
       confidence = at::where(gt_valid, at::ones({H, W}),
                              confidence.defined() ? confidence : at::zeros({H, W}));
     }
@@ -393,8 +397,10 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
   InitOptions init;
   init.seed = config.seed;
-  const GaussianTensors t = fromCloud(initialCloud(scene.points, init), s.device, config.feature_dim);
-  auto add = [&](const std::string& name, const at::Tensor& value, double lr, bool per_gaussian = true) {
+  const GaussianTensors t =
+      fromCloud(initialCloud(scene.points, init), s.device, config.feature_dim);
+  auto add = [&](const std::string& name, const at::Tensor& value, double lr,
+                 bool per_gaussian = true) {
     Param q;
     q.name = name;
     q.value = value.detach().clone().contiguous().requires_grad_(true);
@@ -416,8 +422,10 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   add("decoder_w",
       at::empty({s.num_classes, config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),
       config.lr_decoder, false);
-  add("decoder_b", at::zeros({s.num_classes}, at::TensorOptions().device(s.device)), config.lr_decoder, false);
-  add("log_alpha", at::full({s.n()}, config.log_alpha_init, t.means.options()), config.lr_log_alpha);
+  add("decoder_b", at::zeros({s.num_classes}, at::TensorOptions().device(s.device)),
+      config.lr_decoder, false);
+  add("log_alpha", at::full({s.n()}, config.log_alpha_init, t.means.options()),
+      config.lr_log_alpha);
   const auto fopts = at::TensorOptions().dtype(at::kFloat).device(s.device);
   s.grad_accum = at::zeros({s.n()}, fopts);
   s.denom = at::zeros({s.n()}, fopts);
@@ -442,7 +450,9 @@ StepStats Trainer::step() {
   const int it = s.iteration;
   // Position learning rate: exponential from init to final over the run (3DGS).
   const double t = std::min(1.0, static_cast<double>(it) / std::max(1, c.iterations));
-  s.p("means").lr = std::exp(std::log(c.lr_position_init) * (1 - t) + std::log(c.lr_position_final) * t) * s.extent;
+  s.p("means").lr =
+      std::exp(std::log(c.lr_position_init) * (1 - t) + std::log(c.lr_position_final) * t) *
+      s.extent;
 
   // This iteration's views: the next one of a seeded shuffle of the training views, and every
   // semantic_interval iterations the next labelled view.
@@ -479,7 +489,8 @@ StepStats Trainer::step() {
     const at::Tensor& gt = s.images[v];
     const at::Tensor mask = s.masks[v].unsqueeze(2);
     const at::Tensor l1 = ((r.rgb - gt).abs() * mask).mean();
-    const at::Tensor rgb_loss = (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
+    const at::Tensor rgb_loss =
+        (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
     at::Tensor loss = c.lambda_rgb * rgb_loss;
     rgb_sum += rgb_loss.item<double>();
     const at::Tensor& labels = s.labels[v];

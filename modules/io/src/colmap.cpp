@@ -45,9 +45,9 @@ void validateCamera(const ColmapCamera& c, const std::string& file, const std::s
   for (std::size_t i = 0; i < c.params.size(); ++i) {
     requireFinite(c.params[i], file, where + " param " + std::to_string(i));
   }
-  if (c.params[0] <= 0 || (c.model == CameraModel::kPinhole || c.model == CameraModel::kOpenCV
-                               ? c.params[1] <= 0
-                               : false)) {
+  if (c.params[0] <= 0 ||
+      (c.model == CameraModel::kPinhole || c.model == CameraModel::kOpenCV ? c.params[1] <= 0
+                                                                           : false)) {
     throw Error(file, where + " focal length", "positive", std::to_string(c.params[0]));
   }
 }
@@ -158,7 +158,8 @@ std::vector<ColmapImage> readImagesText(const std::string& path) {
     for (int i = 0; i < 3; ++i) im.tvec[i] = parseDouble(in, lines, "TVEC");
     im.camera_id = parseField<std::uint32_t>(in, lines, "CAMERA_ID");
     std::getline(in >> std::ws, im.name);
-    while (!im.name.empty() && (im.name.back() == ' ' || im.name.back() == '\r')) im.name.pop_back();
+    while (!im.name.empty() && (im.name.back() == ' ' || im.name.back() == '\r'))
+      im.name.pop_back();
     validateImage(im, path, lines.where());
     const std::string image_where = lines.where();
     std::string points_line;
@@ -357,22 +358,32 @@ void put(std::string& out, const T& v) {
 
 const char* cameraModelName(CameraModel model) {
   switch (model) {
-    case CameraModel::kSimplePinhole: return "SIMPLE_PINHOLE";
-    case CameraModel::kPinhole: return "PINHOLE";
-    case CameraModel::kSimpleRadial: return "SIMPLE_RADIAL";
-    case CameraModel::kRadial: return "RADIAL";
-    case CameraModel::kOpenCV: return "OPENCV";
+    case CameraModel::kSimplePinhole:
+      return "SIMPLE_PINHOLE";
+    case CameraModel::kPinhole:
+      return "PINHOLE";
+    case CameraModel::kSimpleRadial:
+      return "SIMPLE_RADIAL";
+    case CameraModel::kRadial:
+      return "RADIAL";
+    case CameraModel::kOpenCV:
+      return "OPENCV";
   }
   return "UNKNOWN";
 }
 
 int cameraModelNumParams(CameraModel model) {
   switch (model) {
-    case CameraModel::kSimplePinhole: return 3;
-    case CameraModel::kPinhole: return 4;
-    case CameraModel::kSimpleRadial: return 4;
-    case CameraModel::kRadial: return 5;
-    case CameraModel::kOpenCV: return 8;
+    case CameraModel::kSimplePinhole:
+      return 3;
+    case CameraModel::kPinhole:
+      return 4;
+    case CameraModel::kSimpleRadial:
+      return 4;
+    case CameraModel::kRadial:
+      return 5;
+    case CameraModel::kOpenCV:
+      return 8;
   }
   return 0;
 }
@@ -438,8 +449,8 @@ void writeColmapText(const std::string& dir, const ColmapModel& model) {
       << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
       << "# Number of points: " << model.points.size() << "\n";
   for (const auto& p : model.points) {
-    pts << p.id << " " << p.xyz[0] << " " << p.xyz[1] << " " << p.xyz[2] << " "
-        << int(p.rgb[0]) << " " << int(p.rgb[1]) << " " << int(p.rgb[2]) << " " << p.error;
+    pts << p.id << " " << p.xyz[0] << " " << p.xyz[1] << " " << p.xyz[2] << " " << int(p.rgb[0])
+        << " " << int(p.rgb[1]) << " " << int(p.rgb[2]) << " " << p.error;
     for (const auto& t : p.track) pts << " " << t.first << " " << t.second;
     pts << "\n";
   }

@@ -40,7 +40,9 @@ void describeBounds(std::ostream& out, const Range& points, GetXyz xyz) {
 
 void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& cloud) {
   out << "gaussians: " << cloud.size() << "\n";
-  describeBounds(out, cloud, [](const GaussianPoint& p) { return std::array<float, 3>{p.x, p.y, p.z}; });
+  describeBounds(out, cloud, [](const GaussianPoint& p) {
+    return std::array<float, 3>{p.x, p.y, p.z};
+  });
   std::size_t labelled = 0;
   std::uint32_t max_label = 0;
   for (const auto& p : cloud) {
@@ -72,8 +74,8 @@ void describeScene(std::ostream& out, const Scene& scene) {
   out << "classes: " << scene.classes.size() << "\n";
   for (std::size_t i = 0; i < scene.classes.size(); ++i) {
     const auto& c = scene.classes[i];
-    out << "  " << i << " " << c.name << " rgb(" << int(c.color[0]) << "," << int(c.color[1])
-        << "," << int(c.color[2]) << ") \"" << c.prompt << "\"\n";
+    out << "  " << i << " " << c.name << " rgb(" << int(c.color[0]) << "," << int(c.color[1]) << ","
+        << int(c.color[2]) << ") \"" << c.prompt << "\"\n";
   }
 }
 
@@ -93,8 +95,8 @@ std::string describeFile(const std::string& path) {
     const auto cloud = readGaussianPly(path, &info);
     out << path << ": 3DGS PLY (" << info.format << ")\n"
         << "SH degree: " << info.sh_degree << "\n"
-        << "semantic properties: " << (info.has_semantic ? "yes" : "no")
-        << " (feature dim " << info.feature_dim << ")\n";
+        << "semantic properties: " << (info.has_semantic ? "yes" : "no") << " (feature dim "
+        << info.feature_dim << ")\n";
     if (!info.ignored_properties.empty()) {
       out << "ignored properties:";
       for (const auto& n : info.ignored_properties) out << " " << n;

@@ -38,11 +38,11 @@ struct PlyHeader {
 
 bool parseType(const std::string& s, PlyType* type) {
   static const std::pair<const char*, PlyType> kNames[] = {
-      {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUInt8},
-      {"uint8", PlyType::kUInt8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
-      {"ushort", PlyType::kUInt16}, {"uint16", PlyType::kUInt16},   {"int", PlyType::kInt32},
-      {"int32", PlyType::kInt32},   {"uint", PlyType::kUInt32},     {"uint32", PlyType::kUInt32},
-      {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
+      {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},       {"uchar", PlyType::kUInt8},
+      {"uint8", PlyType::kUInt8},    {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
+      {"ushort", PlyType::kUInt16},  {"uint16", PlyType::kUInt16},   {"int", PlyType::kInt32},
+      {"int32", PlyType::kInt32},    {"uint", PlyType::kUInt32},     {"uint32", PlyType::kUInt32},
+      {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
       {"float64", PlyType::kFloat64}};
   for (const auto& [name, t] : kNames) {
     if (s == name) {
@@ -104,8 +104,8 @@ PlyHeader parseHeader(const std::string& path, const std::string& bytes) {
       } else if (name == "binary_big_endian") {
         header.format = PlyFormat::kBinaryBigEndian;
       } else {
-        throw Error(path, where + " (format)",
-                    "ascii, binary_little_endian or binary_big_endian", name);
+        throw Error(path, where + " (format)", "ascii, binary_little_endian or binary_big_endian",
+                    name);
       }
       header.format_name = name;
       have_format = true;
@@ -171,8 +171,7 @@ int indexedName(const std::string& name, const std::string& prefix) {
 
 class ValueDecoder {
  public:
-  ValueDecoder(const std::string& path, const std::string& bytes, std::size_t pos,
-               PlyFormat format)
+  ValueDecoder(const std::string& path, const std::string& bytes, std::size_t pos, PlyFormat format)
       : path_(path), bytes_(bytes), pos_(pos), format_(format) {}
 
   double next(PlyType type, const std::string& what) {
@@ -188,14 +187,22 @@ class ValueDecoder {
       for (std::size_t i = 0; i < size / 2; ++i) std::swap(raw[i], raw[size - 1 - i]);
     }
     switch (type) {
-      case PlyType::kInt8: return static_cast<double>(static_cast<std::int8_t>(raw[0]));
-      case PlyType::kUInt8: return static_cast<double>(raw[0]);
-      case PlyType::kInt16: return load<std::int16_t>(raw);
-      case PlyType::kUInt16: return load<std::uint16_t>(raw);
-      case PlyType::kInt32: return load<std::int32_t>(raw);
-      case PlyType::kUInt32: return load<std::uint32_t>(raw);
-      case PlyType::kFloat32: return load<float>(raw);
-      case PlyType::kFloat64: return load<double>(raw);
+      case PlyType::kInt8:
+        return static_cast<double>(static_cast<std::int8_t>(raw[0]));
+      case PlyType::kUInt8:
+        return static_cast<double>(raw[0]);
+      case PlyType::kInt16:
+        return load<std::int16_t>(raw);
+      case PlyType::kUInt16:
+        return load<std::uint16_t>(raw);
+      case PlyType::kInt32:
+        return load<std::int32_t>(raw);
+      case PlyType::kUInt32:
+        return load<std::uint32_t>(raw);
+      case PlyType::kFloat32:
+        return load<float>(raw);
+      case PlyType::kFloat64:
+        return load<double>(raw);
     }
     return 0.0;
   }
@@ -224,7 +231,8 @@ class ValueDecoder {
     char* end = nullptr;
     const double v = std::strtod(begin, &end);
     if (end == begin) {
-      throw Error(path_, what, "a number", std::string(begin, std::min<std::size_t>(16, bytes_.size() - pos_)));
+      throw Error(path_, what, "a number",
+                  std::string(begin, std::min<std::size_t>(16, bytes_.size() - pos_)));
     }
     pos_ += static_cast<std::size_t>(end - begin);
     return v;
@@ -334,9 +342,9 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
       found.ignored_properties.push_back(n);
     }
   }
-  static const char* kRequiredNames[14] = {"x",     "y",       "z",       "f_dc_0", "f_dc_1",
+  static const char* kRequiredNames[14] = {"x",      "y",       "z",       "f_dc_0",  "f_dc_1",
                                            "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
-                                           "rot_0", "rot_1",   "rot_2",   "rot_3"};
+                                           "rot_0",  "rot_1",   "rot_2",   "rot_3"};
   for (int r = 0; r < 14; ++r) {
     if (!seen_required[r]) {
       throw Error(path, std::string("vertex property ") + kRequiredNames[r],
@@ -375,12 +383,13 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
     auto* base = reinterpret_cast<unsigned char*>(&point);
     for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
       const PlyProperty& p = vertex.properties[i];
-      const double value = decoder.next(p.type, "vertex " + std::to_string(v) + " property " + p.name);
+      const double value =
+          decoder.next(p.type, "vertex " + std::to_string(v) + " property " + p.name);
       const Target& t = targets[i];
       if (t.kind == Target::kSkip) continue;
       if (!std::isfinite(value)) {
-        throw Error(path, "vertex " + std::to_string(v) + " property " + p.name,
-                    "a finite number", std::to_string(value));
+        throw Error(path, "vertex " + std::to_string(v) + " property " + p.name, "a finite number",
+                    std::to_string(value));
       }
       if (t.kind == Target::kLabel) {
         if (value < 0 || value > static_cast<double>(kUnlabelled) || value != std::floor(value)) {

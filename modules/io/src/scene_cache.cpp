@@ -59,7 +59,8 @@ class ByteReader {
   }
   double getFinite(const char* field) {
     const double v = get<double>(field);
-    if (!std::isfinite(v)) throw Error(path_, context_ + " " + field, "a finite number", std::to_string(v));
+    if (!std::isfinite(v))
+      throw Error(path_, context_ + " " + field, "a finite number", std::to_string(v));
     return v;
   }
   std::string getString(const char* field) {
@@ -150,8 +151,9 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
     const auto pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
     if (v.rgb.pixels.size() != pixels * 3 || v.mask.pixels.size() != pixels ||
         (!v.labels.empty() && v.labels.pixels.size() != pixels)) {
-      throw Error(path, "view " + v.name, "images of the camera's size " +
-                  std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height));
+      throw Error(path, "view " + v.name,
+                  "images of the camera's size " + std::to_string(v.camera.width) + "x" +
+                      std::to_string(v.camera.height));
     }
     ByteWriter c;
     c.putString(v.name);
@@ -319,8 +321,10 @@ Scene readSceneCache(const std::string& path) {
       p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
       const std::size_t pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
       p.region = c.getArray<std::int32_t>(pixels, "region map");
-      p.scores = c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
-      p.features = c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.feature_dim, "features");
+      p.scores =
+          c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
+      p.features =
+          c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.feature_dim, "features");
       p.kept = c.getBytes(p.num_targets, "kept flags");
       if (p.num_classes != static_cast<int>(scene.classes.size())) {
         throw Error(path, "view " + name + " pseudo-labels class count",

@@ -64,8 +64,7 @@ std::vector<ClassInfo> readClassesJson(const std::string& path) {
     if (!names.insert(c.name).second) {
       throw Error(path, where + ".name", "a unique class name", c.name + " (a duplicate)");
     }
-    if (!item.contains("color") || !item.at("color").is_array() ||
-        item.at("color").size() != 3) {
+    if (!item.contains("color") || !item.at("color").is_array() || item.at("color").size() != 3) {
       throw Error(path, where + ".color", "[r, g, b] with integers 0..255");
     }
     for (int k = 0; k < 3; ++k) {

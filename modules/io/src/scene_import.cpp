@@ -42,7 +42,8 @@ Image8 toImage8(const cv::Mat& mat) {
   image.height = mat.rows;
   image.channels = mat.channels();
   const cv::Mat contiguous = mat.isContinuous() ? mat : mat.clone();
-  image.pixels.assign(contiguous.data, contiguous.data + contiguous.total() * contiguous.elemSize());
+  image.pixels.assign(contiguous.data,
+                      contiguous.data + contiguous.total() * contiguous.elemSize());
   return image;
 }
 
@@ -52,12 +53,24 @@ void opencvIntrinsics(const ColmapCamera& c, cv::Mat* K, cv::Mat* dist, PinholeC
   double fx = p[0], fy = p[0], cx = p[1], cy = p[2];
   std::vector<double> d(4, 0.0);
   switch (c.model) {
-    case CameraModel::kSimplePinhole: break;
-    case CameraModel::kPinhole: fy = p[1]; cx = p[2]; cy = p[3]; break;
-    case CameraModel::kSimpleRadial: d[0] = p[3]; break;
-    case CameraModel::kRadial: d[0] = p[3]; d[1] = p[4]; break;
+    case CameraModel::kSimplePinhole:
+      break;
+    case CameraModel::kPinhole:
+      fy = p[1];
+      cx = p[2];
+      cy = p[3];
+      break;
+    case CameraModel::kSimpleRadial:
+      d[0] = p[3];
+      break;
+    case CameraModel::kRadial:
+      d[0] = p[3];
+      d[1] = p[4];
+      break;
     case CameraModel::kOpenCV:
-      fy = p[1]; cx = p[2]; cy = p[3];
+      fy = p[1];
+      cx = p[2];
+      cy = p[3];
       d = {p[4], p[5], p[6], p[7]};
       break;
   }
@@ -78,7 +91,8 @@ cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& clas
   cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw Error(path, "image data", "a readable PNG label map", "cannot decode");
   if (raw.depth() != CV_8U) {
-    throw Error(path, "pixel depth", "8-bit label map", "depth code " + std::to_string(raw.depth()));
+    throw Error(path, "pixel depth", "8-bit label map",
+                "depth code " + std::to_string(raw.depth()));
   }
   cv::Mat labels(raw.rows, raw.cols, CV_8UC1);
   if (raw.channels() == 1) {

@@ -21,7 +21,8 @@ namespace {
 #if SADSPLAT_HAVE_OPENCV
 // Image | pseudo-labels (class colours where kept, grey where a target was filtered out) |
 // ground truth where the view has it.
-void writeOverlay(const std::string& path, const io::View& v, const std::vector<ClassInfo>& classes) {
+void writeOverlay(const std::string& path, const io::View& v,
+                  const std::vector<ClassInfo>& classes) {
   const int W = v.camera.width, H = v.camera.height;
   const bool gt = !v.labels.empty();
   cv::Mat out(H, W * (gt ? 3 : 2), CV_8UC3, cv::Scalar(0, 0, 0));
@@ -79,15 +80,20 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
   }
   const auto start = std::chrono::steady_clock::now();
   pseudo_labels::ProgressFn progress;
-  if (o.progress) progress = [&](const std::string& line) { *o.progress << "  " << line << "\n" << std::flush; };
-  const pseudo_labels::PseudoLabelSummary s = pseudo_labels::generatePseudoLabels(scene, *scorer, o.filter, progress);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (o.progress)
+    progress = [&](const std::string& line) { *o.progress << "  " << line << "\n" << std::flush; };
+  const pseudo_labels::PseudoLabelSummary s =
+      pseudo_labels::generatePseudoLabels(scene, *scorer, o.filter, progress);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   io::writeSceneCache(out, scene);
   if (o.progress) {
     *o.progress << s.backend << ": " << s.views << " training views, " << s.targets << " targets, "
-                << s.kept_targets << " kept (TOP1 > " << s.statistics.top1_mean + o.filter.filter_k * s.statistics.top1_std
-                << ", dTOP > " << s.statistics.delta_top_mean + o.filter.filter_k * s.statistics.delta_top_std
-                << ", entropy < " << s.statistics.entropy_mean + o.filter.filter_k * s.statistics.entropy_std
+                << s.kept_targets << " kept (TOP1 > "
+                << s.statistics.top1_mean + o.filter.filter_k * s.statistics.top1_std << ", dTOP > "
+                << s.statistics.delta_top_mean + o.filter.filter_k * s.statistics.delta_top_std
+                << ", entropy < "
+                << s.statistics.entropy_mean + o.filter.filter_k * s.statistics.entropy_std
                 << ") in " << seconds << " s; wrote " << out << "\n";
   }
   if (o.report_dir.empty()) return "";

@@ -46,8 +46,11 @@ std::string formatSeconds(double s) {
 
 void writeRunJson(const std::string& dir, const std::string& scene, double scale,
                   const std::string& device, int iterations, double seconds) {
-  const nlohmann::json j = {{"scene", scene}, {"scale", scale}, {"device", device},
-                            {"iterations", iterations}, {"train_seconds", seconds}};
+  const nlohmann::json j = {{"scene", scene},
+                            {"scale", scale},
+                            {"device", device},
+                            {"iterations", iterations},
+                            {"train_seconds", seconds}};
   writeText(dir + "/run.json", j.dump(2) + "\n");
 }
 
@@ -78,7 +81,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   gaussians::TrainConfig config = config_in;
   double previous_seconds = 0;
   if (o.resume) {
-    if (!pathExists(checkpoint)) throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
+    if (!pathExists(checkpoint))
+      throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
     // The run's own configuration wins: resuming continues the same run.
     config = gaussians::TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"),
                                               o.out + "/config.json");
@@ -91,21 +95,28 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     int labelled = 0, pseudo = 0;
     for (const io::View& v : scene.views) {
       if (!v.train) continue;
-      if (v.labelled && !v.labels.empty()) ++labelled;
-      else if (!v.pseudo.empty()) ++pseudo;
+      if (v.labelled && !v.labels.empty())
+        ++labelled;
+      else if (!v.pseudo.empty())
+        ++pseudo;
     }
     *o.progress << "semantic supervision: " << labelled << " labelled views, "
                 << (config.use_pseudo_labels ? pseudo : 0) << " pseudo-labelled views"
-                << (pseudo == 0 ? " (run `sadsplat pseudo-labels` on the scene cache to add them)" : "")
+                << (pseudo == 0 ? " (run `sadsplat pseudo-labels` on the scene cache to add them)"
+                                : "")
                 << "; drop " << config.drop << " with confidence maps of "
-                << (pseudo > 0 ? "the pseudo-label backend + ground truth" : "the ground truth only") << "\n";
+                << (pseudo > 0 ? "the pseudo-label backend + ground truth"
+                               : "the ground truth only")
+                << "\n";
   }
   gaussians::Trainer trainer(scene, config);
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   if (o.resume) trainer.loadCheckpoint(checkpoint);
   writeText(o.out + "/config.json", trainer.config().toJson());
   const auto start = Clock::now();
-  auto seconds = [&] { return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count(); };
+  auto seconds = [&] {
+    return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count();
+  };
   const int first = trainer.iteration();
   while (trainer.iteration() < config.iterations) {
     const gaussians::StepStats stats = trainer.step();
@@ -113,14 +124,15 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
-                  << config.drop << ", P_base " << std::defaultfloat << config.p_base << "), " << stats.num_gaussians
-                  << " left; of the removed: " << d.removed_low_confidence << " with P_conf < 0.5 ("
-                  << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
-                  << " with P_nonzero < 0.5\n";
+                  << config.drop << ", P_base " << std::defaultfloat << config.p_base << "), "
+                  << stats.num_gaussians << " left; of the removed: " << d.removed_low_confidence
+                  << " with P_conf < 0.5 (" << d.removed_unseen << " seen by no confidence map), "
+                  << d.removed_closed_gate << " with P_nonzero < 0.5\n";
     }
     if (stats.removed_closed_gates > 0 && o.progress) {
       *o.progress << "\n[drop] end of training: removed " << stats.removed_closed_gates
-                  << " Gaussians with a closed gate (they render nothing), " << stats.num_gaussians << " left\n";
+                  << " Gaussians with a closed gate (they render nothing), " << stats.num_gaussians
+                  << " left\n";
     }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -132,7 +144,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   << formatSeconds((config.iterations - it) / std::max(rate, 1e-9)) << "   "
                   << std::flush;
     }
-    if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 && it < config.iterations) {
+    if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 &&
+        it < config.iterations) {
       trainer.saveCheckpoint(checkpoint);
       writeRunJson(o.out, o.scene, o.scale, config.device, it, seconds());
     }
@@ -148,7 +161,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
 
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
   const auto run = nlohmann::json::parse(io::readWholeFile(run_dir + "/run.json"));
-  const std::string scene_path = scene_override.empty() ? run.at("scene").get<std::string>() : scene_override;
+  const std::string scene_path =
+      scene_override.empty() ? run.at("scene").get<std::string>() : scene_override;
   const double run_scale = scene_override.empty() ? run.value("scale", scale) : scale;
   const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
       io::readWholeFile(run_dir + "/config.json"), run_dir + "/config.json");
@@ -176,8 +190,8 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   out << "[1/4] generating the demo city scene (" << scene_dir << ")\n";
   const auto scene = synth::generate(synth::SynthOptions::demo(synth::SceneKind::kCity, 0));
   synth::writeScene(scene, scene_dir);
-  out << "      " << scene.views.size() << " views 320x180, " << scene.points.size() << " sparse points, "
-      << formatSeconds(scene.seconds) << "\n";
+  out << "      " << scene.views.size() << " views 320x180, " << scene.points.size()
+      << " sparse points, " << formatSeconds(scene.seconds) << "\n";
   std::string train_scene = scene_dir;
   if (baseline) {
     out << "[2/4] pseudo-labels: skipped (--baseline)\n";
@@ -193,7 +207,9 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
     train_scene = p.out;
   }
   out << "[3/4] training " << iterations << " iterations on the CPU ("
-      << (baseline ? "baseline: no pseudo-labels, no drop" : "pseudo-labels + full semantic-aware drop") << ")\n";
+      << (baseline ? "baseline: no pseudo-labels, no drop"
+                   : "pseudo-labels + full semantic-aware drop")
+      << ")\n";
   gaussians::TrainConfig config;
   config.iterations = iterations;
   config.sh_increase_interval = std::max(1, iterations / 4);
@@ -211,19 +227,22 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   const double seconds = trainRun(o, config);
   out << "[4/4] evaluating the test views\n";
   const auto metrics = nlohmann::json::parse(evalRun(o.out));
-  out << "\n| metric | value |\n|---|---|\n" << std::fixed << std::setprecision(2)
-      << "| mIoU | " << 100 * metrics["miou"].get<double>() << " % |\n"
+  out << "\n| metric | value |\n|---|---|\n"
+      << std::fixed << std::setprecision(2) << "| mIoU | " << 100 * metrics["miou"].get<double>()
+      << " % |\n"
       << "| mAcc | " << 100 * metrics["macc"].get<double>() << " % |\n"
       << "| overall accuracy | " << 100 * metrics["oacc"].get<double>() << " % |\n"
       << "| PSNR | " << metrics["psnr"].get<double>() << " dB |\n"
       << "| SSIM | " << std::setprecision(3) << metrics["ssim"].get<double>() << " |\n"
       << "| Gaussians | " << metrics["num_gaussians"].get<std::int64_t>() << " |\n"
       << "| training time | " << std::setprecision(1) << seconds << " s |\n"
-      << "| total time | " << std::chrono::duration<double>(Clock::now() - start).count() << " s |\n";
+      << "| total time | " << std::chrono::duration<double>(Clock::now() - start).count()
+      << " s |\n";
   out << "per-class IoU:";
   for (auto it = metrics["per_class_iou"].begin(); it != metrics["per_class_iou"].end(); ++it) {
     out << " " << it.key() << " "
-        << (it.value().is_null() ? std::string("-") : std::to_string(it.value().get<double>()).substr(0, 5));
+        << (it.value().is_null() ? std::string("-")
+                                 : std::to_string(it.value().get<double>()).substr(0, 5));
   }
   out << "\noutputs: " << o.out << " (model.ply, metrics.json, panels/)\n";
   return 0;

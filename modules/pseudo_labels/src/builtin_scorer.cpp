@@ -28,23 +28,27 @@ class BuiltinScorer : public TargetScorer {
     std::vector<int> all = views;
     for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) {
       const io::View& v = scene.views[i];
-      if (v.labelled && !v.labels.empty() && std::find(all.begin(), all.end(), i) == all.end()) all.push_back(i);
+      if (v.labelled && !v.labels.empty() && std::find(all.begin(), all.end(), i) == all.end())
+        all.push_back(i);
     }
     std::vector<Segmentation> segs(all.size());
     std::vector<std::vector<float>> desc(all.size());
     std::atomic<int> done{0};
-    at::parallel_for(0, static_cast<std::int64_t>(all.size()), 1, [&](std::int64_t b, std::int64_t e) {
-      for (std::int64_t k = b; k < e; ++k) {
-        const io::View& v = scene.views[all[k]];
-        segs[k] = options_.targets == MaskGenerator::kGraph ? graphSegmentation(v.rgb, v.mask, options_.graph)
-                                                             : slicSuperpixels(v.rgb, v.mask, options_.superpixels);
-        desc[k] = regionFeatures(scene, v, segs[k], g);
-        const int n = ++done;
-        if (progress && (n % 10 == 0 || n == static_cast<int>(all.size()))) {
-          progress("superpixels + descriptors: " + std::to_string(n) + "/" + std::to_string(all.size()) + " views");
-        }
-      }
-    });
+    at::parallel_for(0, static_cast<std::int64_t>(all.size()), 1,
+                     [&](std::int64_t b, std::int64_t e) {
+                       for (std::int64_t k = b; k < e; ++k) {
+                         const io::View& v = scene.views[all[k]];
+                         segs[k] = options_.targets == MaskGenerator::kGraph
+                                       ? graphSegmentation(v.rgb, v.mask, options_.graph)
+                                       : slicSuperpixels(v.rgb, v.mask, options_.superpixels);
+                         desc[k] = regionFeatures(scene, v, segs[k], g);
+                         const int n = ++done;
+                         if (progress && (n % 10 == 0 || n == static_cast<int>(all.size()))) {
+                           progress("superpixels + descriptors: " + std::to_string(n) + "/" +
+                                    std::to_string(all.size()) + " views");
+                         }
+                       }
+                     });
 
     std::vector<float> x;
     std::vector<int> y, group;
@@ -61,7 +65,8 @@ class BuiltinScorer : public TargetScorer {
       for (int r = 0; r < segs[k].num_regions; ++r) {
         int total = 0, best = 0;
         for (int c = 0; c <= C; ++c) total += hist[r][c];
-        for (int c = 1; c < C; ++c) if (hist[r][c] > hist[r][best]) best = c;
+        for (int c = 1; c < C; ++c)
+          if (hist[r][c] > hist[r][best]) best = c;
         if (total == 0 || hist[r][best] < options_.min_purity * total) continue;
         x.insert(x.end(), desc[k].begin() + static_cast<std::ptrdiff_t>(r) * kRegionFeatureDim,
                  desc[k].begin() + static_cast<std::ptrdiff_t>(r + 1) * kRegionFeatureDim);
@@ -71,7 +76,8 @@ class BuiltinScorer : public TargetScorer {
     }
     if (y.empty()) {
       throw Error(scene.source, "labelled views",
-                  "at least one labelled training view with label maps (the built-in backend's few-shot examples)");
+                  "at least one labelled training view with label maps (the built-in backend's "
+                  "few-shot examples)");
     }
     FewShotClassifier classifier(options_.classifier);
     classifier.fit(x, kRegionFeatureDim, y, group, C);

@@ -43,7 +43,8 @@ std::vector<float> FewShotClassifier::expand(const std::vector<float>& features)
 FewShotClassifier::Model FewShotClassifier::fitModel(const std::vector<float>& expanded,
                                                      const std::vector<int>& labels,
                                                      const std::vector<std::size_t>& rows) const {
-  const std::int64_t n = static_cast<std::int64_t>(rows.size()), D = expanded_dim_, C = num_classes_;
+  const std::int64_t n = static_cast<std::int64_t>(rows.size()), D = expanded_dim_,
+                     C = num_classes_;
   at::Tensor X = at::empty({n, D}, at::kFloat), Y = at::zeros({n, C}, at::kFloat);
   float* xp = X.data_ptr<float>();
   float* yp = Y.data_ptr<float>();
@@ -54,7 +55,8 @@ FewShotClassifier::Model FewShotClassifier::fitModel(const std::vector<float>& e
   at::Tensor W = at::zeros({D, C}, at::kFloat), b = at::zeros({C}, at::kFloat);
   // Start the bias at the log class frequencies (faster, and exact for an uninformative X).
   b = at::log(Y.mean(0) + 1e-3);
-  at::Tensor mW = at::zeros_like(W), vW = at::zeros_like(W), mb = at::zeros_like(b), vb = at::zeros_like(b);
+  at::Tensor mW = at::zeros_like(W), vW = at::zeros_like(W), mb = at::zeros_like(b),
+             vb = at::zeros_like(b);
   const double b1 = 0.9, b2 = 0.999, eps = 1e-8, lr = options_.learning_rate;
   for (int step = 1; step <= options_.steps; ++step) {
     const at::Tensor P = at::softmax(at::matmul(X, W) + b, 1);
@@ -72,7 +74,8 @@ FewShotClassifier::Model FewShotClassifier::fitModel(const std::vector<float>& e
   return {toVector(W), toVector(b)};
 }
 
-std::vector<float> FewShotClassifier::logits(const Model& model, const std::vector<float>& expanded) const {
+std::vector<float> FewShotClassifier::logits(const Model& model,
+                                             const std::vector<float>& expanded) const {
   const std::int64_t n = static_cast<std::int64_t>(expanded.size() / expanded_dim_);
   const at::Tensor Z = at::matmul(fromVector(expanded, n, expanded_dim_),
                                   fromVector(model.weight, expanded_dim_, num_classes_)) +
@@ -80,8 +83,9 @@ std::vector<float> FewShotClassifier::logits(const Model& model, const std::vect
   return toVector(Z);
 }
 
-void FewShotClassifier::fit(const std::vector<float>& features, int dim, const std::vector<int>& labels,
-                            const std::vector<int>& groups, int num_classes) {
+void FewShotClassifier::fit(const std::vector<float>& features, int dim,
+                            const std::vector<int>& labels, const std::vector<int>& groups,
+                            int num_classes) {
   if (dim < 1 || num_classes < 2 || labels.empty() || features.size() != labels.size() * dim ||
       groups.size() != labels.size()) {
     throw Error("<few-shot classifier>", "training samples",
@@ -89,14 +93,16 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim, const s
   }
   for (int l : labels) {
     if (l < 0 || l >= num_classes) {
-      throw Error("<few-shot classifier>", "label", "0.." + std::to_string(num_classes - 1), std::to_string(l));
+      throw Error("<few-shot classifier>", "label", "0.." + std::to_string(num_classes - 1),
+                  std::to_string(l));
     }
   }
   dim_ = dim;
   num_classes_ = num_classes;
   const std::size_t n = labels.size();
   const int quadratic_dim = dim + dim * (dim + 1) / 2;
-  use_quadratic_ = options_.quadratic && n >= options_.quadratic_min_samples_per_weight * quadratic_dim;
+  use_quadratic_ =
+      options_.quadratic && n >= options_.quadratic_min_samples_per_weight * quadratic_dim;
   expanded_dim_ = use_quadratic_ ? quadratic_dim : dim;
   mean_.assign(dim, 0.0f);
   scale_.assign(dim, 0.0f);
@@ -121,7 +127,8 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim, const s
       const Model m = fitModel(expanded, labels, train_rows);
       std::vector<float> test_x(test_rows.size() * expanded_dim_);
       for (std::size_t j = 0; j < test_rows.size(); ++j) {
-        std::copy_n(&expanded[test_rows[j] * expanded_dim_], expanded_dim_, &test_x[j * expanded_dim_]);
+        std::copy_n(&expanded[test_rows[j] * expanded_dim_], expanded_dim_,
+                    &test_x[j * expanded_dim_]);
       }
       const std::vector<float> z = logits(m, test_x);
       for (std::size_t j = 0; j < test_rows.size(); ++j) {
@@ -133,7 +140,8 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim, const s
     for (std::size_t i = 0; i < n; ++i) target[i] = labels[i];
     double best = 1e300;
     for (double T = 0.25; T <= 8.0 + 1e-9; T *= 1.05) {
-      const double nll = -at::log_softmax(Z / T, 1).gather(1, target.unsqueeze(1)).mean().item<double>();
+      const double nll =
+          -at::log_softmax(Z / T, 1).gather(1, target.unsqueeze(1)).mean().item<double>();
       if (nll < best) best = nll, temperature_ = T;
     }
   }
@@ -142,9 +150,11 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim, const s
   model_ = fitModel(expanded, labels, all);
 }
 
-std::vector<float> FewShotClassifier::predictProbabilities(const std::vector<float>& features) const {
+std::vector<float> FewShotClassifier::predictProbabilities(
+    const std::vector<float>& features) const {
   if (dim_ == 0) throw Error("<few-shot classifier>", "state", "fit() before predicting");
-  if (features.size() % dim_ != 0) throw Error("<few-shot classifier>", "features", "n x dim values");
+  if (features.size() % dim_ != 0)
+    throw Error("<few-shot classifier>", "features", "n x dim values");
   if (features.empty()) return {};
   const std::vector<float> z = logits(model_, expand(features));
   const std::int64_t n = static_cast<std::int64_t>(features.size() / dim_);

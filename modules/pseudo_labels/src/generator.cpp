@@ -6,7 +6,8 @@ namespace sadsplat {
 namespace pseudo_labels {
 
 PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
-                                        const PseudoLabelOptions& options, const ProgressFn& progress) {
+                                        const PseudoLabelOptions& options,
+                                        const ProgressFn& progress) {
   const int C = static_cast<int>(scene.classes.size());
   if (C < 2) throw Error(scene.source, "classes", "at least 2 classes for pseudo-labels");
   std::vector<int> views;
@@ -17,15 +18,16 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
   if (views.empty()) throw Error(scene.source, "split", "at least one training view");
   std::vector<ViewTargets> targets = scorer.score(scene, views, progress);
   if (targets.size() != views.size()) {
-    throw Error("<pseudo-labels " + scorer.name() + ">", "scored views", std::to_string(views.size()),
-                std::to_string(targets.size()));
+    throw Error("<pseudo-labels " + scorer.name() + ">", "scored views",
+                std::to_string(views.size()), std::to_string(targets.size()));
   }
 
   // The statistics are taken over all targets of the training set (paper).
   std::vector<TargetMeasures> measures;
   for (const ViewTargets& t : targets) {
     for (int r = 0; r < t.segmentation.num_regions; ++r) {
-      measures.push_back(measureTarget(&t.scores[static_cast<std::size_t>(r) * C], C, options.scale));
+      measures.push_back(
+          measureTarget(&t.scores[static_cast<std::size_t>(r) * C], C, options.scale));
     }
   }
   PseudoLabelSummary summary;

@@ -16,14 +16,17 @@ void gaussianBlur(std::vector<float>& img, int W, int H, double sigma) {
   const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
   std::vector<float> kernel(2 * r + 1);
   float sum = 0;
-  for (int i = -r; i <= r; ++i) sum += kernel[i + r] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+  for (int i = -r; i <= r; ++i)
+    sum += kernel[i + r] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
   for (float& k : kernel) k /= sum;
   std::vector<float> tmp(img.size());
   for (int y = 0; y < H; ++y) {
     for (int x = 0; x < W; ++x) {
       for (int c = 0; c < 3; ++c) {
         float v = 0;
-        for (int i = -r; i <= r; ++i) v += kernel[i + r] * img[3 * (static_cast<std::size_t>(y) * W + std::clamp(x + i, 0, W - 1)) + c];
+        for (int i = -r; i <= r; ++i)
+          v += kernel[i + r] *
+               img[3 * (static_cast<std::size_t>(y) * W + std::clamp(x + i, 0, W - 1)) + c];
         tmp[3 * (static_cast<std::size_t>(y) * W + x) + c] = v;
       }
     }
@@ -32,7 +35,9 @@ void gaussianBlur(std::vector<float>& img, int W, int H, double sigma) {
     for (int x = 0; x < W; ++x) {
       for (int c = 0; c < 3; ++c) {
         float v = 0;
-        for (int i = -r; i <= r; ++i) v += kernel[i + r] * tmp[3 * (static_cast<std::size_t>(std::clamp(y + i, 0, H - 1)) * W + x) + c];
+        for (int i = -r; i <= r; ++i)
+          v += kernel[i + r] *
+               tmp[3 * (static_cast<std::size_t>(std::clamp(y + i, 0, H - 1)) * W + x) + c];
         img[3 * (static_cast<std::size_t>(y) * W + x) + c] = v;
       }
     }
@@ -69,8 +74,10 @@ class Components {
 
 }  // namespace
 
-Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask, const GraphSegmentationOptions& o) {
-  if (rgb.channels != 3 || rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
+Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask,
+                               const GraphSegmentationOptions& o) {
+  if (rgb.channels != 3 ||
+      rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
     throw Error("<graph segmentation>", "image", "a 3-channel image");
   }
   if (!mask.empty() && (mask.width != rgb.width || mask.height != rgb.height)) {
@@ -83,7 +90,8 @@ Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask, co
   const std::size_t N = static_cast<std::size_t>(W) * H;
   auto valid = [&](std::size_t i) { return mask.empty() || mask.pixels[i] != 0; };
   std::vector<float> lab(N * 3);
-  for (std::size_t i = 0; i < N; ++i) srgbToLab(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2], &lab[3 * i]);
+  for (std::size_t i = 0; i < N; ++i)
+    srgbToLab(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2], &lab[3 * i]);
   gaussianBlur(lab, W, H, o.sigma);
 
   std::vector<Edge> edges;
@@ -91,7 +99,8 @@ Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask, co
   auto add = [&](std::size_t i, std::size_t j) {
     if (!valid(i) || !valid(j)) return;
     float d2 = 0;
-    for (int c = 0; c < 3; ++c) d2 += (lab[3 * i + c] - lab[3 * j + c]) * (lab[3 * i + c] - lab[3 * j + c]);
+    for (int c = 0; c < 3; ++c)
+      d2 += (lab[3 * i + c] - lab[3 * j + c]) * (lab[3 * i + c] - lab[3 * j + c]);
     edges.push_back({std::sqrt(d2), static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)});
   };
   for (int y = 0; y < H; ++y) {
@@ -113,7 +122,8 @@ Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask, co
   for (const Edge& e : edges) {
     const std::uint32_t a = comp.find(e.a), b = comp.find(e.b);
     if (a == b) continue;
-    if (e.w <= comp.internal(a) + k / comp.size(a) && e.w <= comp.internal(b) + k / comp.size(b)) comp.unite(a, b, e.w);
+    if (e.w <= comp.internal(a) + k / comp.size(a) && e.w <= comp.internal(b) + k / comp.size(b))
+      comp.unite(a, b, e.w);
   }
   for (const Edge& e : edges) {  // small components join their lightest neighbour
     const std::uint32_t a = comp.find(e.a), b = comp.find(e.b);

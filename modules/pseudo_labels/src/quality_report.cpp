@@ -62,8 +62,9 @@ PseudoLabelQuality evaluatePseudoLabels(const io::Scene& scene) {
     }
   }
   if (q.views == 0) {
-    throw Error(scene.source, "views",
-                "a training view with pseudo-labels and a label map that does not supervise training");
+    throw Error(
+        scene.source, "views",
+        "a training view with pseudo-labels and a label map that does not supervise training");
   }
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
   q.precision = ratio(correct, q.kept_pixels);
@@ -80,7 +81,8 @@ PseudoLabelQuality evaluatePseudoLabels(const io::Scene& scene) {
     bin.pixels = bin_pixels[b];
     bin.accuracy = ratio(bin_correct[b], bin_pixels[b]);
     bin.mean_score = ratio(bin_score[b], bin_pixels[b]);
-    q.expected_calibration_error += ratio(bin_pixels[b], target_pixels) * std::abs(bin.accuracy - bin.mean_score);
+    q.expected_calibration_error +=
+        ratio(bin_pixels[b], target_pixels) * std::abs(bin.accuracy - bin.mean_score);
     q.reliability.push_back(bin);
   }
   return q;
@@ -96,12 +98,18 @@ std::string PseudoLabelQuality::toJson() const {
   j["argmax_accuracy"] = argmax_accuracy;
   j["expected_calibration_error"] = expected_calibration_error;
   for (const auto& c : classes) {
-    j["classes"].push_back({{"name", c.name}, {"gt_pixels", c.gt_pixels}, {"predicted_pixels", c.predicted_pixels},
-                            {"precision", c.precision}, {"coverage", c.coverage}});
+    j["classes"].push_back({{"name", c.name},
+                            {"gt_pixels", c.gt_pixels},
+                            {"predicted_pixels", c.predicted_pixels},
+                            {"precision", c.precision},
+                            {"coverage", c.coverage}});
   }
   for (const auto& b : reliability) {
-    j["reliability"].push_back({{"low", b.low}, {"high", b.high}, {"pixels", b.pixels},
-                                {"accuracy", b.accuracy}, {"mean_score", b.mean_score}});
+    j["reliability"].push_back({{"low", b.low},
+                                {"high", b.high},
+                                {"pixels", b.pixels},
+                                {"accuracy", b.accuracy},
+                                {"mean_score", b.mean_score}});
   }
   return j.dump(2) + "\n";
 }
@@ -109,15 +117,17 @@ std::string PseudoLabelQuality::toJson() const {
 std::string PseudoLabelQuality::toText() const {
   std::ostringstream o;
   char line[256];
-  std::snprintf(line, sizeof line,
-                "pseudo-labels on %d views: precision %.2f %%, coverage %.2f %% (%zu of %zu labelled "
-                "pixels); argmax accuracy before filtering %.2f %%; ECE %.3f\n",
-                views, 100 * precision, 100 * coverage, kept_pixels, gt_pixels, 100 * argmax_accuracy,
-                expected_calibration_error);
+  std::snprintf(
+      line, sizeof line,
+      "pseudo-labels on %d views: precision %.2f %%, coverage %.2f %% (%zu of %zu labelled "
+      "pixels); argmax accuracy before filtering %.2f %%; ECE %.3f\n",
+      views, 100 * precision, 100 * coverage, kept_pixels, gt_pixels, 100 * argmax_accuracy,
+      expected_calibration_error);
   o << line << "class             precision  coverage  gt share\n";
   for (const auto& c : classes) {
-    std::snprintf(line, sizeof line, "%-16s %8.2f %% %8.2f %% %8.2f %%\n", c.name.c_str(), 100 * c.precision,
-                  100 * c.coverage, gt_pixels ? 100.0 * c.gt_pixels / gt_pixels : 0.0);
+    std::snprintf(line, sizeof line, "%-16s %8.2f %% %8.2f %% %8.2f %%\n", c.name.c_str(),
+                  100 * c.precision, 100 * c.coverage,
+                  gt_pixels ? 100.0 * c.gt_pixels / gt_pixels : 0.0);
     o << line;
   }
   o << "TOP1 bin     pixels  accuracy  mean TOP1\n";

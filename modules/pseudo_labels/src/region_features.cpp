@@ -24,7 +24,8 @@ std::vector<float> boxMean(const std::vector<float>& img, int W, int H, int r) {
     double row = 0;
     for (int x = 0; x < W; ++x) {
       row += img[static_cast<std::size_t>(y) * W + x];
-      integral[static_cast<std::size_t>(y + 1) * (W + 1) + x + 1] = integral[static_cast<std::size_t>(y) * (W + 1) + x + 1] + row;
+      integral[static_cast<std::size_t>(y + 1) * (W + 1) + x + 1] =
+          integral[static_cast<std::size_t>(y) * (W + 1) + x + 1] + row;
     }
   }
   std::vector<float> out(img.size());
@@ -32,8 +33,10 @@ std::vector<float> boxMean(const std::vector<float>& img, int W, int H, int r) {
     for (int x = 0; x < W; ++x) {
       const int x0 = std::max(0, x - r), x1 = std::min(W, x + r + 1);
       const int y0 = std::max(0, y - r), y1 = std::min(H, y + r + 1);
-      const double s = integral[static_cast<std::size_t>(y1) * (W + 1) + x1] - integral[static_cast<std::size_t>(y0) * (W + 1) + x1] -
-                       integral[static_cast<std::size_t>(y1) * (W + 1) + x0] + integral[static_cast<std::size_t>(y0) * (W + 1) + x0];
+      const double s = integral[static_cast<std::size_t>(y1) * (W + 1) + x1] -
+                       integral[static_cast<std::size_t>(y0) * (W + 1) + x1] -
+                       integral[static_cast<std::size_t>(y1) * (W + 1) + x0] +
+                       integral[static_cast<std::size_t>(y0) * (W + 1) + x0];
       out[static_cast<std::size_t>(y) * W + x] = static_cast<float>(s / ((x1 - x0) * (y1 - y0)));
     }
   }
@@ -96,12 +99,32 @@ std::vector<float> regionFeatures(const io::Scene& scene, const io::View& view,
     }
   }
   // Context: Lab means over a window about three region sizes wide, centred on each pixel.
-  const int context_radius = std::max(4, static_cast<int>(std::sqrt(static_cast<double>(N) / std::max(1, R))) * 3 / 2);
-  const std::vector<float> cL = boxMean(L, W, H, context_radius), cA = boxMean(A, W, H, context_radius),
+  const int context_radius =
+      std::max(4, static_cast<int>(std::sqrt(static_cast<double>(N) / std::max(1, R))) * 3 / 2);
+  const std::vector<float> cL = boxMean(L, W, H, context_radius),
+                           cA = boxMean(A, W, H, context_radius),
                            cB = boxMean(B, W, H, context_radius);
 
   // Accumulate moments per region.
-  enum { kCount, kL, kA, kB, kL2, kA2, kB2, kGreen, kGrad, kJxx, kJxy, kJyy, kLap, kCL, kCA, kCB, kAcc };
+  enum {
+    kCount,
+    kL,
+    kA,
+    kB,
+    kL2,
+    kA2,
+    kB2,
+    kGreen,
+    kGrad,
+    kJxx,
+    kJxy,
+    kJyy,
+    kLap,
+    kCL,
+    kCA,
+    kCB,
+    kAcc
+  };
   std::vector<double> acc(static_cast<std::size_t>(R) * kAcc, 0.0);
   for (std::size_t i = 0; i < N; ++i) {
     const int r = seg.region[i];
@@ -126,7 +149,11 @@ std::vector<float> regionFeatures(const io::Scene& scene, const io::View& view,
     constexpr int kCell = 4;
     const int CW = (W + kCell - 1) / kCell, CH = (H + kCell - 1) / kCell;
     std::vector<float> zbuf(static_cast<std::size_t>(CW) * CH, std::numeric_limits<float>::max());
-    struct Hit { std::size_t pixel, cell; float z; std::size_t point; };
+    struct Hit {
+      std::size_t pixel, cell;
+      float z;
+      std::size_t point;
+    };
     std::vector<Hit> hits;
     for (std::size_t p = 0; p < scene.points.size(); ++p) {
       const auto& X = scene.points[p].xyz;
@@ -134,7 +161,8 @@ std::vector<float> regionFeatures(const io::Scene& scene, const io::View& view,
       const double yc = Rm[3] * X[0] + Rm[4] * X[1] + Rm[5] * X[2] + t[1];
       const double zc = Rm[6] * X[0] + Rm[7] * X[1] + Rm[8] * X[2] + t[2];
       if (zc <= 1e-6) continue;
-      const double u = view.camera.fx * xc / zc + view.camera.cx, v = view.camera.fy * yc / zc + view.camera.cy;
+      const double u = view.camera.fx * xc / zc + view.camera.cx,
+                   v = view.camera.fy * yc / zc + view.camera.cy;
       if (u < 0 || v < 0 || u >= W || v >= H) continue;
       const int px = static_cast<int>(u), py = static_cast<int>(v);
       const std::size_t cell = static_cast<std::size_t>(py / kCell) * CW + px / kCell;

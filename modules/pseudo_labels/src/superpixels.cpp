@@ -25,7 +25,8 @@ struct Centre {
 }  // namespace
 
 void srgbToLab(std::uint8_t r8, std::uint8_t g8, std::uint8_t b8, float lab[3]) {
-  const float r = srgbToLinear(r8 / 255.0f), g = srgbToLinear(g8 / 255.0f), b = srgbToLinear(b8 / 255.0f);
+  const float r = srgbToLinear(r8 / 255.0f), g = srgbToLinear(g8 / 255.0f),
+              b = srgbToLinear(b8 / 255.0f);
   const float X = (0.4124f * r + 0.3576f * g + 0.1805f * b) / 0.95047f;
   const float Y = 0.2126f * r + 0.7152f * g + 0.0722f * b;
   const float Z = (0.0193f * r + 0.1192f * g + 0.9505f * b) / 1.08883f;
@@ -36,7 +37,8 @@ void srgbToLab(std::uint8_t r8, std::uint8_t g8, std::uint8_t b8, float lab[3]) 
 }
 
 Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, const SlicOptions& o) {
-  if (rgb.channels != 3 || rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
+  if (rgb.channels != 3 ||
+      rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
     throw Error("<superpixels>", "image", "a 3-channel image");
   }
   if (!mask.empty() && (mask.width != rgb.width || mask.height != rgb.height)) {
@@ -54,7 +56,8 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, cons
   }
   auto gradient = [&](int x, int y) {
     const auto at = [&](int xx, int yy) {
-      return &lab[3 * (static_cast<std::size_t>(std::clamp(yy, 0, H - 1)) * W + std::clamp(xx, 0, W - 1))];
+      return &lab[3 * (static_cast<std::size_t>(std::clamp(yy, 0, H - 1)) * W +
+                       std::clamp(xx, 0, W - 1))];
     };
     float g = 0;
     for (int k = 0; k < 3; ++k) {
@@ -73,7 +76,8 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, cons
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int x = gx + dx, y = gy + dy;
-          if (x < 0 || y < 0 || x >= W || y >= H || !valid(static_cast<std::size_t>(y) * W + x)) continue;
+          if (x < 0 || y < 0 || x >= W || y >= H || !valid(static_cast<std::size_t>(y) * W + x))
+            continue;
           const float g = gradient(x, y);
           if (g < best) best = g, bx = x, by = y;
         }
@@ -91,8 +95,10 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, cons
     std::fill(dist.begin(), dist.end(), std::numeric_limits<float>::max());
     for (std::size_t k = 0; k < centres.size(); ++k) {
       const Centre& c = centres[k];
-      const int x0 = std::max(0, static_cast<int>(c.x) - S), x1 = std::min(W - 1, static_cast<int>(c.x) + S);
-      const int y0 = std::max(0, static_cast<int>(c.y) - S), y1 = std::min(H - 1, static_cast<int>(c.y) + S);
+      const int x0 = std::max(0, static_cast<int>(c.x) - S),
+                x1 = std::min(W - 1, static_cast<int>(c.x) + S);
+      const int y0 = std::max(0, static_cast<int>(c.y) - S),
+                y1 = std::min(H - 1, static_cast<int>(c.y) + S);
       for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * W + x;
@@ -136,8 +142,10 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, cons
     // The label of a neighbour that already has one (left or above), for merging a fragment.
     std::int32_t adjacent = -1;
     const int sx = static_cast<int>(start % W), sy = static_cast<int>(start / W);
-    if (sx > 0 && seg.region[start - 1] >= 0) adjacent = seg.region[start - 1];
-    else if (sy > 0 && seg.region[start - W] >= 0) adjacent = seg.region[start - W];
+    if (sx > 0 && seg.region[start - 1] >= 0)
+      adjacent = seg.region[start - 1];
+    else if (sy > 0 && seg.region[start - W] >= 0)
+      adjacent = seg.region[start - W];
     component.clear();
     stack.assign(1, start);
     seg.region[start] = next;

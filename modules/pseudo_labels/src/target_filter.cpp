@@ -21,7 +21,8 @@ TargetMeasures measureTarget(const float* scores, int num_classes, ScoreScale sc
   }
   if (scale == ScoreScale::kLogOdds) {
     constexpr double e = 1e-6;
-    const double p1 = std::clamp(top1 / std::max(sum, e), e, 1 - e), p2 = std::clamp(top2 / std::max(sum, e), e, 1 - e);
+    const double p1 = std::clamp(top1 / std::max(sum, e), e, 1 - e),
+                 p2 = std::clamp(top2 / std::max(sum, e), e, 1 - e);
     m.top1 = std::log(p1 / (1 - p1));
     m.delta_top = std::log(p1 / p2);
   } else {
@@ -61,7 +62,8 @@ TargetStatistics targetStatistics(const std::vector<TargetMeasures>& targets) {
 }
 
 bool keepTarget(const TargetMeasures& t, const TargetStatistics& s, double k) {
-  return t.top1 > s.top1_mean + k * s.top1_std && t.delta_top > s.delta_top_mean + k * s.delta_top_std &&
+  return t.top1 > s.top1_mean + k * s.top1_std &&
+         t.delta_top > s.delta_top_mean + k * s.delta_top_std &&
          t.entropy < s.entropy_mean + k * s.entropy_std;
 }
 

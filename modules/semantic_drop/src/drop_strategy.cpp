@@ -11,15 +11,23 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
  public:
   SemanticDropStrategy(const gaussians::TrainConfig& c, bool semantic, bool structure,
                        const HardConcreteParams& hc)
-      : semantic_(semantic), structure_(structure), p_base_(c.p_base), interval_(c.drop_interval),
-        iterations_(c.iterations), lambda_l0_(c.lambda_l0), seed_(c.seed), hc_(hc) {}
+      : semantic_(semantic),
+        structure_(structure),
+        p_base_(c.p_base),
+        interval_(c.drop_interval),
+        iterations_(c.iterations),
+        lambda_l0_(c.lambda_l0),
+        seed_(c.seed),
+        hc_(hc) {}
 
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
-    at::Generator gen = gaussians::seededGenerator(seed_, 13, static_cast<std::uint64_t>(iteration));
-    const at::Tensor u = at::empty({log_alpha.size(0)}, at::TensorOptions().dtype(log_alpha.scalar_type()))
-                             .uniform_(0, 1, gen)
-                             .to(log_alpha.device());
+    at::Generator gen =
+        gaussians::seededGenerator(seed_, 13, static_cast<std::uint64_t>(iteration));
+    const at::Tensor u =
+        at::empty({log_alpha.size(0)}, at::TensorOptions().dtype(log_alpha.scalar_type()))
+            .uniform_(0, 1, gen)
+            .to(log_alpha.device());
     return sampleGate(log_alpha, u, hc_);
   }
 
@@ -41,7 +49,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     at::Tensor confidence = at::zeros({in.means.size(0)}, opts);
     at::Tensor seen = at::zeros({in.means.size(0)}, opts.dtype(at::kBool));
     if (semantic_ && !in.cameras.empty()) {
-      confidence = semanticConfidence(in.means, in.opacities, in.cameras, in.confidence_maps, &seen);
+      confidence =
+          semanticConfidence(in.means, in.opacities, in.cameras, in.confidence_maps, &seen);
     }
     const at::Tensor p_nonzero = probabilityNonZero(in.log_alpha, hc_);
     at::Tensor p_drop = at::full_like(confidence, p_base_);
@@ -49,9 +58,10 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     if (structure_) p_drop = p_drop * (1 - p_nonzero);
     p_drop = p_drop.clamp(0, 1);
     at::Generator gen = gaussians::seededGenerator(seed_, 17, static_cast<std::uint64_t>(done));
-    const at::Tensor u = at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
-                             .uniform_(0, 1, gen)
-                             .to(in.means.device());
+    const at::Tensor u =
+        at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
+            .uniform_(0, 1, gen)
+            .to(in.means.device());
     gaussians::DropDecision d;
     d.keep = u >= p_drop;
     d.confidence = confidence;
@@ -61,7 +71,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
       d.removed_low_confidence = (removed & (confidence < 0.5)).sum().item<std::int64_t>();
       d.removed_unseen = (removed & seen.logical_not()).sum().item<std::int64_t>();
     }
-    if (structure_) d.removed_closed_gate = (removed & (p_nonzero < 0.5)).sum().item<std::int64_t>();
+    if (structure_)
+      d.removed_closed_gate = (removed & (p_nonzero < 0.5)).sum().item<std::int64_t>();
     return d;
   }
 
@@ -78,12 +89,14 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
 
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
                                                                 const HardConcreteParams& hc) {
-  if (c.p_base < 0) throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
+  if (c.p_base < 0)
+    throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
   if (!(c.lambda_l0 >= 0)) {
     throw Error("<config>", "lambda_l0", "a non-negative weight", std::to_string(c.lambda_l0));
   }
   if (c.drop_interval < 1) {
-    throw Error("<config>", "drop_interval", "a positive number of iterations", std::to_string(c.drop_interval));
+    throw Error("<config>", "drop_interval", "a positive number of iterations",
+                std::to_string(c.drop_interval));
   }
   if (c.drop == "none") return nullptr;
   if (c.drop == "semantic") return std::make_shared<SemanticDropStrategy>(c, true, false, hc);

@@ -17,7 +17,8 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
   for (std::size_t v = 0; v < cameras.size(); ++v) {
     const auto& cam = cameras[v];
     const at::Tensor& map = confidence_maps[v];
-    if ((map.dim() != 3 && map.dim() != 2) || map.size(0) != cam.height || map.size(1) != cam.width) {
+    if ((map.dim() != 3 && map.dim() != 2) || map.size(0) != cam.height ||
+        map.size(1) != cam.width) {
       throw Error("<semantic confidence>", "confidence map " + std::to_string(v),
                   "[H, W, C] or [H, W] with the camera's " + std::to_string(cam.width) + "x" +
                       std::to_string(cam.height));
@@ -25,14 +26,18 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
     const double q[4] = {cam.qvec[0], cam.qvec[1], cam.qvec[2], cam.qvec[3]};
     double R[9];
     gaussians::raster::quatToRotation(q, R);
-    const at::Tensor Rt = at::tensor({R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]}, opts).view({3, 3});
+    const at::Tensor Rt =
+        at::tensor({R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]}, opts).view({3, 3});
     const at::Tensor t = at::tensor({cam.tvec[0], cam.tvec[1], cam.tvec[2]}, opts);
     const at::Tensor p = at::matmul(means, Rt) + t;
     const at::Tensor z = p.select(1, 2);
     const at::Tensor u = cam.fx * p.select(1, 0) / z + cam.cx;
     const at::Tensor w = cam.fy * p.select(1, 1) / z + cam.cy;
-    const at::Tensor visible = (z > cam.near_plane) & (u >= 0) & (u < cam.width) & (w >= 0) & (w < cam.height);
-    const at::Tensor pixel = (w.clamp(0, cam.height - 1).floor() * cam.width + u.clamp(0, cam.width - 1).floor()).to(at::kLong);
+    const at::Tensor visible =
+        (z > cam.near_plane) & (u >= 0) & (u < cam.width) & (w >= 0) & (w < cam.height);
+    const at::Tensor pixel =
+        (w.clamp(0, cam.height - 1).floor() * cam.width + u.clamp(0, cam.width - 1).floor())
+            .to(at::kLong);
     const at::Tensor m = map.to(means.device(), opts.dtype().toScalarType());
     const at::Tensor best = (m.dim() == 3 ? std::get<0>(m.max(2)) : m).reshape({-1});
     const at::Tensor value = best.index_select(0, pixel) * opacities;
@@ -45,8 +50,8 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
 
 at::Tensor oneHotConfidence(const at::Tensor& labels, int num_classes) {
   const at::Tensor valid = labels >= 0;
-  at::Tensor onehot = at::zeros({labels.size(0), labels.size(1), num_classes},
-                                labels.options().dtype(at::kFloat));
+  at::Tensor onehot =
+      at::zeros({labels.size(0), labels.size(1), num_classes}, labels.options().dtype(at::kFloat));
   onehot.scatter_(2, labels.clamp_min(0).unsqueeze(2), 1.0);
   return onehot * valid.unsqueeze(2).to(at::kFloat);
 }

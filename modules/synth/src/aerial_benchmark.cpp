@@ -20,7 +20,9 @@ struct Vec3 {
 };
 Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3 cross(Vec3 a, Vec3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 Vec3 normalize(Vec3 a) {
   const float n = std::sqrt(dot(a, a));
   return {a.x / n, a.y / n, a.z / n};
@@ -90,13 +92,15 @@ Vec3 shade(const World& world, const Hit& h, Vec3 dir, Vec3 sun, std::uint64_t s
   float tex = 1.f, spec_strength = 0.f, shininess = 40.f;
   switch (h.material) {
     case Material::kAsphalt:
-      tex = 0.88f + 0.2f * noise(px / 1.3f, py / 1.3f, seed + 1) + 0.06f * noise(px * 3, py * 3, seed + 2);
+      tex = 0.88f + 0.2f * noise(px / 1.3f, py / 1.3f, seed + 1) +
+            0.06f * noise(px * 3, py * 3, seed + 2);
       break;
     case Material::kMarking:
       break;
     case Material::kPaving: {
       tex = 0.9f + 0.14f * noise(px / 3.f, py / 3.f, seed + 3);
-      const float gx = std::fabs(std::remainder(px, 1.5f)), gy = std::fabs(std::remainder(py, 1.5f));
+      const float gx = std::fabs(std::remainder(px, 1.5f)),
+                  gy = std::fabs(std::remainder(py, 1.5f));
       if (gx < 0.06f || gy < 0.06f) tex *= 0.82f;
       break;
     }
@@ -202,7 +206,8 @@ void renderView(const World& world, const SynthOptions& o, const Pose& pose, Vec
   const float origin[3] = {pose.centre.x, pose.centre.y, pose.centre.z};
   // Unit world direction and 1/|camera direction| of the ray through image point (x, y).
   auto ray = [&](double x, double y, float dir[3]) {
-    const Vec3 dc = {static_cast<float>((x - cam.cx) / cam.fx), static_cast<float>((y - cam.cy) / cam.fy), 1.f};
+    const Vec3 dc = {static_cast<float>((x - cam.cx) / cam.fx),
+                     static_cast<float>((y - cam.cy) / cam.fy), 1.f};
     const float inv = 1.f / std::sqrt(dot(dc, dc));
     dir[0] = (pose.rows[0].x * dc.x + pose.rows[1].x * dc.y + pose.rows[2].x) * inv;
     dir[1] = (pose.rows[0].y * dc.x + pose.rows[1].y * dc.y + pose.rows[2].y) * inv;
@@ -211,7 +216,8 @@ void renderView(const World& world, const SynthOptions& o, const Pose& pose, Vec
   };
   auto radiance = [&](const float dir[3]) {
     Hit hit;
-    if (world.trace(origin, dir, 1e5f, &hit)) return shade(world, hit, {dir[0], dir[1], dir[2]}, sun, o.seed * 131 + 7);
+    if (world.trace(origin, dir, 1e5f, &hit))
+      return shade(world, hit, {dir[0], dir[1], dir[2]}, sun, o.seed * 131 + 7);
     const float k = std::min(1.f, std::max(0.f, dir[2] * 4.f));
     return Vec3{0.76f - 0.3f * k, 0.82f - 0.2f * k, 0.9f - 0.05f * k};
   };
@@ -275,7 +281,8 @@ bool project(const SynthView& v, const float X[3], float* u, float* w, float* z)
   R[7] = 2 * (qy * qz + qw * qx);
   R[8] = 1 - 2 * (qx * qx + qy * qy);
   double p[3];
-  for (int i = 0; i < 3; ++i) p[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + c.tvec[i];
+  for (int i = 0; i < 3; ++i)
+    p[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + c.tvec[i];
   if (p[2] <= 1e-3) return false;
   *u = static_cast<float>(c.fx * p[0] / p[2] + c.cx);
   *w = static_cast<float>(c.fy * p[1] / p[2] + c.cy);
@@ -350,7 +357,8 @@ SynthScene generate(const SynthOptions& o) {
   const World world(o.kind, o.seed);
   SynthScene scene;
   scene.classes = world.classes();
-  const double sun_azimuth = 2 * kPi * hash01(o.seed, 51), sun_elevation = (45 + 15 * hash01(o.seed, 52)) * kPi / 180;
+  const double sun_azimuth = 2 * kPi * hash01(o.seed, 51),
+               sun_elevation = (45 + 15 * hash01(o.seed, 52)) * kPi / 180;
   const Vec3 sun = {static_cast<float>(std::cos(sun_elevation) * std::cos(sun_azimuth)),
                     static_cast<float>(std::cos(sun_elevation) * std::sin(sun_azimuth)),
                     static_cast<float>(std::sin(sun_elevation))};
@@ -402,8 +410,9 @@ io::Scene toScene(const SynthScene& synth) {
     view.camera = v.camera;
     view.rgb = v.rgb;
     view.labels = v.labels;
-    view.mask = {v.rgb.width, v.rgb.height, 1,
-                 std::vector<std::uint8_t>(static_cast<std::size_t>(v.rgb.width) * v.rgb.height, 255)};
+    view.mask = {
+        v.rgb.width, v.rgb.height, 1,
+        std::vector<std::uint8_t>(static_cast<std::size_t>(v.rgb.width) * v.rgb.height, 255)};
     view.train = train.count(v.name) > 0;
     view.test = test.count(v.name) > 0;
     view.labelled = labelled.count(v.name) > 0;
@@ -432,7 +441,8 @@ SynthStats computeStats(const SynthScene& scene) {
     }
   }
   s.class_share.resize(counts.size());
-  for (std::size_t c = 0; c < counts.size(); ++c) s.class_share[c] = labelled > 0 ? counts[c] / labelled : 0;
+  for (std::size_t c = 0; c < counts.size(); ++c)
+    s.class_share[c] = labelled > 0 ? counts[c] / labelled : 0;
   s.effective_share = total > 0 ? labelled / total : 0;
   return s;
 }

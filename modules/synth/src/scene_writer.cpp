@@ -18,7 +18,8 @@ void writePng(const std::string& path, const cv::Mat& image) {
   std::vector<std::uint8_t> bytes;
   if (!cv::imencode(".png", image, bytes)) throw Error(path, "PNG encoding", "success");
   io::writeFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
   });
 }
 
@@ -33,7 +34,8 @@ void writeNpy(const std::string& path, const std::vector<float>& data, int heigh
     const std::uint16_t len = static_cast<std::uint16_t>(header.size());
     out.write(reinterpret_cast<const char*>(&len), 2);
     out << header;
-    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size() * 4));
+    out.write(reinterpret_cast<const char*>(data.data()),
+              static_cast<std::streamsize>(data.size() * 4));
   });
 }
 
@@ -64,7 +66,8 @@ cv::Mat bgr(const SynthView& v) {
 
 void writeScene(const SynthScene& scene, const std::string& dir) {
   io::makeDirectory(dir);
-  for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"}) io::makeDirectory(dir + sub);
+  for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"})
+    io::makeDirectory(dir + sub);
   io::ColmapModel model;
   io::ColmapCamera cam;
   cam.id = 1;
@@ -77,9 +80,11 @@ void writeScene(const SynthScene& scene, const std::string& dir) {
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
     const SynthView& v = scene.views[i];
     writePng(dir + "/images/" + v.name, bgr(v));
-    cv::Mat labels(v.labels.height, v.labels.width, CV_8UC1, const_cast<std::uint8_t*>(v.labels.pixels.data()));
+    cv::Mat labels(v.labels.height, v.labels.width, CV_8UC1,
+                   const_cast<std::uint8_t*>(v.labels.pixels.data()));
     writePng(dir + "/labels/" + v.name, labels);
-    writeNpy(dir + "/depth/" + v.name.substr(0, v.name.size() - 4) + ".npy", v.depth, v.rgb.height, v.rgb.width);
+    writeNpy(dir + "/depth/" + v.name.substr(0, v.name.size() - 4) + ".npy", v.depth, v.rgb.height,
+             v.rgb.width);
     io::ColmapImage im;
     im.id = static_cast<std::uint32_t>(i + 1);
     im.qvec = v.camera.qvec;
@@ -97,7 +102,8 @@ void writeScene(const SynthScene& scene, const std::string& dir) {
     out.error = 0.5;
     for (const auto& [view, uv] : p.track) {
       auto& points2d = model.images[view].points2d;
-      out.track.emplace_back(static_cast<std::uint32_t>(view + 1), static_cast<std::uint32_t>(points2d.size()));
+      out.track.emplace_back(static_cast<std::uint32_t>(view + 1),
+                             static_cast<std::uint32_t>(points2d.size()));
       points2d.push_back({uv[0], uv[1], static_cast<std::int64_t>(k + 1)});
     }
     model.points.push_back(std::move(out));
@@ -117,7 +123,8 @@ void writeContactSheet(const SynthScene& scene, const std::string& png_path) {
     const SynthView& v = scene.views[picks[r]];
     cv::Mat a, b;
     cv::resize(bgr(v), a, cv::Size(panel_w, panel_h), 0, 0, cv::INTER_AREA);
-    cv::resize(colorLabels(v, scene.classes), b, cv::Size(panel_w, panel_h), 0, 0, cv::INTER_NEAREST);
+    cv::resize(colorLabels(v, scene.classes), b, cv::Size(panel_w, panel_h), 0, 0,
+               cv::INTER_NEAREST);
     a.copyTo(sheet(cv::Rect(0, r * panel_h, panel_w, panel_h)));
     b.copyTo(sheet(cv::Rect(panel_w, r * panel_h, panel_w, panel_h)));
   }

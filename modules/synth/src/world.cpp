@@ -25,7 +25,9 @@ class Rng {
   explicit Rng(std::uint64_t seed) : state_(mix64(seed)) {}
   float uniform() { return static_cast<float>((next() >> 40) * (1.0 / 16777216.0)); }
   float uniform(float lo, float hi) { return lo + (hi - lo) * uniform(); }
-  int integer(int lo, int hi) { return lo + static_cast<int>(uniform() * (hi - lo + 1) * 0.99999f); }
+  int integer(int lo, int hi) {
+    return lo + static_cast<int>(uniform() * (hi - lo + 1) * 0.99999f);
+  }
   bool chance(float p) { return uniform() < p; }
 
  private:
@@ -66,9 +68,12 @@ float valueNoise(float x, float y, std::uint64_t seed) {
 
 const char* sceneKindName(SceneKind kind) {
   switch (kind) {
-    case SceneKind::kCity: return "city";
-    case SceneKind::kCountry: return "country";
-    case SceneKind::kPort: return "port";
+    case SceneKind::kCity:
+      return "city";
+    case SceneKind::kCountry:
+      return "country";
+    case SceneKind::kPort:
+      return "port";
   }
   return "?";
 }
@@ -82,9 +87,15 @@ SceneKind parseSceneKind(const std::string& name) {
 
 World::World(SceneKind kind, std::uint64_t seed) : kind_(kind), seed_(seed) {
   switch (kind) {
-    case SceneKind::kCity: buildCity(); break;
-    case SceneKind::kCountry: buildCountry(); break;
-    case SceneKind::kPort: buildPort(); break;
+    case SceneKind::kCity:
+      buildCity();
+      break;
+    case SceneKind::kCountry:
+      buildCountry();
+      break;
+    case SceneKind::kPort:
+      buildPort();
+      break;
   }
   max_height_ = 1.f;
   for (const Object& o : objects_) max_height_ = std::max(max_height_, o.hi[2]);
@@ -144,7 +155,8 @@ void World::buildCity() {
   for (int bx = -2; bx <= 2; ++bx) {
     for (int by = -2; by <= 2; ++by) {
       const float cx = (bx + 0.5f) * block_, cy = (by + 0.5f) * block_;
-      if (std::fabs(cx) + block_ / 2 > extent_ + 1 || std::fabs(cy) + block_ / 2 > extent_ + 1) continue;
+      if (std::fabs(cx) + block_ / 2 > extent_ + 1 || std::fabs(cy) + block_ / 2 > extent_ + 1)
+        continue;
       const float type = hash01(seed_, 11, bx + 100, by + 100);
       if (type < 0.62f) {  // buildings
         const int nx = rng.integer(1, 3), ny = rng.integer(1, 2);
@@ -184,7 +196,8 @@ void World::buildCity() {
           for (float x = cx - inner + 2; x < cx + inner - 3; x += 2.6f) {
             if (!rng.chance(0.7f)) continue;
             float color[3];
-            setColor(color, rng.uniform(0.1f, 0.9f), rng.uniform(0.1f, 0.9f), rng.uniform(0.1f, 0.9f));
+            setColor(color, rng.uniform(0.1f, 0.9f), rng.uniform(0.1f, 0.9f),
+                     rng.uniform(0.1f, 0.9f));
             addBox(x, y - 2.2f, 0.f, x + 1.8f, y + 2.2f, 1.5f, 4, Material::kCarPaint,
                    Material::kCarPaint, color);
           }
@@ -211,7 +224,8 @@ void World::buildCity() {
     for (float s = -extent_ + 2; s < extent_ - 6; s += rng.uniform(6.f, 18.f)) {
       if (distanceToGrid(s, block_) < road_half_ + 1) continue;  // keep junctions clear
       float color[3];
-      setColor(color, rng.uniform(0.05f, 0.95f), rng.uniform(0.05f, 0.9f), rng.uniform(0.05f, 0.9f));
+      setColor(color, rng.uniform(0.05f, 0.95f), rng.uniform(0.05f, 0.9f),
+               rng.uniform(0.05f, 0.9f));
       const float lane = line + (rng.chance(0.5f) ? -2.f : 2.f);
       if (rng.chance(0.5f)) {
         addBox(s, lane - 0.9f, 0.f, s + 4.5f, lane + 0.9f, 1.5f, 4, Material::kCarPaint,
@@ -242,7 +256,8 @@ void World::buildCountry() {
   // Farmsteads away from the road and the river.
   const int farms = rng.integer(2, 4);
   for (int f = 0, attempts = 0; f < farms && attempts < 200; ++attempts) {
-    float fx = rng.uniform(-extent_ + 25, extent_ - 25), fy = rng.uniform(-extent_ + 25, extent_ - 25);
+    float fx = rng.uniform(-extent_ + 25, extent_ - 25),
+          fy = rng.uniform(-extent_ + 25, extent_ - 25);
     if (std::fabs(fy - road_y(fx)) < 18 || std::fabs(fx - river_x(fy)) < 22) continue;
     ++f;
     const int n = rng.integer(1, 4);
@@ -252,8 +267,8 @@ void World::buildCountry() {
       float color[3];
       const float tone = rng.uniform(0.5f, 0.8f);
       setColor(color, tone, tone * 0.8f, tone * 0.7f);
-      addBox(x0, y0, 0.f, x0 + w, y0 + d, rng.uniform(4.f, 9.f), 1, Material::kRoof, Material::kWall,
-             color);
+      addBox(x0, y0, 0.f, x0 + w, y0 + d, rng.uniform(4.f, 9.f), 1, Material::kRoof,
+             Material::kWall, color);
     }
     for (int t = 0; t < 5; ++t) {
       addTree(fx + rng.uniform(-22.f, 22.f), fy + rng.uniform(-22.f, 22.f), rng.uniform(2.5f, 4.5f),
@@ -271,7 +286,8 @@ void World::buildCountry() {
   }
   const int groves = rng.integer(2, 4);
   for (int g = 0; g < groves; ++g) {
-    const float gx = rng.uniform(-extent_ + 15, extent_ - 15), gy = rng.uniform(-extent_ + 15, extent_ - 15);
+    const float gx = rng.uniform(-extent_ + 15, extent_ - 15),
+                gy = rng.uniform(-extent_ + 15, extent_ - 15);
     for (int t = 0; t < 25; ++t) {
       const float x = gx + rng.uniform(-15.f, 15.f), y = gy + rng.uniform(-15.f, 15.f);
       if (std::fabs(y - road_y(x)) < 6 || std::fabs(x - river_x(y)) < 10) continue;
@@ -294,16 +310,19 @@ void World::buildPort() {
   extent_ = 110.f;
   Rng rng(seed_ * 1299709 + 3);
   quay_y_ = rng.uniform(-35.f, -20.f);
-  const float container_colors[6][3] = {{0.7f, 0.15f, 0.1f}, {0.1f, 0.3f, 0.6f}, {0.15f, 0.5f, 0.25f},
-                                        {0.8f, 0.55f, 0.1f}, {0.55f, 0.55f, 0.55f}, {0.85f, 0.85f, 0.8f}};
+  const float container_colors[6][3] = {{0.7f, 0.15f, 0.1f},   {0.1f, 0.3f, 0.6f},
+                                        {0.15f, 0.5f, 0.25f},  {0.8f, 0.55f, 0.1f},
+                                        {0.55f, 0.55f, 0.55f}, {0.85f, 0.85f, 0.8f}};
   auto container = [&](float x, float y, float z, bool along_x, std::uint8_t cls) {
     const float* c = container_colors[rng.integer(0, 5)];
     float color[3] = {c[0] * rng.uniform(0.85f, 1.1f), c[1] * rng.uniform(0.85f, 1.1f),
                       c[2] * rng.uniform(0.85f, 1.1f)};
     if (along_x) {
-      addBox(x, y, z, x + 12.f, y + 2.4f, z + 2.6f, cls, Material::kContainer, Material::kContainer, color);
+      addBox(x, y, z, x + 12.f, y + 2.4f, z + 2.6f, cls, Material::kContainer, Material::kContainer,
+             color);
     } else {
-      addBox(x, y, z, x + 2.4f, y + 12.f, z + 2.6f, cls, Material::kContainer, Material::kContainer, color);
+      addBox(x, y, z, x + 2.4f, y + 12.f, z + 2.6f, cls, Material::kContainer, Material::kContainer,
+             color);
     }
   };
   // Ships along the quay.
@@ -337,7 +356,8 @@ void World::buildPort() {
     addBox(x, y + 12, 0.f, x + 1.2f, y + 13.2f, h, 3, Material::kSteel, Material::kSteel, color);
     addBox(x - 0.4f, quay_y_ - 30.f, h, x + 1.6f, y + 20.f, h + 2.f, 3, Material::kSteel,
            Material::kSteel, color);
-    addBox(x - 2.f, y + 2.f, h - 4.f, x + 3.2f, y + 6.f, h, 3, Material::kSteel, Material::kSteel, color);
+    addBox(x - 2.f, y + 2.f, h - 4.f, x + 3.2f, y + 6.f, h, 3, Material::kSteel, Material::kSteel,
+           color);
   }
   // Land: a quay road, a cross road grid, container yards, warehouses and a few trees.
   road_half_ = 4.f;
@@ -347,7 +367,8 @@ void World::buildPort() {
       const float x0 = bx + 6, y0 = by + 6, x1 = std::min(bx + block_ - 6, extent_ - 2),
                   y1 = std::min(by + block_ - 6, extent_ - 2);
       if (x1 - x0 < 14 || y1 - y0 < 14) continue;
-      const float type = hash01(seed_, 21, static_cast<std::uint64_t>(bx + 500), static_cast<std::uint64_t>(by + 500));
+      const float type = hash01(seed_, 21, static_cast<std::uint64_t>(bx + 500),
+                                static_cast<std::uint64_t>(by + 500));
       if (type < 0.5f) {  // container yard
         for (float y = y0; y + 2.4f < y1; y += 3.2f) {
           for (float x = x0; x + 12 < x1; x += 13.f) {
@@ -387,7 +408,8 @@ void World::buildGrid() {
     }
   }
   cell_start_.assign(total + 1, 0);
-  for (int c = 0; c < total; ++c) cell_start_[c + 1] = cell_start_[c] + static_cast<int>(lists[c].size());
+  for (int c = 0; c < total; ++c)
+    cell_start_[c + 1] = cell_start_[c] + static_cast<int>(lists[c].size());
   cell_items_.clear();
   cell_items_.reserve(cell_start_[total]);
   for (const auto& l : lists) cell_items_.insert(cell_items_.end(), l.begin(), l.end());
@@ -574,7 +596,8 @@ GroundSample World::ground(float x, float y) const {
       } else if (d < road_half_ + 3.f) {
         set(5, Material::kPaving, 0.52f, 0.5f, 0.48f);
       } else {
-        const int bx = static_cast<int>(std::floor(x / block_)), by = static_cast<int>(std::floor(y / block_));
+        const int bx = static_cast<int>(std::floor(x / block_)),
+                  by = static_cast<int>(std::floor(y / block_));
         const float type = hash01(seed_, 11, bx + 100, by + 100);
         if (type >= 0.62f && type < 0.85f) {
           set(3, Material::kGrass, 0.33f, 0.5f, 0.22f);
@@ -597,7 +620,8 @@ GroundSample World::ground(float x, float y) const {
         // Fields on a rotated grid.
         const float c = std::cos(0.2f), s = std::sin(0.2f);
         const float u = c * x + s * y, v = -s * x + c * y;
-        const int fi = static_cast<int>(std::floor(u / 45.f)), fj = static_cast<int>(std::floor(v / 35.f));
+        const int fi = static_cast<int>(std::floor(u / 45.f)),
+                  fj = static_cast<int>(std::floor(v / 35.f));
         const float type = hash01(seed_, 31, fi + 100, fj + 100);
         const float tone = hash01(seed_, 32, fi + 100, fj + 100);
         const float soil_patch = valueNoise(x / 18.f, y / 18.f, seed_ + 5);

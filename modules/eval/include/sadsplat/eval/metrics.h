@@ -14,7 +14,9 @@ class ConfusionMatrix {
   explicit ConfusionMatrix(int num_classes);
   /// \brief Adds pixels; gt == 255 (or any value >= num_classes) is ignored; pred must be a class.
   void add(const std::uint8_t* gt, const std::int64_t* pred, std::size_t n);
-  std::int64_t at(int gt, int pred) const { return counts_[static_cast<std::size_t>(gt) * n_ + pred]; }
+  std::int64_t at(int gt, int pred) const {
+    return counts_[static_cast<std::size_t>(gt) * n_ + pred];
+  }
   int numClasses() const { return n_; }
   std::int64_t total() const;
 

@@ -15,10 +15,10 @@ namespace gaussians {
 
 /// \brief Parameters of the initialisation; defaults are those of the 3DGS reference trainer.
 struct InitOptions {
-  float initial_opacity = 0.1f;   ///< opacity (not logit) of every Gaussian
-  int scale_neighbours = 3;       ///< scale = mean distance to this many nearest neighbours
-  float min_scale = 1e-7f;        ///< floor for the distance (duplicate points)
-  float feature_stddev = 1e-2f;   ///< semantic features ~ N(0, stddev), seeded
+  float initial_opacity = 0.1f;  ///< opacity (not logit) of every Gaussian
+  int scale_neighbours = 3;      ///< scale = mean distance to this many nearest neighbours
+  float min_scale = 1e-7f;       ///< floor for the distance (duplicate points)
+  float feature_stddev = 1e-2f;  ///< semantic features ~ N(0, stddev), seeded
   std::uint64_t seed = 42;
 };
 

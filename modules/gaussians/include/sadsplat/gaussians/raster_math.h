@@ -124,12 +124,12 @@ SADSPLAT_HD void quatToRotationBackward(const T q[4], const T G[9], T dq[4]) {
   const T w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
   T g[4];
   g[0] = T(2) * (-z * G[1] + y * G[2] + z * G[3] - x * G[5] - y * G[6] + x * G[7]);
-  g[1] = T(2) * (y * G[1] + z * G[2] + y * G[3] - T(2) * x * G[4] - w * G[5] + z * G[6] +
-                 w * G[7] - T(2) * x * G[8]);
+  g[1] = T(2) * (y * G[1] + z * G[2] + y * G[3] - T(2) * x * G[4] - w * G[5] + z * G[6] + w * G[7] -
+                 T(2) * x * G[8]);
   g[2] = T(2) * (-T(2) * y * G[0] + x * G[1] + w * G[2] + x * G[3] + z * G[5] - w * G[6] +
                  z * G[7] - T(2) * y * G[8]);
-  g[3] = T(2) * (-T(2) * z * G[0] - w * G[1] + x * G[2] + w * G[3] - T(2) * z * G[4] +
-                 y * G[5] + x * G[6] + y * G[7]);
+  g[3] = T(2) * (-T(2) * z * G[0] - w * G[1] + x * G[2] + w * G[3] - T(2) * z * G[4] + y * G[5] +
+                 x * G[6] + y * G[7]);
   // Through the normalisation qn = q / |q|.
   const T dot = w * g[0] + x * g[1] + y * g[2] + z * g[3];
   dq[0] = (g[0] - w * dot) / n;
@@ -151,14 +151,14 @@ struct Projected {
 /// the backward pass (which recomputes them instead of storing them).
 template <typename T>
 struct EwaTerms {
-  T p[3];                        ///< centre in camera coordinates
-  T Rq[9], s[3], M[9], S[9];     ///< rotation, scales, M = Rq diag(s), 3D covariance S = M M^T
-  T cx_ratio, cy_ratio;          ///< x/z, y/z clamped to the frustum limits
-  bool clamp_x, clamp_y;         ///< whether the clamp was active
-  T tx, ty;                      ///< clamped x, y
-  T J00, J02, J11, J12;          ///< the projection Jacobian's non-zero entries
-  T Tm[6];                       ///< J R (2 x 3)
-  T a, b, c;                     ///< 2D covariance (with the dilation)
+  T p[3];                     ///< centre in camera coordinates
+  T Rq[9], s[3], M[9], S[9];  ///< rotation, scales, M = Rq diag(s), 3D covariance S = M M^T
+  T cx_ratio, cy_ratio;       ///< x/z, y/z clamped to the frustum limits
+  bool clamp_x, clamp_y;      ///< whether the clamp was active
+  T tx, ty;                   ///< clamped x, y
+  T J00, J02, J11, J12;       ///< the projection Jacobian's non-zero entries
+  T Tm[6];                    ///< J R (2 x 3)
+  T a, b, c;                  ///< 2D covariance (with the dilation)
 };
 
 template <typename T>
@@ -176,7 +176,8 @@ SADSPLAT_HD void ewaTerms(const T mean[3], const T quat[4], const T log_scale[3]
   const T* M = e->M;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      e->S[3 * i + j] = M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
+      e->S[3 * i + j] =
+          M[3 * i] * M[3 * j] + M[3 * i + 1] * M[3 * j + 1] + M[3 * i + 2] * M[3 * j + 2];
     }
   }
   const T z = e->p[2];
@@ -249,8 +250,8 @@ SADSPLAT_HD bool projectGaussian(const T mean[3], const T quat[4], const T log_s
 template <typename T>
 SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const T log_scale[3],
                                          const Camera<T>& cam, const T g_mean2d[2],
-                                         const T g_conic[3], T g_depth, T g_mean[3],
-                                         T g_quat[4], T g_log_scale[3]) {
+                                         const T g_conic[3], T g_depth, T g_mean[3], T g_quat[4],
+                                         T g_log_scale[3]) {
   const T* R = cam.R;
   EwaTerms<T> e;
   ewaTerms(mean, quat, log_scale, cam, &e);
@@ -281,8 +282,8 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
   T gTm[6];
   for (int r = 0; r < 2; ++r) {
     for (int j = 0; j < 3; ++j) {
-      gTm[3 * r + j] = T(2) * (G2T[3 * r] * S[j] + G2T[3 * r + 1] * S[3 + j] +
-                               G2T[3 * r + 2] * S[6 + j]);
+      gTm[3 * r + j] =
+          T(2) * (G2T[3 * r] * S[j] + G2T[3 * r + 1] * S[3 + j] + G2T[3 * r + 2] * S[6 + j]);
     }
   }
   // Tm = J R: dL/dJ = gTm R^T; only J00, J02, J11, J12 are variables.
@@ -317,7 +318,8 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
   T gM[9];
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      gM[3 * i + j] = T(2) * (gS[3 * i] * M[j] + gS[3 * i + 1] * M[3 + j] + gS[3 * i + 2] * M[6 + j]);
+      gM[3 * i + j] =
+          T(2) * (gS[3 * i] * M[j] + gS[3 * i + 1] * M[3 + j] + gS[3 * i + 2] * M[6 + j]);
     }
   }
   T gR[9];
@@ -368,9 +370,9 @@ SADSPLAT_HD T pixelAlpha(const T mean2d[2], const T conic[3], T opacity, T px, T
 /// Backward of pixelAlpha for a contributing Gaussian: adds the gradients of mean2d, conic and
 /// opacity for a gradient g_alpha of its alpha.
 template <typename T>
-SADSPLAT_HD void pixelAlphaBackward(const T mean2d[2], const T conic[3], T opacity, T px, T py,
-                                   T G, bool clamped, T g_alpha, T g_mean2d[2], T g_conic[3],
-                                   T* g_opacity) {
+SADSPLAT_HD void pixelAlphaBackward(const T mean2d[2], const T conic[3], T opacity, T px, T py, T G,
+                                    bool clamped, T g_alpha, T g_mean2d[2], T g_conic[3],
+                                    T* g_opacity) {
   if (clamped) return;  // alpha = kMaxAlpha does not depend on the Gaussian
   *g_opacity += G * g_alpha;
   const T g_power = opacity * G * g_alpha;

@@ -34,7 +34,7 @@ struct RasterCamera {
 
 /// \brief What to render.
 struct RenderSettings {
-  int sh_degree = 3;                          ///< 0..3; sh must hold (degree+1)^2 coefficients
+  int sh_degree = 3;                         ///< 0..3; sh must hold (degree+1)^2 coefficients
   std::array<float, 3> background{0, 0, 0};  ///< RGB behind the Gaussians
 };
 

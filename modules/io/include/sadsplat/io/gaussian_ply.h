@@ -26,12 +26,12 @@ struct PlyWriteOptions {
 
 /// \brief What readGaussianPly found in a file.
 struct PlyFileInfo {
-  std::string format;                        ///< "ascii", "binary_little_endian", ...
+  std::string format;  ///< "ascii", "binary_little_endian", ...
   std::size_t num_vertices = 0;
-  int sh_degree = 0;                         ///< from the number of f_rest_* properties
+  int sh_degree = 0;  ///< from the number of f_rest_* properties
   bool has_normals = false;
-  bool has_semantic = false;                 ///< any feature_*/log_alpha/confidence/label
-  int feature_dim = 0;                       ///< number of feature_* properties
+  bool has_semantic = false;                    ///< any feature_*/log_alpha/confidence/label
+  int feature_dim = 0;                          ///< number of feature_* properties
   std::vector<std::string> ignored_properties;  ///< vertex properties sadsplat does not know
 };
 

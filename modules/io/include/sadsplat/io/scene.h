@@ -49,10 +49,10 @@ struct ViewPseudoLabels {
   std::vector<std::int32_t> region;  ///< per pixel (row-major): target id, or -1 for none
   int num_targets = 0;
   int num_classes = 0;
-  std::vector<float> scores;         ///< num_targets x num_classes, each row a distribution
+  std::vector<float> scores;  ///< num_targets x num_classes, each row a distribution
   int feature_dim = 0;
-  std::vector<float> features;       ///< num_targets x feature_dim
-  std::vector<std::uint8_t> kept;    ///< num_targets: 1 = passed the filter
+  std::vector<float> features;     ///< num_targets x feature_dim
+  std::vector<std::uint8_t> kept;  ///< num_targets: 1 = passed the filter
 
   bool empty() const { return region.empty(); }
   /// \brief Class of the kept target at each pixel, or -1 (not kept, no target).
@@ -68,14 +68,14 @@ struct ViewPseudoLabels {
 
 /// \brief One posed image of the scene.
 struct View {
-  std::string name;       ///< image file name, relative to images/
-  PinholeCamera camera;   ///< already undistorted and resized to the image below
-  Image8 rgb;             ///< 3 channels
-  Image8 mask;            ///< 1 channel: 255 = valid pixel, 0 = outside the undistorted image
-  Image8 labels;          ///< 1 channel class ids (kIgnoreLabel = none); empty if unlabelled
-  bool train = false;     ///< in the training set
-  bool test = false;      ///< in the test set
-  bool labelled = false;  ///< a training view whose label map supervises training
+  std::string name;         ///< image file name, relative to images/
+  PinholeCamera camera;     ///< already undistorted and resized to the image below
+  Image8 rgb;               ///< 3 channels
+  Image8 mask;              ///< 1 channel: 255 = valid pixel, 0 = outside the undistorted image
+  Image8 labels;            ///< 1 channel class ids (kIgnoreLabel = none); empty if unlabelled
+  bool train = false;       ///< in the training set
+  bool test = false;        ///< in the test set
+  bool labelled = false;    ///< a training view whose label map supervises training
   ViewPseudoLabels pseudo;  ///< empty until `sadsplat pseudo-labels` ran on the scene
 };
 
@@ -93,9 +93,9 @@ struct ScenePoint {
 
 /// \brief A whole scene.
 struct Scene {
-  std::string source;               ///< where it was imported from (informational)
+  std::string source;  ///< where it was imported from (informational)
   std::vector<ClassInfo> classes;
-  std::vector<View> views;          ///< sorted by name
+  std::vector<View> views;  ///< sorted by name
   std::vector<ScenePoint> points;
 };
 

@@ -14,15 +14,15 @@ namespace pipeline {
 
 /// \brief Options of a pseudo-label run.
 struct PseudoLabelRunOptions {
-  std::string scene;          ///< scene directory or scene cache
-  std::string out;            ///< scene cache to write (default: the input cache, replaced)
-  double scale = 0.5;         ///< import scale for scene directories
+  std::string scene;                ///< scene directory or scene cache
+  std::string out;                  ///< scene cache to write (default: the input cache, replaced)
+  double scale = 0.5;               ///< import scale for scene directories
   std::string backend = "builtin";  ///< builtin | torchscript
-  std::string sam_model;      ///< torchscript: SAM export (see scripts/export_foundation_models.py)
-  std::string clip_model;     ///< torchscript: CLIP-family export
+  std::string sam_model;   ///< torchscript: SAM export (see scripts/export_foundation_models.py)
+  std::string clip_model;  ///< torchscript: CLIP-family export
   pseudo_labels::BuiltinOptions builtin;
   pseudo_labels::PseudoLabelOptions filter;
-  std::string report_dir;     ///< write the quality report here (empty: none)
+  std::string report_dir;  ///< write the quality report here (empty: none)
   std::ostream* progress = nullptr;
 };
 

@@ -23,10 +23,10 @@ io::Scene loadScene(const std::string& path, double scale = 0.5);
 
 /// \brief Options of a training run.
 struct TrainRunOptions {
-  std::string scene;       ///< scene directory or cache
-  std::string out;         ///< run directory (created)
-  double scale = 0.5;      ///< import scale for scene directories (paper: half resolution)
-  bool resume = false;     ///< continue from out/checkpoint.bin
+  std::string scene;    ///< scene directory or cache
+  std::string out;      ///< run directory (created)
+  double scale = 0.5;   ///< import scale for scene directories (paper: half resolution)
+  bool resume = false;  ///< continue from out/checkpoint.bin
   std::ostream* progress = nullptr;  ///< live progress line (carriage returns), or none
 };
 

@@ -13,8 +13,8 @@ namespace pseudo_labels {
 
 /// \brief Fit parameters.
 struct ClassifierOptions {
-  double l2 = 1e-3;        ///< weight decay on the weights (not the bias)
-  int steps = 400;         ///< Adam steps of the full-batch fit
+  double l2 = 1e-3;  ///< weight decay on the weights (not the bias)
+  int steps = 400;   ///< Adam steps of the full-batch fit
   double learning_rate = 0.05;
   /// Add pairwise products of the standardised descriptors, when there are at least
   /// `quadratic_min_samples_per_weight` samples per expanded dimension (otherwise the products

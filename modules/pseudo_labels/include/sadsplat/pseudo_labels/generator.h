@@ -21,7 +21,7 @@ namespace pseudo_labels {
 /// \brief The targets of one view with their class scores and features.
 struct ViewTargets {
   Segmentation segmentation;
-  std::vector<float> scores;    ///< num_regions x C, rows are distributions
+  std::vector<float> scores;  ///< num_regions x C, rows are distributions
   int feature_dim = 0;
   std::vector<float> features;  ///< num_regions x feature_dim
 };
@@ -52,8 +52,8 @@ struct BuiltinOptions {
   SlicOptions superpixels;
   GraphSegmentationOptions graph;
   ClassifierOptions classifier;
-  bool geometry = true;         ///< use the sparse points' heights as a descriptor
-  double min_purity = 0.7;      ///< a labelled region trains the scorer if this share agrees
+  bool geometry = true;     ///< use the sparse points' heights as a descriptor
+  double min_purity = 0.7;  ///< a labelled region trains the scorer if this share agrees
 };
 
 /// \brief The built-in backend: SLIC targets, few-shot classifier fitted on the labelled views.

@@ -15,9 +15,9 @@ namespace pseudo_labels {
 
 /// \brief Parameters of the graph segmentation.
 struct GraphSegmentationOptions {
-  double k = 300.0;      ///< scale of the merge threshold k / |C| (CIELab units x pixels)
-  int min_size = 64;     ///< components smaller than this are merged into a neighbour
-  double sigma = 0.8;    ///< Gaussian smoothing before the edge weights (pixels; 0: none)
+  double k = 300.0;    ///< scale of the merge threshold k / |C| (CIELab units x pixels)
+  int min_size = 64;   ///< components smaller than this are merged into a neighbour
+  double sigma = 0.8;  ///< Gaussian smoothing before the edge weights (pixels; 0: none)
 };
 
 /// \brief Segments an RGB image; pixels whose mask is 0 belong to no region. Regions are

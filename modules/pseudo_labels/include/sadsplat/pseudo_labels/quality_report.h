@@ -18,8 +18,8 @@ namespace pseudo_labels {
 struct ReliabilityBin {
   double low = 0, high = 0;
   std::size_t pixels = 0;
-  double accuracy = 0;      ///< share of those pixels whose argmax is the ground truth
-  double mean_score = 0;    ///< mean TOP1 score of those pixels
+  double accuracy = 0;    ///< share of those pixels whose argmax is the ground truth
+  double mean_score = 0;  ///< mean TOP1 score of those pixels
 };
 
 /// \brief Precision and coverage of one class.
@@ -33,12 +33,12 @@ struct ClassQuality {
 
 /// \brief The whole report.
 struct PseudoLabelQuality {
-  int views = 0;                     ///< views evaluated
-  std::size_t gt_pixels = 0;         ///< pixels with a ground-truth class
-  std::size_t kept_pixels = 0;       ///< of those, pixels with a kept pseudo-label
-  double precision = 0;              ///< kept pixels whose pseudo-label is right
-  double coverage = 0;               ///< kept_pixels / gt_pixels
-  double argmax_accuracy = 0;        ///< argmax of the scores over all target pixels (no filter)
+  int views = 0;                ///< views evaluated
+  std::size_t gt_pixels = 0;    ///< pixels with a ground-truth class
+  std::size_t kept_pixels = 0;  ///< of those, pixels with a kept pseudo-label
+  double precision = 0;         ///< kept pixels whose pseudo-label is right
+  double coverage = 0;          ///< kept_pixels / gt_pixels
+  double argmax_accuracy = 0;   ///< argmax of the scores over all target pixels (no filter)
   double expected_calibration_error = 0;
   std::vector<ClassQuality> classes;
   std::vector<ReliabilityBin> reliability;

@@ -22,7 +22,7 @@ struct SceneGeometry {
   std::array<double, 3> up{0, 0, 1};  ///< unit vector away from the ground (towards the cameras)
   std::vector<float> height;          ///< per sparse point, above the 2nd height percentile
   float median_height = 0;
-  float scale = 1;                    ///< spread of the heights (for normalisation)
+  float scale = 1;  ///< spread of the heights (for normalisation)
 
   /// \brief Up = the mean of the cameras' backward viewing directions (aerial views look down).
   static SceneGeometry fromScene(const io::Scene& scene);

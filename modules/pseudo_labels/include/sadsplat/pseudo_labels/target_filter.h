@@ -33,7 +33,8 @@ enum class ScoreScale {
 };
 
 /// \brief Measures of a target from its `num_classes` non-negative scores.
-TargetMeasures measureTarget(const float* scores, int num_classes, ScoreScale scale = ScoreScale::kScore);
+TargetMeasures measureTarget(const float* scores, int num_classes,
+                             ScoreScale scale = ScoreScale::kScore);
 
 /// \brief Statistics over the targets.
 TargetStatistics targetStatistics(const std::vector<TargetMeasures>& targets);

@@ -47,8 +47,8 @@ TargetScorer::Ptr makeTorchScriptScorer(const std::string& sam_path, const std::
 
 /// \brief Box non-maximum suppression: indices of the boxes kept, by descending score.
 /// \param[in] boxes x0, y0, x1, y1 per box (inclusive pixel bounds)
-std::vector<int> boxNms(const std::vector<std::array<float, 4>>& boxes, const std::vector<float>& scores,
-                        double iou_threshold);
+std::vector<int> boxNms(const std::vector<std::array<float, 4>>& boxes,
+                        const std::vector<float>& scores, double iou_threshold);
 
 }  // namespace pseudo_labels
 }  // namespace sadsplat

@@ -17,8 +17,8 @@ namespace semantic_drop {
 /// Until pseudo-label confidence maps exist, P_conf comes from one-hot maps of the labelled
 /// views, so a Gaussian seen in none of them has P_conf = 0.
 /// \throws sadsplat::Error on an unknown mode or a negative P_base / interval
-std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& config,
-                                                                const HardConcreteParams& hc = {});
+std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(
+    const gaussians::TrainConfig& config, const HardConcreteParams& hc = {});
 
 }  // namespace semantic_drop
 }  // namespace sadsplat

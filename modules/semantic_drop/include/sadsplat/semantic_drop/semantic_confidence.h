@@ -25,7 +25,8 @@ namespace semantic_drop {
 /// \throws sadsplat::Error on mismatched sizes
 at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opacities,
                               const std::vector<gaussians::RasterCamera>& cameras,
-                              const std::vector<at::Tensor>& confidence_maps, at::Tensor* seen = nullptr);
+                              const std::vector<at::Tensor>& confidence_maps,
+                              at::Tensor* seen = nullptr);
 
 /// \brief One-hot confidence maps [H, W, C] from a label map (the stand-in for the pseudo-label
 /// backend's maps: 1 for the labelled class, 0 elsewhere and on ignored pixels).

@@ -21,12 +21,12 @@ struct SynthOptions {
   int views = 70;
   int width = 1600;
   int height = 900;
-  std::vector<int> labelled = {0, 7, 28};                      ///< labelled training views
-  std::vector<int> test = {14, 21, 35, 42, 49, 56, 63};        ///< test views (those < views)
+  std::vector<int> labelled = {0, 7, 28};                ///< labelled training views
+  std::vector<int> test = {14, 21, 35, 42, 49, 56, 63};  ///< test views (those < views)
   double horizontal_fov_deg = 60.0;
-  int max_points = 20000;  ///< sparse points kept (a few thousand to tens of thousands)
+  int max_points = 20000;    ///< sparse points kept (a few thousand to tens of thousands)
   int samples_per_axis = 2;  ///< colour anti-aliasing: s x s rays per pixel (labels, depth: 1)
-  int threads = 0;         ///< 0 = all hardware threads
+  int threads = 0;           ///< 0 = all hardware threads
 
   /// \brief The `--preset demo` size: 320x180, 40 views, 4000 points.
   static SynthOptions demo(SceneKind kind, std::uint64_t seed);
@@ -36,9 +36,9 @@ struct SynthOptions {
 struct SynthView {
   std::string name;
   io::PinholeCamera camera;
-  io::Image8 rgb;                ///< 3 channels
-  io::Image8 labels;             ///< class ids, 255 = outside the labelled area / sky
-  std::vector<float> depth;      ///< camera z per pixel in metres, 0 = sky
+  io::Image8 rgb;            ///< 3 channels
+  io::Image8 labels;         ///< class ids, 255 = outside the labelled area / sky
+  std::vector<float> depth;  ///< camera z per pixel in metres, 0 = sky
 };
 
 /// \brief One sparse point with the class of the surface it was sampled from.

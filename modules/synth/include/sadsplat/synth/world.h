@@ -22,8 +22,24 @@ SceneKind parseSceneKind(const std::string& name);
 
 /// \brief Surface materials: how a hit is textured and lit (several per class).
 enum class Material : std::uint8_t {
-  kAsphalt, kMarking, kPaving, kGrass, kFoliage, kRoof, kFlatRoof, kWall, kCarPaint, kField,
-  kSoil, kWater, kHull, kDeck, kContainer, kSteel, kConcrete, kOutside
+  kAsphalt,
+  kMarking,
+  kPaving,
+  kGrass,
+  kFoliage,
+  kRoof,
+  kFlatRoof,
+  kWall,
+  kCarPaint,
+  kField,
+  kSoil,
+  kWater,
+  kHull,
+  kDeck,
+  kContainer,
+  kSteel,
+  kConcrete,
+  kOutside
 };
 
 /// \brief One solid object.
@@ -31,7 +47,7 @@ struct Object {
   enum Shape : std::uint8_t { kBox, kEllipsoid } shape = kBox;
   float lo[3] = {0, 0, 0};  ///< axis-aligned bounds (the ellipsoid fills them)
   float hi[3] = {0, 0, 0};
-  std::uint8_t cls = 0;     ///< class id
+  std::uint8_t cls = 0;             ///< class id
   Material top = Material::kRoof;   ///< material of faces whose normal points up
   Material side = Material::kWall;  ///< material of the other faces
   float color[3] = {1, 1, 1};       ///< base colour (0..1)
@@ -39,7 +55,7 @@ struct Object {
 
 /// \brief A ray-surface intersection.
 struct Hit {
-  float t = 0;           ///< distance along the (unit) ray
+  float t = 0;  ///< distance along the (unit) ray
   float p[3] = {0, 0, 0};
   float n[3] = {0, 0, 1};
   int object = -1;       ///< index into World::objects, -1 = ground
