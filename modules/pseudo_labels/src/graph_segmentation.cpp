@@ -10,38 +10,39 @@ namespace sadsplat {
 namespace pseudo_labels {
 namespace {
 
+// One pass of a separable blur of an interleaved 3-channel image (clamped borders): along x
+// (step 1, extent W) or along y (step W, extent H).
+void blurPass(const std::vector<float>& in, std::vector<float>& out, int W, int H,
+              const std::vector<float>& kernel, bool along_x) {
+  const int r = static_cast<int>(kernel.size() / 2);
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        float v = 0;
+        for (int i = -r; i <= r; ++i) {
+          const int xx = along_x ? std::clamp(x + i, 0, W - 1) : x;
+          const int yy = along_x ? y : std::clamp(y + i, 0, H - 1);
+          v += kernel[i + r] * in[3 * (static_cast<std::size_t>(yy) * W + xx) + c];
+        }
+        out[3 * (static_cast<std::size_t>(y) * W + x) + c] = v;
+      }
+    }
+  }
+}
+
 // Separable Gaussian blur of an interleaved 3-channel float image (clamped borders).
 void gaussianBlur(std::vector<float>& img, int W, int H, double sigma) {
   if (sigma <= 0) return;
   const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
   std::vector<float> kernel(2 * r + 1);
   float sum = 0;
-  for (int i = -r; i <= r; ++i)
+  for (int i = -r; i <= r; ++i) {
     sum += kernel[i + r] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+  }
   for (float& k : kernel) k /= sum;
   std::vector<float> tmp(img.size());
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        float v = 0;
-        for (int i = -r; i <= r; ++i)
-          v += kernel[i + r] *
-               img[3 * (static_cast<std::size_t>(y) * W + std::clamp(x + i, 0, W - 1)) + c];
-        tmp[3 * (static_cast<std::size_t>(y) * W + x) + c] = v;
-      }
-    }
-  }
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        float v = 0;
-        for (int i = -r; i <= r; ++i)
-          v += kernel[i + r] *
-               tmp[3 * (static_cast<std::size_t>(std::clamp(y + i, 0, H - 1)) * W + x) + c];
-        img[3 * (static_cast<std::size_t>(y) * W + x) + c] = v;
-      }
-    }
-  }
+  blurPass(img, tmp, W, H, kernel, true);
+  blurPass(tmp, img, W, H, kernel, false);
 }
 
 struct Edge {
@@ -89,9 +90,7 @@ Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask,
   const int W = rgb.width, H = rgb.height;
   const std::size_t N = static_cast<std::size_t>(W) * H;
   auto valid = [&](std::size_t i) { return mask.empty() || mask.pixels[i] != 0; };
-  std::vector<float> lab(N * 3);
-  for (std::size_t i = 0; i < N; ++i)
-    srgbToLab(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2], &lab[3 * i]);
+  std::vector<float> lab = imageToLab(rgb);
   gaussianBlur(lab, W, H, o.sigma);
 
   std::vector<Edge> edges;

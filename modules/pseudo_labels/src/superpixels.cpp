@@ -36,6 +36,15 @@ void srgbToLab(std::uint8_t r8, std::uint8_t g8, std::uint8_t b8, float lab[3]) 
   lab[2] = 200 * (fy - fz);
 }
 
+std::vector<float> imageToLab(const io::Image8& rgb) {
+  const std::size_t N = static_cast<std::size_t>(rgb.width) * rgb.height;
+  std::vector<float> lab(N * 3);
+  for (std::size_t i = 0; i < N; ++i) {
+    srgbToLab(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2], &lab[3 * i]);
+  }
+  return lab;
+}
+
 Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, const SlicOptions& o) {
   if (rgb.channels != 3 ||
       rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
@@ -50,10 +59,7 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, cons
   const int W = rgb.width, H = rgb.height, S = o.region_size;
   const std::size_t N = static_cast<std::size_t>(W) * H;
   auto valid = [&](std::size_t i) { return mask.empty() || mask.pixels[i] != 0; };
-  std::vector<float> lab(N * 3);
-  for (std::size_t i = 0; i < N; ++i) {
-    srgbToLab(rgb.pixels[3 * i], rgb.pixels[3 * i + 1], rgb.pixels[3 * i + 2], &lab[3 * i]);
-  }
+  const std::vector<float> lab = imageToLab(rgb);
   auto gradient = [&](int x, int y) {
     const auto at = [&](int xx, int yy) {
       return &lab[3 * (static_cast<std::size_t>(std::clamp(yy, 0, H - 1)) * W +

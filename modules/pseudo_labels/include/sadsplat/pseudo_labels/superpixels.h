@@ -38,5 +38,8 @@ Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask,
 /// \brief Converts an sRGB byte triple to CIELab (D65), L in [0, 100].
 void srgbToLab(std::uint8_t r, std::uint8_t g, std::uint8_t b, float lab[3]);
 
+/// \brief CIELab of every pixel of a 3-channel sRGB image, interleaved (L, a, b per pixel).
+std::vector<float> imageToLab(const io::Image8& rgb);
+
 }  // namespace pseudo_labels
 }  // namespace sadsplat
