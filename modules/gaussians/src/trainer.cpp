@@ -235,14 +235,16 @@ struct Trainer::State {
     max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
   }
 
-  // Activated opacity times the drop's evaluation gate (when there is one).
+  // The drop's deterministic (evaluation) gate per Gaussian; undefined without one.
+  at::Tensor evaluationGate() const {
+    return drop ? drop->evaluationGate(p("log_alpha").value.detach()) : at::Tensor();
+  }
+
+  // Activated opacity times the evaluation gate (when there is one).
   at::Tensor effectiveOpacity() const {
-    at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
-    if (drop) {
-      const at::Tensor gate = drop->evaluationGate(p("log_alpha").value.detach());
-      if (gate.defined()) opacity = opacity * gate;
-    }
-    return opacity;
+    const at::Tensor opacity = at::sigmoid(p("opacity").value.detach());
+    const at::Tensor gate = evaluationGate();
+    return gate.defined() ? opacity * gate : opacity;
   }
 
   void densifyAndPrune(bool prune_big) {
@@ -556,10 +558,10 @@ StepStats Trainer::step() {
       dropped = s.n() - decision.keep.sum().item<std::int64_t>();
       s.resize(decision.keep.to(s.device), {});
     }
-    if (s.drop && done == c.iterations) {
+    if (done == c.iterations) {
       // Gaussians whose evaluation gate is closed (z = 0) render nothing: removing them at the
       // end changes no render and shrinks the model.
-      const at::Tensor gate = s.drop->evaluationGate(s.p("log_alpha").value.detach());
+      const at::Tensor gate = s.evaluationGate();
       if (gate.defined()) {
         const at::Tensor open = gate > 0;
         closed_at_end = s.n() - open.sum().item<std::int64_t>();
@@ -597,7 +599,7 @@ RenderResult Trainer::renderView(const io::View& view) const {
   settings.sh_degree = state_->shDegree();
   settings.background = state_->config.background;
   GaussianParams g = state_->gaussians();
-  if (state_->drop) g.opacity_gate = state_->drop->evaluationGate(state_->p("log_alpha").value);
+  g.opacity_gate = state_->evaluationGate();
   return render(g, RasterCamera::fromPinhole(view.camera), settings);
 }
 
