@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <iomanip>
+#include <sstream>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
@@ -124,10 +125,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
-                  << config.drop << ", P_base " << std::defaultfloat << config.p_base << "), "
-                  << stats.num_gaussians << " left; of the removed: " << d.removed_low_confidence
-                  << " with P_conf < 0.5 (" << d.removed_unseen << " seen by no confidence map), "
-                  << d.removed_closed_gate << " with P_nonzero < 0.5\n";
+                  << config.drop << ", P_base " << config.p_base << "), " << stats.num_gaussians
+                  << " left; of the removed: " << d.removed_low_confidence << " with P_conf < 0.5 ("
+                  << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
+                  << " with P_nonzero < 0.5\n";
     }
     if (stats.removed_closed_gates > 0 && o.progress) {
       *o.progress << "\n[drop] end of training: removed " << stats.removed_closed_gates
@@ -137,12 +138,14 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = (it - first) / std::max(1e-9, elapsed);
-      *o.progress << "\r[" << it << "/" << config.iterations << "] loss " << std::fixed
-                  << std::setprecision(4) << stats.loss << " (rgb " << stats.rgb_loss << ", sem "
-                  << stats.semantic_loss << ")  gaussians " << stats.num_gaussians << "  "
-                  << std::setprecision(1) << rate << " it/s  ETA "
-                  << formatSeconds((config.iterations - it) / std::max(rate, 1e-9)) << "   "
-                  << std::flush;
+      // Formatted apart so that the fixed-point state does not leak into the caller's stream.
+      std::ostringstream line;
+      line << "\r[" << it << "/" << config.iterations << "] loss " << std::fixed
+           << std::setprecision(4) << stats.loss << " (rgb " << stats.rgb_loss << ", sem "
+           << stats.semantic_loss << ")  gaussians " << stats.num_gaussians << "  "
+           << std::setprecision(1) << rate << " it/s  ETA "
+           << formatSeconds((config.iterations - it) / std::max(rate, 1e-9)) << "   ";
+      *o.progress << line.str() << std::flush;
     }
     if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 &&
         it < config.iterations) {
