@@ -189,8 +189,14 @@ int main(int argc, char** argv) {
   std::string pseudo_targets = "slic";
   pseudo
       ->add_option("--targets", pseudo_targets,
-                   "builtin: mask generator, slic (equal-size superpixels) or graph")
-      ->check(CLI::IsMember({"slic", "graph"}))
+                   "builtin: mask generator, slic (equal-size superpixels), graph, or multiscale "
+                   "(overlapping SLIC layers of sizes region-size x --scales)")
+      ->check(CLI::IsMember({"slic", "graph", "multiscale"}))
+      ->capture_default_str();
+  pseudo
+      ->add_option("--scales", pseudo_options.builtin.multiscale,
+                   "builtin, multiscale: ascending region-size factors")
+      ->delimiter(',')
       ->capture_default_str();
   pseudo
       ->add_option("--graph-k", pseudo_options.builtin.graph.k,
@@ -309,9 +315,11 @@ int main(int argc, char** argv) {
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
     } else if (*pseudo) {
       pseudo_options.builtin.geometry = !pseudo_no_geometry;
-      pseudo_options.builtin.targets = pseudo_targets == "graph"
-                                           ? sadsplat::pseudo_labels::MaskGenerator::kGraph
-                                           : sadsplat::pseudo_labels::MaskGenerator::kSlic;
+      using sadsplat::pseudo_labels::MaskGenerator;
+      pseudo_options.builtin.targets = pseudo_targets == "graph" ? MaskGenerator::kGraph
+                                       : pseudo_targets == "multiscale"
+                                           ? MaskGenerator::kSlicMultiscale
+                                           : MaskGenerator::kSlic;
       pseudo_options.filter.scale = pseudo_scale == "log-odds"
                                         ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
                                         : sadsplat::pseudo_labels::ScoreScale::kScore;

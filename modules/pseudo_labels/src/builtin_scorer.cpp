@@ -1,7 +1,9 @@
-// The built-in backend: SLIC superpixels as targets, region descriptors, and a few-shot
-// classifier fitted on the labelled views' regions (majority label of sufficiently pure regions).
+// The built-in backend: SLIC superpixels (one or several sizes) or graph segments as targets,
+// region descriptors, and a few-shot classifier fitted on the labelled views' regions (majority
+// label of sufficiently pure regions, of every layer).
 #include <ATen/Parallel.h>
 
+#include <functional>
 #include <map>
 
 #include "sadsplat/common/error.h"
@@ -31,20 +33,21 @@ class BuiltinScorer : public TargetScorer {
       if (v.labelled && !v.labels.empty() && std::find(all.begin(), all.end(), i) == all.end())
         all.push_back(i);
     }
-    std::vector<Segmentation> segs(all.size());
-    std::vector<std::vector<float>> desc(all.size());
+    const std::vector<Segmenter> layers = segmenters();
+    std::vector<std::vector<Segmentation>> segs(all.size());        // [view][layer]
+    std::vector<std::vector<std::vector<float>>> desc(all.size());  // [view][layer]
     std::atomic<int> done{0};
     at::parallel_for(0, static_cast<std::int64_t>(all.size()), 1,
                      [&](std::int64_t b, std::int64_t e) {
                        for (std::int64_t k = b; k < e; ++k) {
                          const io::View& v = scene.views[all[k]];
-                         segs[k] = options_.targets == MaskGenerator::kGraph
-                                       ? graphSegmentation(v.rgb, v.mask, options_.graph)
-                                       : slicSuperpixels(v.rgb, v.mask, options_.superpixels);
-                         desc[k] = regionFeatures(scene, v, segs[k], g);
+                         for (const Segmenter& segment : layers) {
+                           segs[k].push_back(segment(v));
+                           desc[k].push_back(regionFeatures(scene, v, segs[k].back(), g));
+                         }
                          const int n = ++done;
                          if (progress && (n % 10 == 0 || n == static_cast<int>(all.size()))) {
-                           progress("superpixels + descriptors: " + std::to_string(n) + "/" +
+                           progress("targets + descriptors: " + std::to_string(n) + "/" +
                                     std::to_string(all.size()) + " views");
                          }
                        }
@@ -55,23 +58,8 @@ class BuiltinScorer : public TargetScorer {
     for (std::size_t k = 0; k < all.size(); ++k) {
       const io::View& v = scene.views[all[k]];
       if (!v.labelled || v.labels.empty()) continue;
-      std::vector<std::vector<int>> hist(segs[k].num_regions, std::vector<int>(C + 1, 0));
-      for (std::size_t i = 0; i < segs[k].region.size(); ++i) {
-        const int r = segs[k].region[i];
-        if (r < 0) continue;
-        const int l = v.labels.pixels[i];
-        hist[r][l < C ? l : C]++;
-      }
-      for (int r = 0; r < segs[k].num_regions; ++r) {
-        int total = 0, best = 0;
-        for (int c = 0; c <= C; ++c) total += hist[r][c];
-        for (int c = 1; c < C; ++c)
-          if (hist[r][c] > hist[r][best]) best = c;
-        if (total == 0 || hist[r][best] < options_.min_purity * total) continue;
-        x.insert(x.end(), desc[k].begin() + static_cast<std::ptrdiff_t>(r) * kRegionFeatureDim,
-                 desc[k].begin() + static_cast<std::ptrdiff_t>(r + 1) * kRegionFeatureDim);
-        y.push_back(best);
-        group.push_back(all[k]);
+      for (std::size_t l = 0; l < layers.size(); ++l) {
+        addLabelledRegions(v, segs[k][l], desc[k][l], C, all[k], x, y, group);
       }
     }
     if (y.empty()) {
@@ -89,17 +77,70 @@ class BuiltinScorer : public TargetScorer {
 
     std::vector<ViewTargets> out(views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
-      ViewTargets& t = out[k];
-      t.segmentation = std::move(segs[k]);
-      t.scores = classifier.predictProbabilities(desc[k]);
-      // In the class-score space of the built-in backend a target's feature is its scores.
-      t.feature_dim = C;
-      t.features = t.scores;
+      for (std::size_t l = 0; l < layers.size(); ++l) {
+        TargetLayer t;
+        t.segmentation = std::move(segs[k][l]);
+        t.scores = classifier.predictProbabilities(desc[k][l]);
+        // In the class-score space of the built-in backend a target's feature is its scores.
+        t.feature_dim = C;
+        t.features = t.scores;
+        out[k].layers.push_back(std::move(t));
+      }
     }
     return out;
   }
 
  private:
+  using Segmenter = std::function<Segmentation(const io::View&)>;
+
+  /// The mask generator of each layer (finest first).
+  std::vector<Segmenter> segmenters() const {
+    std::vector<Segmenter> out;
+    if (options_.targets == MaskGenerator::kGraph) {
+      const GraphSegmentationOptions o = options_.graph;
+      out.push_back([o](const io::View& v) { return graphSegmentation(v.rgb, v.mask, o); });
+      return out;
+    }
+    std::vector<int> factors{1};
+    if (options_.targets == MaskGenerator::kSlicMultiscale) factors = options_.multiscale;
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      if (factors[i] < 1 || (i > 0 && factors[i] <= factors[i - 1])) {
+        throw Error("<pseudo-labels builtin>", "multiscale factors",
+                    "ascending integers >= 1, e.g. 1,2,4");
+      }
+      SlicOptions o = options_.superpixels;
+      o.region_size *= factors[i];
+      out.push_back([o](const io::View& v) { return slicSuperpixels(v.rgb, v.mask, o); });
+    }
+    return out;
+  }
+
+  /// Appends the regions of a labelled view whose majority label covers at least min_purity of
+  /// their labelled pixels (ignore pixels count against purity) as classifier examples.
+  void addLabelledRegions(const io::View& v, const Segmentation& seg,
+                          const std::vector<float>& desc, int C, int view_index,
+                          std::vector<float>& x, std::vector<int>& y,
+                          std::vector<int>& group) const {
+    std::vector<std::vector<int>> hist(seg.num_regions, std::vector<int>(C + 1, 0));
+    for (std::size_t i = 0; i < seg.region.size(); ++i) {
+      const int r = seg.region[i];
+      if (r < 0) continue;
+      const int l = v.labels.pixels[i];
+      hist[r][l < C ? l : C]++;
+    }
+    for (int r = 0; r < seg.num_regions; ++r) {
+      int total = 0, best = 0;
+      for (int c = 0; c <= C; ++c) total += hist[r][c];
+      for (int c = 1; c < C; ++c)
+        if (hist[r][c] > hist[r][best]) best = c;
+      if (total == 0 || hist[r][best] < options_.min_purity * total) continue;
+      x.insert(x.end(), desc.begin() + static_cast<std::ptrdiff_t>(r) * kRegionFeatureDim,
+               desc.begin() + static_cast<std::ptrdiff_t>(r + 1) * kRegionFeatureDim);
+      y.push_back(best);
+      group.push_back(view_index);
+    }
+  }
+
   BuiltinOptions options_;
 };
 

@@ -1,9 +1,88 @@
 #include "sadsplat/pseudo_labels/generator.h"
 
+#include <unordered_map>
+
 #include "sadsplat/common/error.h"
 
 namespace sadsplat {
 namespace pseudo_labels {
+
+TargetLayer resolveLayers(const std::vector<TargetLayer>& layers,
+                          const std::vector<std::vector<double>>& top1,
+                          const std::vector<std::vector<std::uint8_t>>& kept,
+                          std::vector<std::uint8_t>& refined_kept) {
+  if (layers.empty()) throw Error("<pseudo-labels>", "target layers", "at least one layer");
+  const TargetLayer& base = layers[0];
+  const std::size_t pixels = base.segmentation.region.size();
+  const int C = base.segmentation.num_regions > 0
+                    ? static_cast<int>(base.scores.size() / base.segmentation.num_regions)
+                    : 0;
+  for (std::size_t l = 1; l < layers.size(); ++l) {
+    const Segmentation& s = layers[l].segmentation;
+    if (s.width != base.segmentation.width || s.height != base.segmentation.height ||
+        s.region.size() != pixels || layers[l].feature_dim != base.feature_dim) {
+      throw Error("<pseudo-labels>", "target layer " + std::to_string(l),
+                  "the size and feature dimension of layer 0");
+    }
+  }
+
+  // Common refinement, one layer at a time: a refined region is a distinct tuple of targets
+  // (-1 where a layer has no target at the pixel; pixels of no target in any layer stay -1).
+  std::vector<std::int32_t> refined = base.segmentation.region;
+  std::vector<std::vector<int>> cover(layers.size());  // [layer][refined region] -> target|-1
+  cover[0].resize(base.segmentation.num_regions);
+  for (int r = 0; r < base.segmentation.num_regions; ++r) cover[0][r] = r;
+  for (std::size_t l = 1; l < layers.size(); ++l) {
+    const std::vector<std::int32_t>& other = layers[l].segmentation.region;
+    std::unordered_map<std::int64_t, int> ids;
+    std::vector<std::vector<int>> next(layers.size());
+    for (std::size_t i = 0; i < pixels; ++i) {
+      if (refined[i] < 0 && other[i] < 0) continue;
+      const std::int64_t key = (static_cast<std::int64_t>(refined[i] + 1) << 32) | (other[i] + 1);
+      auto it = ids.find(key);
+      if (it == ids.end()) {
+        it = ids.emplace(key, static_cast<int>(ids.size())).first;
+        for (std::size_t m = 0; m < l; ++m) {
+          next[m].push_back(refined[i] >= 0 ? cover[m][refined[i]] : -1);
+        }
+        next[l].push_back(other[i]);
+      }
+      refined[i] = it->second;
+    }
+    cover = std::move(next);
+  }
+
+  const int n = static_cast<int>(cover[0].size());
+  TargetLayer out;
+  out.segmentation = base.segmentation;
+  out.segmentation.region = std::move(refined);
+  out.segmentation.num_regions = n;
+  out.feature_dim = base.feature_dim;
+  out.scores.resize(static_cast<std::size_t>(n) * C);
+  out.features.resize(static_cast<std::size_t>(n) * base.feature_dim);
+  refined_kept.assign(n, 0);
+  for (int r = 0; r < n; ++r) {
+    // Default: the finest layer with a target here; then the kept target of highest TOP1.
+    std::size_t layer = 0;
+    while (cover[layer][r] < 0) ++layer;
+    int target = cover[layer][r];
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+      const int t = cover[l][r];
+      if (t >= 0 && kept[l][t] && (!refined_kept[r] || top1[l][t] > top1[layer][target])) {
+        layer = l;
+        target = t;
+        refined_kept[r] = 1;
+      }
+    }
+    const TargetLayer& src = layers[layer];
+    std::copy_n(src.scores.begin() + static_cast<std::ptrdiff_t>(target) * C, C,
+                out.scores.begin() + static_cast<std::ptrdiff_t>(r) * C);
+    std::copy_n(src.features.begin() + static_cast<std::ptrdiff_t>(target) * src.feature_dim,
+                src.feature_dim,
+                out.features.begin() + static_cast<std::ptrdiff_t>(r) * out.feature_dim);
+  }
+  return out;
+}
 
 PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                                         const PseudoLabelOptions& options,
@@ -22,12 +101,17 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                 std::to_string(views.size()), std::to_string(targets.size()));
   }
 
-  // The statistics are taken over all targets of the training set (paper).
+  // The statistics are taken over all targets of the training set (paper), of every layer.
   std::vector<TargetMeasures> measures;
   for (const ViewTargets& t : targets) {
-    for (int r = 0; r < t.segmentation.num_regions; ++r) {
-      measures.push_back(
-          measureTarget(&t.scores[static_cast<std::size_t>(r) * C], C, options.scale));
+    if (t.layers.empty()) {
+      throw Error("<pseudo-labels " + scorer.name() + ">", "target layers", "at least one");
+    }
+    for (const TargetLayer& layer : t.layers) {
+      for (int r = 0; r < layer.segmentation.num_regions; ++r) {
+        measures.push_back(
+            measureTarget(&layer.scores[static_cast<std::size_t>(r) * C], C, options.scale));
+      }
     }
   }
   PseudoLabelSummary summary;
@@ -38,20 +122,32 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
   std::size_t m = 0;
   for (std::size_t k = 0; k < views.size(); ++k) {
     io::View& v = scene.views[views[k]];
-    ViewTargets& t = targets[k];
+    std::vector<TargetLayer>& layers = targets[k].layers;
+    std::vector<std::vector<double>> top1(layers.size());
+    std::vector<std::vector<std::uint8_t>> kept(layers.size());
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+      for (int r = 0; r < layers[l].segmentation.num_regions; ++r, ++m) {
+        const bool keep = keepTarget(measures[m], summary.statistics, options.filter_k);
+        top1[l].push_back(measures[m].top1);
+        kept[l].push_back(keep ? 1 : 0);
+        summary.kept_targets += keep ? 1 : 0;
+      }
+    }
     io::ViewPseudoLabels& p = v.pseudo;
     p.backend = scorer.name();
-    p.region = std::move(t.segmentation.region);
-    p.num_targets = t.segmentation.num_regions;
-    p.num_classes = C;
-    p.scores = std::move(t.scores);
-    p.feature_dim = t.feature_dim;
-    p.features = std::move(t.features);
-    p.kept.assign(p.num_targets, 0);
-    for (int r = 0; r < p.num_targets; ++r, ++m) {
-      p.kept[r] = keepTarget(measures[m], summary.statistics, options.filter_k) ? 1 : 0;
-      summary.kept_targets += p.kept[r];
+    TargetLayer stored;
+    if (layers.size() == 1) {
+      stored = std::move(layers[0]);
+      p.kept = std::move(kept[0]);
+    } else {
+      stored = resolveLayers(layers, top1, kept, p.kept);
     }
+    p.region = std::move(stored.segmentation.region);
+    p.num_targets = stored.segmentation.num_regions;
+    p.num_classes = C;
+    p.scores = std::move(stored.scores);
+    p.feature_dim = stored.feature_dim;
+    p.features = std::move(stored.features);
     p.validate(scene.source + " (view " + v.name + ", backend " + scorer.name() + ")",
                static_cast<std::size_t>(v.camera.width) * v.camera.height);
   }

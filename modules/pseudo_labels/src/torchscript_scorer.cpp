@@ -72,10 +72,10 @@ class TorchScriptScorer : public TargetScorer {
     std::vector<ViewTargets> out;
     for (std::size_t k = 0; k < views.size(); ++k) {
       const io::View& v = scene.views[views[k]];
-      out.push_back(scoreView(v, text, logit_scale));
+      out.push_back({{scoreView(v, text, logit_scale)}});
       if (progress) {
         progress("view " + std::to_string(k + 1) + "/" + std::to_string(views.size()) + " " +
-                 v.name + ": " + std::to_string(out.back().segmentation.num_regions) +
+                 v.name + ": " + std::to_string(out.back().layers[0].segmentation.num_regions) +
                  " SAM targets");
       }
     }
@@ -101,7 +101,7 @@ class TorchScriptScorer : public TargetScorer {
     return t / t.norm(2, 1, true).clamp_min(1e-12);
   }
 
-  ViewTargets scoreView(const io::View& v, const at::Tensor& text, double logit_scale) {
+  TargetLayer scoreView(const io::View& v, const at::Tensor& text, double logit_scale) {
     const int W = v.camera.width, H = v.camera.height;
     const at::Tensor rgb =
         at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()), {H, W, 3}, at::kByte)
@@ -195,7 +195,7 @@ class TorchScriptScorer : public TargetScorer {
     for (std::size_t t = 0; t < kept.size(); ++t) {
       if (counts[t].item<std::int64_t>() >= options_.min_mask_pixels) remap[t] = next++;
     }
-    ViewTargets vt;
+    TargetLayer vt;
     vt.segmentation.width = W;
     vt.segmentation.height = H;
     vt.segmentation.num_regions = next;

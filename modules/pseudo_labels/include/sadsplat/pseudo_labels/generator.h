@@ -4,6 +4,7 @@
 /// against every class with a backend, applies the TOP1 / dTOP / entropy filter over all targets
 /// of the training set, and stores the result in each view's io::ViewPseudoLabels.
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -18,13 +19,35 @@
 namespace sadsplat {
 namespace pseudo_labels {
 
-/// \brief The targets of one view with their class scores and features.
-struct ViewTargets {
+/// \brief One partition of a view into targets, with their class scores and features.
+struct TargetLayer {
   Segmentation segmentation;
   std::vector<float> scores;  ///< num_regions x C, rows are distributions
   int feature_dim = 0;
   std::vector<float> features;  ///< num_regions x feature_dim
 };
+
+/// \brief The targets of one view: one or more layers of the same image size. Targets of
+/// different layers overlap (multi-granularity masks, like SAM's whole / part / sub-part); every
+/// target of every layer is one sample of the filter. Layer 0 is the finest.
+struct ViewTargets {
+  std::vector<TargetLayer> layers;
+};
+
+/// \brief Resolves overlapping layers into the one partition that io::ViewPseudoLabels stores:
+/// the common refinement of the layers. Each refined region takes the kept target with the
+/// highest TOP1 among the targets that cover it, or, when none of them is kept, the target of the
+/// finest layer that has one there (scores and features copied, not kept). Pixels of no target
+/// in any layer (-1) stay -1.
+/// \param[in] layers the view's layers (same size and valid pixels)
+/// \param[in] top1 per layer, per target: the TOP1 measure of the filter
+/// \param[in] kept per layer, per target: the filter's decision
+/// \param[out] refined_kept per refined region: kept
+/// \throws sadsplat::Error if there is no layer or the layers differ in size or feature dim
+TargetLayer resolveLayers(const std::vector<TargetLayer>& layers,
+                          const std::vector<std::vector<double>>& top1,
+                          const std::vector<std::vector<std::uint8_t>>& kept,
+                          std::vector<std::uint8_t>& refined_kept);
 
 /// \brief Progress lines ("view 12/67 ..."); may be empty.
 using ProgressFn = std::function<void(const std::string&)>;
@@ -44,6 +67,9 @@ class TargetScorer {
 enum class MaskGenerator {
   kSlic,   ///< SLIC superpixels: equal-size targets
   kGraph,  ///< graph-based segmentation: large targets in homogeneous areas
+  /// SLIC at the region sizes S * scale for each of `multiscale` (overlapping layers; S is
+  /// SlicOptions::region_size), one classifier fitted on the labelled regions of every layer
+  kSlicMultiscale,
 };
 
 /// \brief Options of the built-in backend.
@@ -51,6 +77,7 @@ struct BuiltinOptions {
   MaskGenerator targets = MaskGenerator::kSlic;
   SlicOptions superpixels;
   GraphSegmentationOptions graph;
+  std::vector<int> multiscale{1, 2, 4};  ///< region-size factors of kSlicMultiscale, ascending
   ClassifierOptions classifier;
   bool geometry = true;     ///< use the sparse points' heights as a descriptor
   double min_purity = 0.7;  ///< a labelled region trains the scorer if this share agrees
