@@ -119,3 +119,86 @@ TEST(PseudoLabelQuality, HandComputedPrecisionCoverageAndReliability) {
   EXPECT_DOUBLE_EQ(q2.precision, 1.0);
   EXPECT_DOUBLE_EQ(q2.coverage, 0.5);
 }
+
+// Overlapping layers resolved by hand: 6 pixels in a row, two classes.
+//   layer 0 targets: [0 0 1 2 -1 -1], TOP1 2 1 1, kept 1 0 0
+//   layer 1 targets: [0 0 0 1  1 -1], TOP1 3 0,   kept 1 0
+// Refined regions: pixels {0,1} -> layer-1 target 0 (kept, higher TOP1 than layer-0 target 0);
+// {2} -> layer-1 target 0 (the only kept cover); {3} -> layer-0 target 2 (none kept: finest);
+// {4} -> layer-1 target 1 (no layer-0 target there); pixel 5 -> no target.
+TEST(ResolveLayers, HandMadeOverlapTakesTheBestKeptCover) {
+  auto layer = [](std::vector<std::int32_t> region, int n, std::vector<float> scores) {
+    sp::TargetLayer t;
+    t.segmentation.width = 6;
+    t.segmentation.height = 1;
+    t.segmentation.num_regions = n;
+    t.segmentation.region = std::move(region);
+    t.scores = scores;
+    t.feature_dim = 2;
+    for (float& s : scores) s *= 10;  // features distinct from scores
+    t.features = scores;
+    return t;
+  };
+  const std::vector<sp::TargetLayer> layers = {
+      layer({0, 0, 1, 2, -1, -1}, 3, {0.9f, 0.1f, 0.6f, 0.4f, 0.2f, 0.8f}),
+      layer({0, 0, 0, 1, 1, -1}, 2, {0.3f, 0.7f, 0.5f, 0.5f})};
+  std::vector<std::uint8_t> kept;
+  const sp::TargetLayer out =
+      sp::resolveLayers(layers, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept);
+  ASSERT_EQ(out.segmentation.num_regions, 4);
+  const std::vector<std::int32_t>& r = out.segmentation.region;
+  EXPECT_EQ(r[0], r[1]);
+  EXPECT_EQ(r[5], -1);
+  const std::vector<std::vector<float>> expected_scores = {
+      {0.3f, 0.7f}, {0.3f, 0.7f}, {0.3f, 0.7f}, {0.2f, 0.8f}, {0.5f, 0.5f}};
+  const std::vector<int> expected_kept = {1, 1, 1, 0, 0};
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_GE(r[i], 0) << i;
+    EXPECT_FLOAT_EQ(out.scores[2 * r[i]], expected_scores[i][0]) << i;
+    EXPECT_FLOAT_EQ(out.scores[2 * r[i] + 1], expected_scores[i][1]) << i;
+    EXPECT_FLOAT_EQ(out.features[2 * r[i]], 10 * expected_scores[i][0]) << i;
+    EXPECT_EQ(kept[r[i]], expected_kept[i]) << i;
+  }
+  for (int i = 2; i < 5; ++i) EXPECT_NE(r[i], r[i - 1]) << i;
+
+  sp::TargetLayer wrong = layers[1];
+  wrong.segmentation.width = 3;
+  wrong.segmentation.height = 2;
+  EXPECT_THROW(
+      sp::resolveLayers({layers[0], wrong}, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept),
+      sadsplat::Error);
+  EXPECT_THROW(sp::resolveLayers({}, {}, {}, kept), sadsplat::Error);
+}
+
+TEST(PseudoLabelGenerator, MultiscaleTargetsRefineTheFinestLayerAndStayRight) {
+  io::Scene single = sadsplat::test::toyPseudoLabelScene();
+  io::Scene multi = single;
+  sp::BuiltinOptions o = smallOptions();
+  const sp::PseudoLabelSummary s1 = sp::generatePseudoLabels(single, *sp::makeBuiltinScorer(o));
+  o.targets = sp::MaskGenerator::kSlicMultiscale;
+  o.multiscale = {1, 2};
+  const sp::PseudoLabelSummary s2 = sp::generatePseudoLabels(multi, *sp::makeBuiltinScorer(o));
+  // Every target of both layers is a sample of the filter.
+  EXPECT_GT(s2.targets, s1.targets);
+  for (std::size_t k = 0; k < multi.views.size(); ++k) {
+    const io::View& v = multi.views[k];
+    if (!v.train) continue;
+    EXPECT_NO_THROW(v.pseudo.validate("test", v.rgb.pixels.size() / 3));
+    // The stored partition refines the finest layer (the single-scale SLIC targets).
+    const std::vector<std::int32_t>& fine = single.views[k].pseudo.region;
+    std::vector<int> parent(v.pseudo.num_targets, -2);
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+      const int r = v.pseudo.region[i];
+      ASSERT_EQ(r < 0, fine[i] < 0) << i;
+      if (r < 0) continue;
+      if (parent[r] == -2) parent[r] = fine[i];
+      EXPECT_EQ(parent[r], fine[i]) << "stored region " << r << " spans two finest targets";
+    }
+  }
+  const sp::PseudoLabelQuality q = sp::evaluatePseudoLabels(multi);
+  EXPECT_GT(q.coverage, 0.05);
+  EXPECT_GE(q.precision, 0.97);
+
+  o.multiscale = {2, 1};
+  EXPECT_THROW(sp::generatePseudoLabels(multi, *sp::makeBuiltinScorer(o)), sadsplat::Error);
+}
