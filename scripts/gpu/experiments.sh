@@ -10,7 +10,8 @@
 #        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
 #        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X.
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
-# summary_KIND_SEED.txt.
+# summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
+# name suffix for the work dir and the outputs, so that two label variants can run side by side).
 set -uo pipefail
 # One training at 800x450 peaks near 30 GB of GPU memory on city (measured: 5 or 3 at once ran
 # out of memory on an 80 GB H100), so 2 at once is the default.
@@ -25,13 +26,14 @@ mkdir -p "$out"
 [ -x build-gpu/bin/sadsplat ] || bash scripts/gpu/build.sh > /tmp/sadsplat-build.log 2>&1 || { tail -30 /tmp/sadsplat-build.log; exit 1; }
 export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=build-gpu/bin/sadsplat
-work=/tmp/sadsplat-exp/${kind}_${seed}
+tag="${kind}_${seed}${PL_TAG:-}"
+work=/tmp/sadsplat-exp/$tag
 res=$work/results
 mkdir -p "$res"
 cache="$work/scene.cache"
 [ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" > "$res/synth.log" 2>&1
 [ -f "$work/scene_pl.cache" ] || /usr/bin/time -v "$bin" pseudo-labels "$cache" --out "$work/scene_pl.cache" \
-  --report "$res/pseudo_report" > "$res/pseudo_labels.log" 2>&1
+  --report "$res/pseudo_report" ${PL_ARGS:-} > "$res/pseudo_labels.log" 2>&1
 echo "prepared in $(( $(date +%s) - start )) s"
 
 train_one() {
@@ -66,10 +68,10 @@ for name in "${runs[@]}"; do
 done
 wait
 
-python3 - "$res" "$kind" "$seed" > "$out/summary_${kind}_${seed}.txt" <<'PY'
+python3 - "$res" "$kind" "$seed" "${PL_ARGS:-}" > "$out/summary_$tag.txt" <<'PY'
 import glob, json, os, sys
-res, kind, seed = sys.argv[1:]
-print(f"{kind} seed {seed}, 800x450, 7000 iterations, H100, several runs at once")
+res, kind, seed, pl_args = sys.argv[1:]
+print(f"{kind} seed {seed}, 800x450, 7000 iterations, H100, several runs at once; pseudo-labels args: '{pl_args}'")
 rows = []
 for f in sorted(glob.glob(os.path.join(res, "metrics_*.json"))):
     name = os.path.basename(f)[8:-5]
@@ -84,9 +86,9 @@ rep = os.path.join(res, "pseudo_report", "report.txt")
 if os.path.exists(rep):
     print(open(rep).read())
 PY
-grep -h 'builtin:\|Elapsed\|Maximum resident' "$res/pseudo_labels.log" >> "$out/summary_${kind}_${seed}.txt" || true
+grep -h 'builtin:\|Elapsed\|Maximum resident' "$res/pseudo_labels.log" >> "$out/summary_$tag.txt" || true
 for f in "$res"/train_*.log; do tr '\r' '\n' < "$f" | grep '^\[drop\]\|semantic supervision' | tail -3 | sed "s|^|$(basename "$f"): |"; done \
-  >> "$out/summary_${kind}_${seed}.txt"
-tar -czf "$out/results_${kind}_${seed}.tar.gz" -C "$work" results
-cat "$out/summary_${kind}_${seed}.txt"
+  >> "$out/summary_$tag.txt"
+tar -czf "$out/results_$tag.tar.gz" -C "$work" results
+cat "$out/summary_$tag.txt"
 echo "total $(( $(date +%s) - start )) s"
