@@ -199,11 +199,6 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   pseudo
-      ->add_option("--object-delta-e", pseudo_options.builtin.object_delta_e,
-                   "builtin: > 0 adds a layer of object targets (adjacent finest targets of the "
-                   "same class and colour within this CIELab distance, merged)")
-      ->capture_default_str();
-  pseudo
       ->add_option("--graph-k", pseudo_options.builtin.graph.k,
                    "builtin, graph: merge threshold scale k")
       ->capture_default_str();

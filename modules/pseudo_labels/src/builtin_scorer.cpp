@@ -3,11 +3,8 @@
 // label of sufficiently pure regions, of every layer).
 #include <ATen/Parallel.h>
 
-#include <array>
-#include <cmath>
 #include <functional>
 #include <map>
-#include <numeric>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/pseudo_labels/generator.h"
@@ -16,76 +13,6 @@
 namespace sadsplat {
 namespace pseudo_labels {
 namespace {
-
-// Object-level targets from a fine partition: adjacent regions with the same most likely class
-// whose colours (CIELab means) differ by at most `max_delta_e` are merged, most similar pairs
-// first, comparing the merged components' mean colours. Only components of two or more regions
-// become targets (the others would repeat a fine target); their pixels are -1 otherwise.
-Segmentation mergeAgreeingRegions(const Segmentation& fine, const std::vector<float>& desc,
-                                  const std::vector<float>& probs, int C, double max_delta_e) {
-  const int n = fine.num_regions;
-  std::vector<int> cls(n, 0), size(n, 0);
-  std::vector<std::array<double, 3>> lab(n);
-  for (int r = 0; r < n; ++r) {
-    const float* p = &probs[static_cast<std::size_t>(r) * C];
-    cls[r] = static_cast<int>(std::max_element(p, p + C) - p);
-    for (int c = 0; c < 3; ++c)
-      lab[r][c] = 100.0 * desc[static_cast<std::size_t>(r) * kRegionFeatureDim + c];
-  }
-  for (std::int32_t r : fine.region)
-    if (r >= 0) ++size[r];
-  std::vector<std::pair<int, int>> pairs;
-  const int W = fine.width, H = fine.height;
-  for (int y = 0; y < H; ++y) {
-    for (int x = 0; x < W; ++x) {
-      const int a = fine.region[static_cast<std::size_t>(y) * W + x];
-      if (a < 0) continue;
-      const int right = x + 1 < W ? fine.region[static_cast<std::size_t>(y) * W + x + 1] : -1;
-      const int down = y + 1 < H ? fine.region[static_cast<std::size_t>(y + 1) * W + x] : -1;
-      for (int b : {right, down}) {
-        if (b >= 0 && b != a && cls[a] == cls[b])
-          pairs.emplace_back(std::min(a, b), std::max(a, b));
-      }
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  auto dist = [&](int a, int b) {
-    double d = 0;
-    for (int c = 0; c < 3; ++c) d += (lab[a][c] - lab[b][c]) * (lab[a][c] - lab[b][c]);
-    return std::sqrt(d);
-  };
-  std::sort(pairs.begin(), pairs.end(), [&](const auto& p, const auto& q) {
-    return dist(p.first, p.second) < dist(q.first, q.second);
-  });
-  std::vector<int> parent(n), members(n, 1);
-  std::iota(parent.begin(), parent.end(), 0);
-  std::function<int(int)> find = [&](int a) {
-    return parent[a] == a ? a : parent[a] = find(parent[a]);
-  };
-  for (const auto& [a0, b0] : pairs) {
-    const int a = find(a0), b = find(b0);
-    if (a == b || dist(a, b) > max_delta_e) continue;
-    const double wa = size[a], wb = size[b];
-    for (int c = 0; c < 3; ++c) lab[a][c] = (wa * lab[a][c] + wb * lab[b][c]) / (wa + wb);
-    size[a] += size[b];
-    members[a] += members[b];
-    parent[b] = a;
-  }
-  Segmentation out;
-  out.width = W;
-  out.height = H;
-  std::vector<int> id(n, -1);
-  for (int r = 0; r < n; ++r) {
-    const int root = find(r);
-    if (members[root] >= 2 && id[root] < 0) id[root] = out.num_regions++;
-  }
-  out.region.resize(fine.region.size(), -1);
-  for (std::size_t i = 0; i < fine.region.size(); ++i) {
-    if (fine.region[i] >= 0) out.region[i] = id[find(fine.region[i])];
-  }
-  return out;
-}
 
 class BuiltinScorer : public TargetScorer {
  public:
@@ -155,16 +82,6 @@ class BuiltinScorer : public TargetScorer {
         t.segmentation = std::move(segs[k][l]);
         t.scores = classifier.predictProbabilities(desc[k][l]);
         // In the class-score space of the built-in backend a target's feature is its scores.
-        t.feature_dim = C;
-        t.features = t.scores;
-        out[k].layers.push_back(std::move(t));
-      }
-      if (options_.object_delta_e > 0) {
-        const io::View& v = scene.views[views[k]];
-        TargetLayer t;
-        t.segmentation = mergeAgreeingRegions(out[k].layers[0].segmentation, desc[k][0],
-                                              out[k].layers[0].scores, C, options_.object_delta_e);
-        t.scores = classifier.predictProbabilities(regionFeatures(scene, v, t.segmentation, g));
         t.feature_dim = C;
         t.features = t.scores;
         out[k].layers.push_back(std::move(t));

@@ -78,7 +78,6 @@ struct BuiltinOptions {
   SlicOptions superpixels;
   GraphSegmentationOptions graph;
   std::vector<int> multiscale{1, 2, 4};  ///< region-size factors of kSlicMultiscale, ascending
-  double object_delta_e = 0;  ///< > 0: add a layer of merged same-class regions (CIELab dE)
   ClassifierOptions classifier;
   bool geometry = true;     ///< use the sparse points' heights as a descriptor
   double min_purity = 0.7;  ///< a labelled region trains the scorer if this share agrees
