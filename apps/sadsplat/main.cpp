@@ -176,6 +176,9 @@ int main(int argc, char** argv) {
       ->add_option("--filter-k", pseudo_options.filter.filter_k,
                    "thresholds mean + k std (paper: 1)")
       ->capture_default_str();
+  pseudo->add_flag("--filter-per-class", pseudo_options.filter.per_class,
+                   "class-balanced filter: mean + k std over the targets of each TOP1 class (not "
+                   "the paper)");
   pseudo
       ->add_option("--region-size", pseudo_options.builtin.superpixels.region_size,
                    "builtin: superpixel size in pixels")

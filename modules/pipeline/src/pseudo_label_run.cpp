@@ -1,6 +1,7 @@
 #include "sadsplat/pipeline/pseudo_label_run.h"
 
 #include <chrono>
+#include <sstream>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
@@ -88,13 +89,22 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   io::writeSceneCache(out, scene);
   if (o.progress) {
+    const double k = o.filter.filter_k;
+    auto thresholds = [k](const pseudo_labels::TargetStatistics& t) {
+      std::ostringstream line;
+      line << "TOP1 > " << t.top1_mean + k * t.top1_std << ", dTOP > "
+           << t.delta_top_mean + k * t.delta_top_std << ", entropy < "
+           << t.entropy_mean + k * t.entropy_std;
+      return line.str();
+    };
     *o.progress << s.backend << ": " << s.views << " training views, " << s.targets << " targets, "
-                << s.kept_targets << " kept (TOP1 > "
-                << s.statistics.top1_mean + o.filter.filter_k * s.statistics.top1_std << ", dTOP > "
-                << s.statistics.delta_top_mean + o.filter.filter_k * s.statistics.delta_top_std
-                << ", entropy < "
-                << s.statistics.entropy_mean + o.filter.filter_k * s.statistics.entropy_std
+                << s.kept_targets << " kept ("
+                << (s.class_statistics.empty() ? thresholds(s.statistics) : "per TOP1 class")
                 << ") in " << seconds << " s; wrote " << out << "\n";
+    for (std::size_t c = 0; c < s.class_statistics.size(); ++c) {
+      *o.progress << "  " << scene.classes[c].name << ": " << thresholds(s.class_statistics[c])
+                  << "\n";
+    }
   }
   if (o.report_dir.empty()) return "";
   io::makeDirectory(o.report_dir);

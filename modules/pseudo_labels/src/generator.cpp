@@ -119,6 +119,7 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
   summary.views = static_cast<int>(views.size());
   summary.statistics = targetStatistics(measures);
   summary.targets = measures.size();
+  if (options.per_class) summary.class_statistics = classStatistics(measures, C);
   std::size_t m = 0;
   for (std::size_t k = 0; k < views.size(); ++k) {
     io::View& v = scene.views[views[k]];
@@ -127,7 +128,12 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
     std::vector<std::vector<std::uint8_t>> kept(layers.size());
     for (std::size_t l = 0; l < layers.size(); ++l) {
       for (int r = 0; r < layers[l].segmentation.num_regions; ++r, ++m) {
-        const bool keep = keepTarget(measures[m], summary.statistics, options.filter_k);
+        const TargetMeasures& t = measures[m];
+        const bool keep =
+            keepTarget(t,
+                       options.per_class && t.top_class >= 0 ? summary.class_statistics[t.top_class]
+                                                             : summary.statistics,
+                       options.filter_k);
         top1[l].push_back(measures[m].top1);
         kept[l].push_back(keep ? 1 : 0);
         summary.kept_targets += keep ? 1 : 0;

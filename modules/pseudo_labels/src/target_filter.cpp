@@ -15,6 +15,7 @@ TargetMeasures measureTarget(const float* scores, int num_classes, ScoreScale sc
     if (s > top1) {
       top2 = top1;
       top1 = s;
+      m.top_class = c;
     } else if (s > top2) {
       top2 = s;
     }
@@ -59,6 +60,20 @@ TargetStatistics targetStatistics(const std::vector<TargetMeasures>& targets) {
   s.delta_top_std = std::sqrt(s.delta_top_std);
   s.entropy_std = std::sqrt(s.entropy_std);
   return s;
+}
+
+std::vector<TargetStatistics> classStatistics(const std::vector<TargetMeasures>& targets,
+                                              int num_classes, std::size_t min_targets) {
+  std::vector<std::vector<TargetMeasures>> by_class(num_classes);
+  for (const TargetMeasures& t : targets) {
+    if (t.top_class >= 0 && t.top_class < num_classes) by_class[t.top_class].push_back(t);
+  }
+  const TargetStatistics all = targetStatistics(targets);
+  std::vector<TargetStatistics> out;
+  for (const auto& members : by_class) {
+    out.push_back(members.size() >= min_targets ? targetStatistics(members) : all);
+  }
+  return out;
 }
 
 bool keepTarget(const TargetMeasures& t, const TargetStatistics& s, double k) {

@@ -94,6 +94,10 @@ struct PseudoLabelOptions {
   /// log-odds scale dTOP = log(p1 / p2) is, for CLIP, logit_scale * (cos1 - cos2): the paper's
   /// dTOP on cosine similarities up to a factor, which the mean + k std rule ignores.
   ScoreScale scale = ScoreScale::kLogOdds;
+  /// Class-balanced: mean and std over the targets of the same TOP1 class instead of over all
+  /// targets (not the paper). Pooled statistics keep the easy classes and starve the confusable
+  /// ones (road, paved, grass: < 1 % of their pixels), which biases the trained model.
+  bool per_class = false;
 };
 
 /// \brief What a run did.
@@ -101,7 +105,8 @@ struct PseudoLabelSummary {
   std::string backend;
   int views = 0;
   std::size_t targets = 0, kept_targets = 0;
-  TargetStatistics statistics;
+  TargetStatistics statistics;                     ///< over all targets
+  std::vector<TargetStatistics> class_statistics;  ///< per TOP1 class, when per_class
 };
 
 /// \brief Runs `scorer` on every training view of `scene`, filters, and fills `view.pseudo`

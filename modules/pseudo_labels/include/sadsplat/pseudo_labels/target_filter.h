@@ -15,6 +15,7 @@ struct TargetMeasures {
   double top1 = 0;
   double delta_top = 0;  ///< TOP1 - TOP2
   double entropy = 0;    ///< natural log, of the scores normalised to sum 1
+  int top_class = -1;    ///< the class of TOP1 (-1: no positive score)
 };
 
 /// \brief Mean and (population) standard deviation of each measure over a set of targets.
@@ -38,6 +39,11 @@ TargetMeasures measureTarget(const float* scores, int num_classes,
 
 /// \brief Statistics over the targets.
 TargetStatistics targetStatistics(const std::vector<TargetMeasures>& targets);
+
+/// \brief Statistics of the targets of each TOP1 class (class-balanced filtering), indexed by
+/// class; a class with fewer than `min_targets` targets gets the statistics over all targets.
+std::vector<TargetStatistics> classStatistics(const std::vector<TargetMeasures>& targets,
+                                              int num_classes, std::size_t min_targets = 10);
 
 /// \brief The keep rule with thresholds mean + k std.
 bool keepTarget(const TargetMeasures& target, const TargetStatistics& stats, double k = 1.0);
