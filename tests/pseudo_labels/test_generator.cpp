@@ -202,3 +202,27 @@ TEST(PseudoLabelGenerator, MultiscaleTargetsRefineTheFinestLayerAndStayRight) {
   o.multiscale = {2, 1};
   EXPECT_THROW(sp::generatePseudoLabels(multi, *sp::makeBuiltinScorer(o)), sadsplat::Error);
 }
+
+TEST(PseudoLabelGenerator, PerClassFilterUsesTheStatisticsOfEachClass) {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene();
+  sp::PseudoLabelOptions options;
+  const sp::PseudoLabelSummary pooled =
+      sp::generatePseudoLabels(scene, *sp::makeBuiltinScorer(smallOptions()), options);
+  EXPECT_TRUE(pooled.class_statistics.empty());
+  options.per_class = true;
+  const sp::PseudoLabelSummary s =
+      sp::generatePseudoLabels(scene, *sp::makeBuiltinScorer(smallOptions()), options);
+  ASSERT_EQ(s.class_statistics.size(), 3u);
+  EXPECT_EQ(s.targets, pooled.targets);
+  std::size_t per_class_targets = 0;
+  for (const sp::TargetStatistics& c : s.class_statistics) per_class_targets += c.count;
+  EXPECT_EQ(per_class_targets, s.targets);  // every toy class has enough targets of its own
+  std::vector<int> kept_pixels(3, 0);
+  for (const io::View& v : scene.views) {
+    if (!v.train) continue;
+    for (std::int16_t l : v.pseudo.labelMap())
+      if (l >= 0) ++kept_pixels[l];
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_GT(kept_pixels[c], 0) << "class " << c;
+  EXPECT_GE(sp::evaluatePseudoLabels(scene).precision, 0.97);
+}
