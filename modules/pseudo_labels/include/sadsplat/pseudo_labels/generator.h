@@ -83,8 +83,9 @@ struct BuiltinOptions {
   double min_purity = 0.7;  ///< a labelled region trains the scorer if this share agrees
 };
 
-/// \brief The built-in backend: SLIC targets, few-shot classifier fitted on the labelled views.
-/// \throws sadsplat::Error (from score) if no labelled view has labels
+/// \brief The built-in backend: targets from `options.targets`, few-shot classifier fitted on the
+/// labelled views.
+/// \throws sadsplat::Error (from score) if no labelled view has labels or the scales are bad
 TargetScorer::Ptr makeBuiltinScorer(const BuiltinOptions& options = {});
 
 /// \brief Options of a pseudo-label run.
