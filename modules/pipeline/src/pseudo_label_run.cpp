@@ -101,6 +101,10 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                 << s.kept_targets << " kept ("
                 << (s.class_statistics.empty() ? thresholds(s.statistics) : "per TOP1 class")
                 << ") in " << seconds << " s; wrote " << out << "\n";
+    if (s.kept_targets == 0) {
+      *o.progress << "warning: no target passed the filter, so no view gets pseudo-labels "
+                     "(training will use the ground truth only); try a smaller --filter-k\n";
+    }
     for (std::size_t c = 0; c < s.class_statistics.size(); ++c) {
       *o.progress << "  " << scene.classes[c].name << ": " << thresholds(s.class_statistics[c])
                   << "\n";

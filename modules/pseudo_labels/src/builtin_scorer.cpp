@@ -105,7 +105,7 @@ class BuiltinScorer : public TargetScorer {
     if (options_.targets == MaskGenerator::kSlicMultiscale) factors = options_.multiscale;
     for (std::size_t i = 0; i < factors.size(); ++i) {
       if (factors[i] < 1 || (i > 0 && factors[i] <= factors[i - 1])) {
-        throw Error("<pseudo-labels builtin>", "multiscale factors",
+        throw Error("<pseudo-labels builtin>", "multiscale factors (--scales)",
                     "ascending integers >= 1, e.g. 1,2,4");
       }
       SlicOptions o = options_.superpixels;
