@@ -180,6 +180,13 @@ int main(int argc, char** argv) {
                    "class-balanced filter: mean + k std over the targets of each TOP1 class (not "
                    "the paper)");
   pseudo
+      ->add_option(
+          "--min-class-precision", pseudo_options.filter.min_class_precision,
+          "remove the pseudo-labels of a class whose kept labels agree with the labelled "
+          "views' ground truth on fewer than this share of pixels (0 = off; not the paper)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  pseudo
       ->add_option("--region-size", pseudo_options.builtin.superpixels.region_size,
                    "builtin: superpixel size in pixels")
       ->capture_default_str();

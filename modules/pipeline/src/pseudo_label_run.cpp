@@ -101,6 +101,13 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                 << s.kept_targets << " kept ("
                 << (s.class_statistics.empty() ? thresholds(s.statistics) : "per TOP1 class")
                 << ") in " << seconds << " s; wrote " << out << "\n";
+    for (std::size_t c = 0; c < s.check_pixels.size(); ++c) {
+      if (s.check_pixels[c] == 0) continue;
+      *o.progress << "  check on the labelled views: " << scene.classes[c].name << " "
+                  << 100.0 * s.check_correct[c] / s.check_pixels[c] << " % of " << s.check_pixels[c]
+                  << " kept pixels right"
+                  << (s.class_rejected[c] ? " -> pseudo-labels of this class removed" : "") << "\n";
+    }
     if (s.kept_targets == 0) {
       *o.progress << "warning: no target passed the filter, so no view gets pseudo-labels "
                      "(training will use the ground truth only); try a smaller --filter-k\n";

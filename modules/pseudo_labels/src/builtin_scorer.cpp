@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <set>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/pseudo_labels/generator.h"
@@ -75,12 +76,34 @@ class BuiltinScorer : public TargetScorer {
                std::to_string(classifier.temperature()));
     }
 
+    // A labelled view is scored by a classifier fitted without it (when another labelled view
+    // exists), so that its scores, like those of the unlabelled views, are held out: the filter's
+    // statistics and the per-class reliability check then see the scorer as it is elsewhere.
+    std::map<int, FewShotClassifier> held_out;
+    const std::set<int> groups(group.begin(), group.end());
+    for (std::size_t k = 0; k < views.size() && groups.size() >= 2; ++k) {
+      if (!groups.count(views[k])) continue;
+      std::vector<float> xo;
+      std::vector<int> yo, go;
+      for (std::size_t i = 0; i < y.size(); ++i) {
+        if (group[i] == views[k]) continue;
+        xo.insert(xo.end(), x.begin() + static_cast<std::ptrdiff_t>(i) * kRegionFeatureDim,
+                  x.begin() + static_cast<std::ptrdiff_t>(i + 1) * kRegionFeatureDim);
+        yo.push_back(y[i]);
+        go.push_back(group[i]);
+      }
+      held_out.emplace(views[k], FewShotClassifier(options_.classifier))
+          .first->second.fit(xo, kRegionFeatureDim, yo, go, C);
+    }
+
     std::vector<ViewTargets> out(views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
+      const auto own = held_out.find(views[k]);
+      const FewShotClassifier& scorer = own != held_out.end() ? own->second : classifier;
       for (std::size_t l = 0; l < layers.size(); ++l) {
         TargetLayer t;
         t.segmentation = std::move(segs[k][l]);
-        t.scores = classifier.predictProbabilities(desc[k][l]);
+        t.scores = scorer.predictProbabilities(desc[k][l]);
         // In the class-score space of the built-in backend a target's feature is its scores.
         t.feature_dim = C;
         t.features = t.scores;

@@ -1,5 +1,6 @@
 #include "sadsplat/pseudo_labels/generator.h"
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "sadsplat/common/error.h"
@@ -84,6 +85,51 @@ TargetLayer resolveLayers(const std::vector<TargetLayer>& layers,
   return out;
 }
 
+namespace {
+
+int argmax(const float* scores, int C) {
+  return static_cast<int>(std::max_element(scores, scores + C) - scores);
+}
+
+// Per-class agreement of the kept pseudo-labels with the ground truth of the labelled training
+// views; classes below options.min_class_precision (with enough evidence) are unkept everywhere.
+void checkClassReliability(io::Scene& scene, const std::vector<int>& views,
+                           const PseudoLabelOptions& options, PseudoLabelSummary& summary) {
+  const int C = static_cast<int>(scene.classes.size());
+  summary.check_pixels.assign(C, 0);
+  summary.check_correct.assign(C, 0);
+  summary.class_rejected.assign(C, false);
+  for (int i : views) {
+    const io::View& v = scene.views[i];
+    if (!v.labelled || v.labels.empty()) continue;
+    const std::vector<std::int16_t> labels = v.pseudo.labelMap();
+    for (std::size_t px = 0; px < labels.size(); ++px) {
+      const int gt = v.labels.pixels[px];
+      if (labels[px] < 0 || gt >= C) continue;
+      ++summary.check_pixels[labels[px]];
+      summary.check_correct[labels[px]] += gt == labels[px] ? 1 : 0;
+    }
+  }
+  if (options.min_class_precision <= 0) return;
+  for (int c = 0; c < C; ++c) {
+    summary.class_rejected[c] =
+        summary.check_pixels[c] >= options.min_check_pixels &&
+        summary.check_correct[c] < options.min_class_precision * summary.check_pixels[c];
+  }
+  for (int i : views) {
+    io::ViewPseudoLabels& p = scene.views[i].pseudo;
+    for (int t = 0; t < p.num_targets; ++t) {
+      if (p.kept[t] &&
+          summary.class_rejected[argmax(&p.scores[static_cast<std::size_t>(t) * C], C)]) {
+        p.kept[t] = 0;
+        --summary.kept_targets;
+      }
+    }
+  }
+}
+
+}  // namespace
+
 PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                                         const PseudoLabelOptions& options,
                                         const ProgressFn& progress) {
@@ -157,6 +203,7 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
     p.validate(scene.source + " (view " + v.name + ", backend " + scorer.name() + ")",
                static_cast<std::size_t>(v.camera.width) * v.camera.height);
   }
+  checkClassReliability(scene, views, options, summary);
   return summary;
 }
 

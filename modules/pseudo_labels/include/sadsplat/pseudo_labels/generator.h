@@ -99,6 +99,11 @@ struct PseudoLabelOptions {
   /// targets (not the paper). Pooled statistics keep the easy classes and starve the confusable
   /// ones (road, paved, grass: < 1 % of their pixels), which biases the trained model.
   bool per_class = false;
+  /// Reliability check (not the paper): a class whose kept pseudo-labels are right on fewer than
+  /// this share of the labelled views' pixels (scored held out by the built-in backend) loses its
+  /// pseudo-labels everywhere; 0 = off. Needs `min_check_pixels` kept pixels of the class there.
+  double min_class_precision = 0;
+  std::size_t min_check_pixels = 500;
 };
 
 /// \brief What a run did.
@@ -108,6 +113,10 @@ struct PseudoLabelSummary {
   std::size_t targets = 0, kept_targets = 0;
   TargetStatistics statistics;                     ///< over all targets
   std::vector<TargetStatistics> class_statistics;  ///< per TOP1 class, when per_class
+  /// Per class, on the labelled training views: kept pseudo-label pixels and how many of them
+  /// agree with the ground truth (ignore pixels not counted).
+  std::vector<std::size_t> check_pixels, check_correct;
+  std::vector<bool> class_rejected;  ///< per class: pseudo-labels removed by the reliability check
 };
 
 /// \brief Runs `scorer` on every training view of `scene`, filters, and fills `view.pseudo`
