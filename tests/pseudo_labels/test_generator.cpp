@@ -226,3 +226,66 @@ TEST(PseudoLabelGenerator, PerClassFilterUsesTheStatisticsOfEachClass) {
   for (int c = 0; c < 3; ++c) EXPECT_GT(kept_pixels[c], 0) << "class " << c;
   EXPECT_GE(sp::evaluatePseudoLabels(scene).precision, 0.97);
 }
+
+namespace {
+// Five one-column targets per 5x2 view: columns 0 and 1 confident (class 0, class 2), the others
+// nearly uniform, so that the filter keeps exactly columns 0 and 1 (2 of 5 above mean + std).
+class ColumnScorer : public sp::TargetScorer {
+ public:
+  std::string name() const override { return "columns"; }
+  std::vector<sp::ViewTargets> score(const io::Scene& scene, const std::vector<int>& views,
+                                     const sp::ProgressFn&) override {
+    std::vector<sp::ViewTargets> out;
+    for (std::size_t k = 0; k < views.size(); ++k) {
+      sp::TargetLayer t;
+      t.segmentation.width = 5;
+      t.segmentation.height = 2;
+      t.segmentation.num_regions = 5;
+      for (int i = 0; i < 10; ++i) t.segmentation.region.push_back(i % 5);
+      t.scores = {0.96f, 0.02f, 0.02f, 0.02f, 0.02f, 0.96f, 0.34f, 0.33f,
+                  0.33f, 0.33f, 0.34f, 0.33f, 0.33f, 0.33f, 0.34f};
+      t.feature_dim = 3;
+      t.features = t.scores;
+      out.push_back({{t}});
+    }
+    (void)scene;
+    return out;
+  }
+};
+
+io::Scene columnScene() {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene(3, 5, 2);
+  // View 0 (labelled): column 0 is class 0 (the scorer is right), column 1 class 1 (the scorer
+  // says 2: wrong), the rest class 0.
+  for (int i = 0; i < 10; ++i) scene.views[0].labels.pixels[i] = i % 5 == 1 ? 1 : 0;
+  return scene;
+}
+}  // namespace
+
+TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass) {
+  io::Scene scene = columnScene();
+  ColumnScorer scorer;
+  sp::PseudoLabelOptions options;
+  sp::PseudoLabelSummary s = sp::generatePseudoLabels(scene, scorer, options);
+  ASSERT_EQ(s.kept_targets, 4u);  // columns 0 and 1 of the two training views
+  ASSERT_EQ(s.check_pixels.size(), 3u);
+  EXPECT_EQ(s.check_pixels[0], 2u);
+  EXPECT_EQ(s.check_correct[0], 2u);
+  EXPECT_EQ(s.check_pixels[2], 2u);
+  EXPECT_EQ(s.check_correct[2], 0u);
+  EXPECT_EQ(s.class_rejected, std::vector<bool>(3, false));  // off by default
+
+  options.min_class_precision = 0.9;
+  options.min_check_pixels = 2;
+  s = sp::generatePseudoLabels(scene, scorer, options);
+  EXPECT_EQ(s.class_rejected, (std::vector<bool>{false, false, true}));
+  EXPECT_EQ(s.kept_targets, 2u);
+  const std::vector<std::int16_t> unlabelled = scene.views[1].pseudo.labelMap();
+  EXPECT_EQ(unlabelled[0], 0);   // class 0 kept
+  EXPECT_EQ(unlabelled[1], -1);  // class 2 removed on the unlabelled view too
+
+  // Too little evidence: nothing is removed.
+  options.min_check_pixels = 3;
+  s = sp::generatePseudoLabels(scene, scorer, options);
+  EXPECT_EQ(s.kept_targets, 4u);
+}
