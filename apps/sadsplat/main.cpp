@@ -252,7 +252,14 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help / --version print and succeed; every usage error exits with 2 (CLI11's own codes
+    // vary by error kind).
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
   try {
     if (*info) {
       std::cout << sadsplat::io::describeFile(info_path);

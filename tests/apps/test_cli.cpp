@@ -36,7 +36,26 @@ TEST(Cli, BadInputGivesOneMessageAndNonZeroExit) {
   std::string out;
   EXPECT_EQ(test::runCommand(kCli + " info " + dir.file("bad.ply"), &out), 1);
   EXPECT_NE(out.find("bad.ply: magic: expected"), std::string::npos) << out;
-  EXPECT_NE(test::runCommand(kCli + " frobnicate", &out), 0);
+  EXPECT_EQ(test::runCommand(kCli + " frobnicate", &out), 2);
+}
+
+// The pseudo-label options reach the built-in backend (committed fixture cache: no OpenCV needed);
+// a bad value is a usage error (exit 2), a bad combination an error naming the option (exit 1).
+TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
+  test::TempDir dir;
+  const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  const std::string run = kCli + " pseudo-labels " + cache + " --out " + dir.file("pl.cache");
+  std::string out;
+  ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2", &out), 0) << out;
+  EXPECT_NE(out.find("83 targets"), std::string::npos) << out;  // 67 with one SLIC layer
+  EXPECT_NE(out.find("check on the labelled views"), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(run + " --filter-per-class", &out), 0) << out;
+  EXPECT_NE(out.find("per TOP1 class"), std::string::npos) << out;
+  EXPECT_NE(out.find("grass: TOP1 >"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(run + " --targets multiscale --scales 2,1", &out), 1) << out;
+  EXPECT_NE(out.find("--scales"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(run + " --min-class-precision 1.5", &out), 2) << out;
+  EXPECT_EQ(test::runCommand(run + " --targets foo", &out), 2) << out;
 }
 
 TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {
