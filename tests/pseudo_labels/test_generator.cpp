@@ -268,6 +268,7 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   sp::PseudoLabelOptions options;
   sp::PseudoLabelSummary s = sp::generatePseudoLabels(scene, scorer, options);
   ASSERT_EQ(s.kept_targets, 4u);  // columns 0 and 1 of the two training views
+  EXPECT_EQ(s.kept_regions, 4u);
   ASSERT_EQ(s.check_pixels.size(), 3u);
   EXPECT_EQ(s.check_pixels[0], 2u);
   EXPECT_EQ(s.check_correct[0], 2u);
@@ -279,7 +280,8 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   options.min_check_pixels = 2;
   s = sp::generatePseudoLabels(scene, scorer, options);
   EXPECT_EQ(s.class_rejected, (std::vector<bool>{false, false, true}));
-  EXPECT_EQ(s.kept_targets, 2u);
+  EXPECT_EQ(s.kept_targets, 4u);  // passed the filter
+  EXPECT_EQ(s.kept_regions, 2u);  // left after the check
   const std::vector<std::int16_t> unlabelled = scene.views[1].pseudo.labelMap();
   EXPECT_EQ(unlabelled[0], 0);   // class 0 kept
   EXPECT_EQ(unlabelled[1], -1);  // class 2 removed on the unlabelled view too
@@ -287,5 +289,5 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   // Too little evidence: nothing is removed.
   options.min_check_pixels = 3;
   s = sp::generatePseudoLabels(scene, scorer, options);
-  EXPECT_EQ(s.kept_targets, 4u);
+  EXPECT_EQ(s.kept_regions, 4u);
 }

@@ -108,8 +108,12 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                   << " kept pixels right"
                   << (s.class_rejected[c] ? " -> pseudo-labels of this class removed" : "") << "\n";
     }
-    if (s.kept_targets == 0) {
-      *o.progress << "warning: no target passed the filter, so no view gets pseudo-labels "
+    if (s.kept_regions != s.kept_targets) {
+      *o.progress << "  stored: " << s.kept_regions
+                  << " kept regions (overlaps resolved, classes removed by the check)\n";
+    }
+    if (s.kept_regions == 0) {
+      *o.progress << "warning: no kept target is left, so no view gets pseudo-labels "
                      "(training will use the ground truth only); try a smaller --filter-k\n";
     }
     for (std::size_t c = 0; c < s.class_statistics.size(); ++c) {

@@ -122,7 +122,6 @@ void checkClassReliability(io::Scene& scene, const std::vector<int>& views,
       if (p.kept[t] &&
           summary.class_rejected[argmax(&p.scores[static_cast<std::size_t>(t) * C], C)]) {
         p.kept[t] = 0;
-        --summary.kept_targets;
       }
     }
   }
@@ -204,6 +203,9 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                static_cast<std::size_t>(v.camera.width) * v.camera.height);
   }
   checkClassReliability(scene, views, options, summary);
+  for (int i : views) {
+    for (std::uint8_t k : scene.views[i].pseudo.kept) summary.kept_regions += k;
+  }
   return summary;
 }
 

@@ -110,7 +110,10 @@ struct PseudoLabelOptions {
 struct PseudoLabelSummary {
   std::string backend;
   int views = 0;
-  std::size_t targets = 0, kept_targets = 0;
+  std::size_t targets = 0, kept_targets = 0;  ///< all targets of all layers; passed the filter
+  /// Stored regions (the layers' common refinement, = targets with one layer) still kept after
+  /// the per-class check: what supervises training.
+  std::size_t kept_regions = 0;
   TargetStatistics statistics;                     ///< over all targets
   std::vector<TargetStatistics> class_statistics;  ///< per TOP1 class, when per_class
   /// Per class, on the labelled training views: kept pseudo-label pixels and how many of them
