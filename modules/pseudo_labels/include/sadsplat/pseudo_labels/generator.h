@@ -39,7 +39,7 @@ struct ViewTargets {
 /// highest TOP1 among the targets that cover it, or, when none of them is kept, the target of the
 /// finest layer that has one there (scores and features copied, not kept). Pixels of no target
 /// in any layer (-1) stay -1.
-/// \param[in] layers the view's layers (same size and valid pixels)
+/// \param[in] layers the view's layers (same image size and feature dimension)
 /// \param[in] top1 per layer, per target: the TOP1 measure of the filter
 /// \param[in] kept per layer, per target: the filter's decision
 /// \param[out] refined_kept per refined region: kept
