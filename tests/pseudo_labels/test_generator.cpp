@@ -144,7 +144,7 @@ TEST(ResolveLayers, HandMadeOverlapTakesTheBestKeptCover) {
       layer({0, 0, 0, 1, 1, -1}, 2, {0.3f, 0.7f, 0.5f, 0.5f})};
   std::vector<std::uint8_t> kept;
   const sp::TargetLayer out =
-      sp::resolveLayers(layers, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept);
+      sp::resolveLayers(layers, 2, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept);
   ASSERT_EQ(out.segmentation.num_regions, 4);
   const std::vector<std::int32_t>& r = out.segmentation.region;
   EXPECT_EQ(r[0], r[1]);
@@ -165,9 +165,9 @@ TEST(ResolveLayers, HandMadeOverlapTakesTheBestKeptCover) {
   wrong.segmentation.width = 3;
   wrong.segmentation.height = 2;
   EXPECT_THROW(
-      sp::resolveLayers({layers[0], wrong}, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept),
+      sp::resolveLayers({layers[0], wrong}, 2, {{2, 1, 1}, {3, 0}}, {{1, 0, 0}, {1, 0}}, kept),
       sadsplat::Error);
-  EXPECT_THROW(sp::resolveLayers({}, {}, {}, kept), sadsplat::Error);
+  EXPECT_THROW(sp::resolveLayers({}, 2, {}, {}, kept), sadsplat::Error);
 }
 
 TEST(PseudoLabelGenerator, MultiscaleTargetsRefineTheFinestLayerAndStayRight) {

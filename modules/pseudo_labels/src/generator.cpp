@@ -8,16 +8,13 @@
 namespace sadsplat {
 namespace pseudo_labels {
 
-TargetLayer resolveLayers(const std::vector<TargetLayer>& layers,
+TargetLayer resolveLayers(const std::vector<TargetLayer>& layers, int C,
                           const std::vector<std::vector<double>>& top1,
                           const std::vector<std::vector<std::uint8_t>>& kept,
                           std::vector<std::uint8_t>& refined_kept) {
   if (layers.empty()) throw Error("<pseudo-labels>", "target layers", "at least one layer");
   const TargetLayer& base = layers[0];
   const std::size_t pixels = base.segmentation.region.size();
-  const int C = base.segmentation.num_regions > 0
-                    ? static_cast<int>(base.scores.size() / base.segmentation.num_regions)
-                    : 0;
   for (std::size_t l = 1; l < layers.size(); ++l) {
     const Segmentation& s = layers[l].segmentation;
     if (s.width != base.segmentation.width || s.height != base.segmentation.height ||
@@ -168,7 +165,7 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
   std::size_t m = 0;
   for (std::size_t k = 0; k < views.size(); ++k) {
     io::View& v = scene.views[views[k]];
-    std::vector<TargetLayer>& layers = targets[k].layers;
+    const std::vector<TargetLayer>& layers = targets[k].layers;
     std::vector<std::vector<double>> top1(layers.size());
     std::vector<std::vector<std::uint8_t>> kept(layers.size());
     for (std::size_t l = 0; l < layers.size(); ++l) {
@@ -186,13 +183,7 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
     }
     io::ViewPseudoLabels& p = v.pseudo;
     p.backend = scorer.name();
-    TargetLayer stored;
-    if (layers.size() == 1) {
-      stored = std::move(layers[0]);
-      p.kept = std::move(kept[0]);
-    } else {
-      stored = resolveLayers(layers, top1, kept, p.kept);
-    }
+    TargetLayer stored = resolveLayers(layers, C, top1, kept, p.kept);
     p.region = std::move(stored.segmentation.region);
     p.num_targets = stored.segmentation.num_regions;
     p.num_classes = C;

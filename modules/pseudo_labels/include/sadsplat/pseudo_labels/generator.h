@@ -40,11 +40,12 @@ struct ViewTargets {
 /// finest layer that has one there (scores and features copied, not kept). Pixels of no target
 /// in any layer (-1) stay -1.
 /// \param[in] layers the view's layers (same image size and feature dimension)
+/// \param[in] C number of classes (columns of the scores)
 /// \param[in] top1 per layer, per target: the TOP1 measure of the filter
 /// \param[in] kept per layer, per target: the filter's decision
 /// \param[out] refined_kept per refined region: kept
 /// \throws sadsplat::Error if there is no layer or the layers differ in size or feature dim
-TargetLayer resolveLayers(const std::vector<TargetLayer>& layers,
+TargetLayer resolveLayers(const std::vector<TargetLayer>& layers, int C,
                           const std::vector<std::vector<double>>& top1,
                           const std::vector<std::vector<std::uint8_t>>& kept,
                           std::vector<std::uint8_t>& refined_kept);
