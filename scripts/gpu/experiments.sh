@@ -8,7 +8,8 @@
 # every run is stopped at it, so a device call returns in time with what finished.
 # Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
 #        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
-#        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X.
+#        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt
+#        pseudo_labels_train_decoder = false (e.g. none_decgt_pl).
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
 # summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
 # name suffix for the work dir and the outputs, so that two label variants can run side by side).
@@ -40,10 +41,13 @@ train_one() {
   local name="$1" left="$2"
   local args=() scene="$cache"
   case "$name" in *_pl) scene="$work/scene_pl.cache" ;; esac
-  case "$name" in
-    *_lambda*) local l0=${name#*_lambda}; l0=${l0%%_*}
-           echo "{\"lambda_l0\": $l0}" > "$work/config_$name.json"; args=(--config "$work/config_$name.json") ;;
-  esac
+  local keys=()
+  case "$name" in *_lambda*) local l0=${name#*_lambda}; keys+=("\"lambda_l0\": ${l0%%_*}") ;; esac
+  case "$name" in *_lp*) local lp=${name#*_lp}; keys+=("\"lambda_pseudo\": ${lp%%_*}") ;; esac
+  case "$name" in *_decgt*) keys+=("\"pseudo_labels_train_decoder\": false") ;; esac
+  if [ ${#keys[@]} -gt 0 ]; then
+    (IFS=,; echo "{${keys[*]}}") > "$work/config_$name.json"; args=(--config "$work/config_$name.json")
+  fi
   case "$name" in
     none_*) args+=(--drop none) ;;
     full_p*) local p=${name#full_p}; p=${p%%_*}; args+=(--drop full --p-base "$p") ;;

@@ -5,6 +5,7 @@
 #include <torch/csrc/autograd/autograd.h>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/scene_cache.h"
 #include "test_support/test_support.h"
@@ -57,16 +58,15 @@ TEST_P(TrainerOnDevice, RgbLossFallsOnTheTinyScene) {
   EXPECT_EQ(trainer.iteration(), 240);
 }
 
-// Pseudo-labels supervise the unlabelled training views: give every unlabelled training view of
-// the tiny scene one kept target per class (from its label map) and count the steps with a
-// semantic loss; with no extra labelled render (semantic_interval 0) only the drawn view counts.
-TEST_P(TrainerOnDevice, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
+// Gives every unlabelled training view one kept pseudo-label target per class (from its label
+// map); returns how many views got them.
+int pseudoLabelTheUnlabelledViews(io::Scene& scene) {
   int unlabelled = 0;
-  for (io::View& v : scene_.views) {
+  for (io::View& v : scene.views) {
     if (!v.train || v.labelled) continue;
     ++unlabelled;
     io::ViewPseudoLabels& p = v.pseudo;
-    p.num_classes = static_cast<int>(scene_.classes.size());
+    p.num_classes = static_cast<int>(scene.classes.size());
     p.num_targets = p.num_classes;
     p.region.resize(v.labels.pixels.size());
     for (std::size_t i = 0; i < p.region.size(); ++i) {
@@ -76,6 +76,13 @@ TEST_P(TrainerOnDevice, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
     for (int t = 0; t < p.num_targets; ++t) p.scores[t * p.num_classes + t] = 1.0f;
     p.kept.assign(p.num_targets, 1);
   }
+  return unlabelled;
+}
+
+// Pseudo-labels supervise the unlabelled training views: count the steps with a semantic loss;
+// with no extra labelled render (semantic_interval 0) only the drawn view counts.
+TEST_P(TrainerOnDevice, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
+  const int unlabelled = pseudoLabelTheUnlabelledViews(scene_);
   ASSERT_GT(unlabelled, 0);
   auto steps_with_semantic_loss = [&](bool use_pseudo, int* pseudo_views) {
     TrainConfig c = small(24);
@@ -95,6 +102,44 @@ TEST_P(TrainerOnDevice, PseudoLabelsSuperviseTheUnlabelledTrainingViews) {
   EXPECT_EQ(pseudo_views, unlabelled);
   EXPECT_LT(steps_with_semantic_loss(false, &pseudo_views), 24);
   EXPECT_EQ(pseudo_views, 0);
+}
+
+// pseudo_labels_train_decoder = false: the pseudo-labelled views' semantic loss moves the
+// Gaussians' features but leaves the decoder exactly as it was (ground truth off here, so only
+// pseudo-labels give semantic gradients); with true both move.
+TEST_F(TrainerTest, PseudoLabelsCanLeaveTheDecoderToGroundTruth) {
+  ASSERT_GT(pseudoLabelTheUnlabelledViews(scene_), 0);
+  test::TempDir tmp;
+  const std::string dir = tmp.path();
+  auto run = [&](bool train_decoder, double* decoder_change, double* feature_change) {
+    TrainConfig c = small(12);
+    c.semantic_interval = 0;
+    c.lambda_semantic = 0;
+    c.pseudo_labels_train_decoder = train_decoder;
+    Trainer trainer(scene_, c);
+    trainer.saveCheckpoint(dir + "/before.ckpt");
+    for (int i = 0; i < 12; ++i) trainer.step();
+    trainer.saveCheckpoint(dir + "/after.ckpt");
+    const auto before = gaussians::readTensorArchive(dir + "/before.ckpt");
+    const auto after = gaussians::readTensorArchive(dir + "/after.ckpt");
+    *decoder_change = 0;
+    for (const char* name : {"decoder_w", "decoder_b"}) {
+      *decoder_change +=
+          (after.tensor(name, "after") - before.tensor(name, "before")).abs().sum().item<double>();
+    }
+    // No densification here, so the Gaussians keep their order and count.
+    *feature_change = (after.tensor("features", "after") - before.tensor("features", "before"))
+                          .abs()
+                          .sum()
+                          .item<double>();
+  };
+  double decoder_change = -1, feature_change = -1;
+  run(false, &decoder_change, &feature_change);
+  EXPECT_EQ(decoder_change, 0.0);
+  EXPECT_GT(feature_change, 0.0);
+  run(true, &decoder_change, &feature_change);
+  EXPECT_GT(decoder_change, 0.0);
+  EXPECT_GT(feature_change, 0.0);
 }
 
 TEST(SemanticLoss, UnsupervisedPixelsGiveNoGradientAndNoValue) {

@@ -63,6 +63,7 @@ std::string TrainConfig::toJson() const {
                       {"semantic_interval", semantic_interval},
                       {"use_pseudo_labels", use_pseudo_labels},
                       {"lambda_pseudo", lambda_pseudo},
+                      {"pseudo_labels_train_decoder", pseudo_labels_train_decoder},
                       {"lr_position_init", lr_position_init},
                       {"lr_position_final", lr_position_final},
                       {"lr_sh_dc", lr_sh_dc},
@@ -125,6 +126,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.semantic_interval = d["semantic_interval"];
   c.use_pseudo_labels = d["use_pseudo_labels"];
   c.lambda_pseudo = d["lambda_pseudo"];
+  c.pseudo_labels_train_decoder = d["pseudo_labels_train_decoder"];
   c.lr_position_init = d["lr_position_init"];
   c.lr_position_final = d["lr_position_final"];
   c.lr_sh_dc = d["lr_sh_dc"];
@@ -499,8 +501,14 @@ StepStats Trainer::step() {
     if (labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
       // class-score space of the built-in backend), averaged over supervised pixels only.
-      const at::Tensor sem =
-          semanticLoss(r.features, labels, s.p("decoder_w").value, s.p("decoder_b").value);
+      const bool ground_truth =
+          std::find(s.labelled_views.begin(), s.labelled_views.end(), v) != s.labelled_views.end();
+      const bool decoder_learns = ground_truth || c.pseudo_labels_train_decoder;
+      const at::Tensor& w = s.p("decoder_w").value;
+      const at::Tensor& b = s.p("decoder_b").value;
+      const at::Tensor sem = decoder_learns
+                                 ? semanticLoss(r.features, labels, w, b)
+                                 : semanticLoss(r.features, labels, w.detach(), b.detach());
       loss = loss + s.semantic_weight[v] * sem;
       sem_sum += sem.item<double>();
     }

@@ -35,7 +35,12 @@ struct TrainConfig {
   /// Supervise the unlabelled training views with the scene's kept pseudo-labels (written by
   /// `sadsplat pseudo-labels`; without them this does nothing). Ground truth always wins.
   bool use_pseudo_labels = true;
-  double lambda_pseudo = 1.0;         ///< weight of the semantic loss on pseudo-labelled views
+  double lambda_pseudo = 1.0;  ///< weight of the semantic loss on pseudo-labelled views
+  /// Whether the semantic loss of pseudo-labelled views also trains the decoder (paper: yes).
+  /// false: pseudo-labels only move the Gaussians' features and the decoder (the class embedding
+  /// space) learns from ground truth alone, so the class mix of the kept pseudo-labels (mostly the
+  /// easy classes) cannot shift the decoder's class prior.
+  bool pseudo_labels_train_decoder = true;
   double lr_position_init = 1.6e-4;   ///< times the scene extent
   double lr_position_final = 1.6e-6;  ///< times the scene extent
   double lr_sh_dc = 2.5e-3;
