@@ -187,6 +187,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   pseudo
+      ->add_option("--min-view-agreement", pseudo_options.filter.min_view_agreement,
+                   "unkeep a target when the other views seeing its sparse points vote for its "
+                   "class less often than this (0 = off; not the paper)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  pseudo
       ->add_option("--region-size", pseudo_options.builtin.superpixels.region_size,
                    "builtin: superpixel size in pixels")
       ->capture_default_str();

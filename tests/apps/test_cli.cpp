@@ -55,6 +55,9 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   EXPECT_EQ(test::runCommand(run + " --targets multiscale --scales 2,1", &out), 1) << out;
   EXPECT_NE(out.find("--scales"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(run + " --min-class-precision 1.5", &out), 2) << out;
+  ASSERT_EQ(test::runCommand(run + " --min-view-agreement 0.5", &out), 0) << out;
+  EXPECT_NE(out.find("cross-view check (agreement < 0.5) unkept:"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(run + " --min-view-agreement 1.5", &out), 2) << out;
   EXPECT_EQ(test::runCommand(run + " --targets foo", &out), 2) << out;
 }
 

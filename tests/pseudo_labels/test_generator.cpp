@@ -3,6 +3,7 @@
 #include "pseudo_labels/toy_scene.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/pseudo_labels/generator.h"
+#include "sadsplat/pseudo_labels/point_visibility.h"
 #include "sadsplat/pseudo_labels/quality_report.h"
 
 namespace sp = sadsplat::pseudo_labels;
@@ -290,4 +291,76 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   options.min_check_pixels = 3;
   s = sp::generatePseudoLabels(scene, scorer, options);
   EXPECT_EQ(s.kept_regions, 4u);
+}
+
+// Camera at the origin looking along +z (toy scene cameras, moved), 8x8 pixels, f = 8: a point
+// (x, y, z) lands at pixel (8x/z + 4, 8y/z + 4).
+TEST(PointVisibility, NearerPointsOfACellHideFartherOnes) {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene(2, 8, 8);
+  io::View& v = scene.views[0];
+  v.camera.fx = v.camera.fy = 8;
+  v.camera.cx = v.camera.cy = 4;
+  v.camera.tvec = {0, 0, 0};
+  auto point = [](float x, float y, float z) {
+    io::ScenePoint p;
+    p.xyz = {x, y, z};
+    return p;
+  };
+  scene.points = {point(0, 0, 4),          // pixel (4, 4), cell (1, 1)
+                  point(0.25f, 0, 8),      // pixel (4, 4): same cell, twice as far: hidden
+                  point(0.25f, 0, 4.05f),  // pixel (4.5 -> 4, 4): within 2 %: seen
+                  point(-2.5f, -2.5f, 5),  // pixel (0, 0), cell (0, 0)
+                  point(3, 0, 4),          // pixel (10, 4): outside
+                  point(0, 0, -4)};        // behind the camera
+  const std::vector<sp::PointHit> hits = sp::visiblePoints(scene, v, 4);
+  ASSERT_EQ(hits.size(), 3u);
+  EXPECT_EQ(hits[0].point, 0u);
+  EXPECT_EQ(hits[0].pixel, 4u * 8 + 4);
+  EXPECT_EQ(hits[1].point, 2u);
+  EXPECT_EQ(hits[2].point, 3u);
+  EXPECT_EQ(hits[2].pixel, 0u);
+  // With 1-pixel cells, points 1 and 2 fall in pixel (4, 4) with point 0: still hidden / seen.
+  EXPECT_EQ(sp::visiblePoints(scene, v, 1).size(), 3u);
+}
+
+// Three views with the same camera see the same 16 points; each view has two regions (left and
+// right half). The left half is class 0 in view 0 but class 2 in views 1 and 2: view 0's left
+// label is outvoted 0 : 16, views 1 and 2 agree with each other 8 : 16 (one of two other views).
+TEST(ViewAgreementCheck, OutvotedRegionsAreUnkept) {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene(4, 8, 8);
+  std::vector<int> views = {0, 1, 2};
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      io::ScenePoint p;
+      // Toy cameras: f = 8, centre (4, 4), 10 units in front: pixel (2x + 0.5, 2y + 0.5).
+      p.xyz = {(2 * x + 0.5f - 4) * 10 / 8, (2 * y + 0.5f - 4) * 10 / 8, 0};
+      scene.points.push_back(p);
+    }
+  }
+  for (int i : views) {
+    io::ViewPseudoLabels& p = scene.views[i].pseudo;
+    p.num_classes = 3;
+    p.num_targets = 2;
+    p.region.resize(64);
+    for (int px = 0; px < 64; ++px) p.region[px] = px % 8 < 4 ? 0 : 1;
+    const int left = i == 0 ? 0 : 2;
+    p.scores.assign(6, 0.05f);
+    p.scores[left] = 0.9f;
+    p.scores[3 + 1] = 0.9f;
+    p.kept = {1, 1};
+  }
+  ASSERT_EQ(sp::visiblePoints(scene, scene.views[0]).size(), 16u);
+  io::Scene strict = scene;
+  std::vector<std::size_t> removed = sp::applyViewAgreementCheck(scene, views, 0.5, 16);
+  EXPECT_EQ(removed, (std::vector<std::size_t>{1, 0, 0}));
+  EXPECT_EQ(scene.views[0].pseudo.kept, (std::vector<std::uint8_t>{0, 1}));
+  EXPECT_EQ(scene.views[1].pseudo.kept, (std::vector<std::uint8_t>{1, 1}));  // 8 of 16 = 0.5
+  // A stricter share also unkeeps views 1 and 2's left halves; the right halves agree 16 of 16.
+  removed = sp::applyViewAgreementCheck(strict, views, 0.6, 16);
+  EXPECT_EQ(removed, (std::vector<std::size_t>{1, 0, 2}));
+  EXPECT_EQ(strict.views[2].pseudo.kept, (std::vector<std::uint8_t>{0, 1}));
+  // Fewer votes than asked for (8 points x 2 other views = 16 per region): nothing changes.
+  io::Scene few = strict;
+  for (int i : views) few.views[i].pseudo.kept = {1, 1};
+  EXPECT_EQ(sp::applyViewAgreementCheck(few, views, 0.6, 17), std::vector<std::size_t>(3, 0));
 }

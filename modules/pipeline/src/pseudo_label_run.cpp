@@ -108,9 +108,17 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                   << " kept pixels right"
                   << (s.class_rejected[c] ? " -> pseudo-labels of this class removed" : "") << "\n";
     }
+    if (!s.view_check_removed.empty()) {
+      *o.progress << "  cross-view check (agreement < " << o.filter.min_view_agreement
+                  << ") unkept:";
+      for (std::size_t c = 0; c < s.view_check_removed.size(); ++c) {
+        *o.progress << " " << scene.classes[c].name << " " << s.view_check_removed[c];
+      }
+      *o.progress << " regions\n";
+    }
     if (s.kept_regions != s.kept_targets) {
       *o.progress << "  stored: " << s.kept_regions
-                  << " kept regions (overlaps resolved, classes removed by the check)\n";
+                  << " kept regions (overlaps resolved, removed by the checks)\n";
     }
     if (s.kept_regions == 0) {
       *o.progress << "warning: no kept target is left, so no view gets pseudo-labels "

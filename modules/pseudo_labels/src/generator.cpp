@@ -4,6 +4,7 @@
 #include <unordered_map>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/pseudo_labels/point_visibility.h"
 
 namespace sadsplat {
 namespace pseudo_labels {
@@ -126,6 +127,48 @@ void checkClassReliability(io::Scene& scene, const std::vector<int>& views,
 
 }  // namespace
 
+std::vector<std::size_t> applyViewAgreementCheck(io::Scene& scene, const std::vector<int>& views,
+                                                 double min_agreement, std::size_t min_votes) {
+  const int C = static_cast<int>(scene.classes.size());
+  std::vector<std::size_t> removed(C, 0);
+  const std::size_t P = scene.points.size();
+  if (P == 0 || min_agreement <= 0) return removed;
+  // votes[p * C + c]: training views whose target at point p has argmax class c.
+  std::vector<std::uint32_t> votes(P * C, 0), seen_by(P, 0);
+  std::vector<std::vector<PointHit>> hits(views.size());
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const io::View& v = scene.views[views[k]];
+    if (v.pseudo.empty()) continue;
+    hits[k] = visiblePoints(scene, v);
+    for (const PointHit& h : hits[k]) {
+      const int r = v.pseudo.region[h.pixel];
+      if (r < 0) continue;
+      ++votes[h.point * C + argmax(&v.pseudo.scores[static_cast<std::size_t>(r) * C], C)];
+      ++seen_by[h.point];
+    }
+  }
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    io::ViewPseudoLabels& p = scene.views[views[k]].pseudo;
+    std::vector<std::size_t> agree(p.num_targets, 0), total(p.num_targets, 0);
+    for (const PointHit& h : hits[k]) {
+      const int r = p.region[h.pixel];
+      if (r < 0 || !p.kept[r]) continue;
+      const int own = argmax(&p.scores[static_cast<std::size_t>(r) * C], C);
+      // This view's own vote at the point is `own`: count the other views only.
+      total[r] += seen_by[h.point] - 1;
+      agree[r] += votes[h.point * C + own] - 1;
+    }
+    for (int r = 0; r < p.num_targets; ++r) {
+      if (!p.kept[r] || total[r] < min_votes || agree[r] >= min_agreement * total[r]) {
+        continue;
+      }
+      p.kept[r] = 0;
+      ++removed[argmax(&p.scores[static_cast<std::size_t>(r) * C], C)];
+    }
+  }
+  return removed;
+}
+
 PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                                         const PseudoLabelOptions& options,
                                         const ProgressFn& progress) {
@@ -192,6 +235,10 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
     p.features = std::move(stored.features);
     p.validate(scene.source + " (view " + v.name + ", backend " + scorer.name() + ")",
                static_cast<std::size_t>(v.camera.width) * v.camera.height);
+  }
+  if (options.min_view_agreement > 0) {
+    summary.view_check_removed =
+        applyViewAgreementCheck(scene, views, options.min_view_agreement, options.min_view_votes);
   }
   checkClassReliability(scene, views, options, summary);
   for (int i : views) {

@@ -4,18 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "sadsplat/pseudo_labels/point_visibility.h"
+
 namespace sadsplat {
 namespace pseudo_labels {
 namespace {
-
-void rotationFromQuat(const std::array<double, 4>& q, double R[9]) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  const double a = w / n, b = x / n, c = y / n, d = z / n;
-  R[0] = 1 - 2 * (c * c + d * d), R[1] = 2 * (b * c - a * d), R[2] = 2 * (b * d + a * c);
-  R[3] = 2 * (b * c + a * d), R[4] = 1 - 2 * (b * b + d * d), R[5] = 2 * (c * d - a * b);
-  R[6] = 2 * (b * d - a * c), R[7] = 2 * (c * d + a * b), R[8] = 1 - 2 * (b * b + c * c);
-}
 
 // Box mean of a single-channel image over a (2r+1)^2 window, via an integral image.
 std::vector<float> boxMean(const std::vector<float>& img, int W, int H, int r) {
@@ -143,34 +136,7 @@ std::vector<float> regionFeatures(const io::Scene& scene, const io::View& view,
   // Heights of the sparse points visible in this view (a coarse z-buffer keeps the nearest ones).
   std::vector<std::vector<float>> region_heights(R);
   if (geometry != nullptr && !geometry->height.empty()) {
-    double Rm[9];
-    rotationFromQuat(view.camera.qvec, Rm);
-    const auto& t = view.camera.tvec;
-    constexpr int kCell = 4;
-    const int CW = (W + kCell - 1) / kCell, CH = (H + kCell - 1) / kCell;
-    std::vector<float> zbuf(static_cast<std::size_t>(CW) * CH, std::numeric_limits<float>::max());
-    struct Hit {
-      std::size_t pixel, cell;
-      float z;
-      std::size_t point;
-    };
-    std::vector<Hit> hits;
-    for (std::size_t p = 0; p < scene.points.size(); ++p) {
-      const auto& X = scene.points[p].xyz;
-      const double xc = Rm[0] * X[0] + Rm[1] * X[1] + Rm[2] * X[2] + t[0];
-      const double yc = Rm[3] * X[0] + Rm[4] * X[1] + Rm[5] * X[2] + t[1];
-      const double zc = Rm[6] * X[0] + Rm[7] * X[1] + Rm[8] * X[2] + t[2];
-      if (zc <= 1e-6) continue;
-      const double u = view.camera.fx * xc / zc + view.camera.cx,
-                   v = view.camera.fy * yc / zc + view.camera.cy;
-      if (u < 0 || v < 0 || u >= W || v >= H) continue;
-      const int px = static_cast<int>(u), py = static_cast<int>(v);
-      const std::size_t cell = static_cast<std::size_t>(py / kCell) * CW + px / kCell;
-      zbuf[cell] = std::min(zbuf[cell], static_cast<float>(zc));
-      hits.push_back({static_cast<std::size_t>(py) * W + px, cell, static_cast<float>(zc), p});
-    }
-    for (const Hit& h : hits) {
-      if (h.z > zbuf[h.cell] * 1.02f) continue;  // occluded by a nearer point
+    for (const PointHit& h : visiblePoints(scene, view)) {
       const int r = seg.region[h.pixel];
       if (r >= 0) region_heights[r].push_back(geometry->height[h.point]);
     }

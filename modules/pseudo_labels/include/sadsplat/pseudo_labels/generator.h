@@ -105,6 +105,14 @@ struct PseudoLabelOptions {
   /// pseudo-labels everywhere; 0 = off. Needs `min_check_pixels` kept pixels of the class there.
   double min_class_precision = 0;
   std::size_t min_check_pixels = 500;
+  /// Cross-view check (not the paper): every sparse point seen in a target is also seen by other
+  /// training views, each of which votes for the class of its own target there (argmax, kept or
+  /// not). A kept target whose class gets less than this share of those votes is unkept; 0 = off.
+  /// A class confused with another in one view only (water read as road under one sun angle) is
+  /// outvoted; a confusion that every view makes is not. Targets with fewer than
+  /// `min_view_votes` votes keep the filter's decision.
+  double min_view_agreement = 0;
+  std::size_t min_view_votes = 10;
 };
 
 /// \brief What a run did.
@@ -121,7 +129,18 @@ struct PseudoLabelSummary {
   /// agree with the ground truth (ignore pixels not counted).
   std::vector<std::size_t> check_pixels, check_correct;
   std::vector<bool> class_rejected;  ///< per class: pseudo-labels removed by the reliability check
+  /// Per class: stored regions unkept by the cross-view check (empty when it is off).
+  std::vector<std::size_t> view_check_removed;
 };
+
+/// \brief The cross-view check (PseudoLabelOptions::min_view_agreement) on the pseudo-labels
+/// stored in `views` (generatePseudoLabels runs it before the class check).
+/// \param[in] views indices into scene.views, each with pseudo-labels
+/// \param[in] min_agreement share of the other views' votes a kept region's class needs
+/// \param[in] min_votes fewer votes than this leave a region as it is
+/// \return per class, the regions it unkept
+std::vector<std::size_t> applyViewAgreementCheck(io::Scene& scene, const std::vector<int>& views,
+                                                 double min_agreement, std::size_t min_votes);
 
 /// \brief Runs `scorer` on every training view of `scene`, filters, and fills `view.pseudo`
 /// of those views (other views' pseudo-labels are cleared).
