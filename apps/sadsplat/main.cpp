@@ -176,9 +176,14 @@ int main(int argc, char** argv) {
       ->add_option("--filter-k", pseudo_options.filter.filter_k,
                    "thresholds mean + k std (paper: 1)")
       ->capture_default_str();
-  pseudo->add_flag("--filter-per-class", pseudo_options.filter.per_class,
-                   "class-balanced filter: mean + k std over the targets of each TOP1 class (not "
-                   "the paper)");
+  std::string pseudo_filter = "per-class";
+  pseudo
+      ->add_option("--filter", pseudo_filter,
+                   "per-class: mean + k std over the targets of each TOP1 class (class-balanced); "
+                   "paper: over all targets (the paper's filter; with --min-view-agreement 0 "
+                   "exactly the paper)")
+      ->check(CLI::IsMember({"per-class", "paper"}))
+      ->capture_default_str();
   pseudo
       ->add_option(
           "--min-class-precision", pseudo_options.filter.min_class_precision,
@@ -343,6 +348,7 @@ int main(int argc, char** argv) {
                                        : pseudo_targets == "multiscale"
                                            ? MaskGenerator::kSlicMultiscale
                                            : MaskGenerator::kSlic;
+      pseudo_options.filter.per_class = pseudo_filter == "per-class";
       pseudo_options.filter.scale = pseudo_scale == "log-odds"
                                         ? sadsplat::pseudo_labels::ScoreScale::kLogOdds
                                         : sadsplat::pseudo_labels::ScoreScale::kScore;

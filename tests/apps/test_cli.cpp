@@ -49,14 +49,18 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2", &out), 0) << out;
   EXPECT_NE(out.find("83 targets"), std::string::npos) << out;  // 67 with one SLIC layer
   EXPECT_NE(out.find("check on the labelled views"), std::string::npos) << out;
-  ASSERT_EQ(test::runCommand(run + " --filter-per-class", &out), 0) << out;
+  ASSERT_EQ(test::runCommand(run, &out), 0) << out;  // default: per class + cross-view check
   EXPECT_NE(out.find("per TOP1 class"), std::string::npos) << out;
   EXPECT_NE(out.find("grass: TOP1 >"), std::string::npos) << out;
+  EXPECT_NE(out.find("cross-view check (agreement < 0.5) unkept:"), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(run + " --filter paper --min-view-agreement 0", &out), 0) << out;
+  EXPECT_EQ(out.find("per TOP1 class"), std::string::npos) << out;
+  EXPECT_EQ(out.find("cross-view check"), std::string::npos) << out;
+  EXPECT_NE(out.find("(TOP1 > "), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(run + " --filter pooled", &out), 2) << out;
   EXPECT_EQ(test::runCommand(run + " --targets multiscale --scales 2,1", &out), 1) << out;
   EXPECT_NE(out.find("--scales"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(run + " --min-class-precision 1.5", &out), 2) << out;
-  ASSERT_EQ(test::runCommand(run + " --min-view-agreement 0.5", &out), 0) << out;
-  EXPECT_NE(out.find("cross-view check (agreement < 0.5) unkept:"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(run + " --min-view-agreement 1.5", &out), 2) << out;
   EXPECT_EQ(test::runCommand(run + " --targets foo", &out), 2) << out;
 }

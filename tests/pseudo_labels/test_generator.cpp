@@ -207,6 +207,7 @@ TEST(PseudoLabelGenerator, MultiscaleTargetsRefineTheFinestLayerAndStayRight) {
 TEST(PseudoLabelGenerator, PerClassFilterUsesTheStatisticsOfEachClass) {
   io::Scene scene = sadsplat::test::toyPseudoLabelScene();
   sp::PseudoLabelOptions options;
+  options.per_class = false;  // the paper's filter
   const sp::PseudoLabelSummary pooled =
       sp::generatePseudoLabels(scene, *sp::makeBuiltinScorer(smallOptions()), options);
   EXPECT_TRUE(pooled.class_statistics.empty());
@@ -267,6 +268,7 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   io::Scene scene = columnScene();
   ColumnScorer scorer;
   sp::PseudoLabelOptions options;
+  options.per_class = false;  // the paper's filter, by hand in ColumnScorer's comment
   sp::PseudoLabelSummary s = sp::generatePseudoLabels(scene, scorer, options);
   ASSERT_EQ(s.kept_targets, 4u);  // columns 0 and 1 of the two training views
   EXPECT_EQ(s.kept_regions, 4u);

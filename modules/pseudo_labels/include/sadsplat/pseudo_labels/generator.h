@@ -1,8 +1,9 @@
 #pragma once
 /// \file generator.h
 /// \brief `sadsplat pseudo-labels`: splits every training view into targets, scores each target
-/// against every class with a backend, applies the TOP1 / dTOP / entropy filter over all targets
-/// of the training set, and stores the result in each view's io::ViewPseudoLabels.
+/// against every class with a backend, applies the TOP1 / dTOP / entropy filter (the paper's, over
+/// all targets of the training set, or per TOP1 class) and the cross-view check, and stores the
+/// result in each view's io::ViewPseudoLabels.
 
 #include <cstdint>
 #include <functional>
@@ -97,9 +98,11 @@ struct PseudoLabelOptions {
   /// dTOP on cosine similarities up to a factor, which the mean + k std rule ignores.
   ScoreScale scale = ScoreScale::kLogOdds;
   /// Class-balanced: mean and std over the targets of the same TOP1 class instead of over all
-  /// targets (not the paper). Pooled statistics keep the easy classes and starve the confusable
-  /// ones (road, paved, grass: < 1 % of their pixels), which biases the trained model.
-  bool per_class = false;
+  /// targets (not the paper; the paper's pooled filter is per_class = false). Pooled statistics
+  /// keep the easy classes and starve the confusable ones (road, paved, grass: < 1 % of their
+  /// pixels), which biased the trained model (README, "Measured"). Default together with the
+  /// cross-view check, which removes the wrong labels that balancing lets in.
+  bool per_class = true;
   /// Reliability check (not the paper): a class whose kept pseudo-labels are right on fewer than
   /// this share of the labelled views' pixels (scored held out by the built-in backend) loses its
   /// pseudo-labels everywhere; 0 = off. Needs `min_check_pixels` kept pixels of the class there.
@@ -107,11 +110,12 @@ struct PseudoLabelOptions {
   std::size_t min_check_pixels = 500;
   /// Cross-view check (not the paper): every sparse point seen in a target is also seen by other
   /// training views, each of which votes for the class of its own target there (argmax, kept or
-  /// not). A kept target whose class gets less than this share of those votes is unkept; 0 = off.
+  /// not). A kept target whose class gets less than this share of those votes is unkept; 0 = off
+  /// (the paper). Does nothing on a scene without sparse points.
   /// A class confused with another in one view only (water read as road under one sun angle) is
   /// outvoted; a confusion that every view makes is not. Targets with fewer than
   /// `min_view_votes` votes keep the filter's decision.
-  double min_view_agreement = 0;
+  double min_view_agreement = 0.5;
   std::size_t min_view_votes = 10;
 };
 
