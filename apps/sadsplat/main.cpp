@@ -199,8 +199,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   pseudo
       ->add_option("--region-size", pseudo_options.builtin.superpixels.region_size,
-                   "builtin: superpixel size in pixels")
+                   "builtin: superpixel size in pixels of an 800x450 view (scaled with the view's "
+                   "size, at least 4; see --fixed-region-size)")
       ->capture_default_str();
+  bool pseudo_fixed_region_size = false;
+  pseudo->add_flag("--fixed-region-size", pseudo_fixed_region_size,
+                   "builtin: --region-size in pixels whatever the view's size");
   std::string pseudo_scale = "log-odds";
   pseudo
       ->add_option("--filter-scale", pseudo_scale,
@@ -343,6 +347,7 @@ int main(int argc, char** argv) {
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
     } else if (*pseudo) {
       pseudo_options.builtin.geometry = !pseudo_no_geometry;
+      pseudo_options.builtin.scale_region_size = !pseudo_fixed_region_size;
       using sadsplat::pseudo_labels::MaskGenerator;
       pseudo_options.builtin.targets = pseudo_targets == "graph" ? MaskGenerator::kGraph
                                        : pseudo_targets == "multiscale"

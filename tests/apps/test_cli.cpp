@@ -46,9 +46,14 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
   const std::string run = kCli + " pseudo-labels " + cache + " --out " + dir.file("pl.cache");
   std::string out;
-  ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2", &out), 0) << out;
-  EXPECT_NE(out.find("83 targets"), std::string::npos) << out;  // 67 with one SLIC layer
+  ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2 --fixed-region-size", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("83 targets"), std::string::npos) << out;  // 67 with one 16-px SLIC layer
   EXPECT_NE(out.find("check on the labelled views"), std::string::npos) << out;
+  // By default 16 px is the size at 800x450: 4 and 8 px on the 64x48 views (4 is the minimum).
+  ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2", &out), 0) << out;
+  EXPECT_NE(out.find("1506 targets"), std::string::npos) << out;
   ASSERT_EQ(test::runCommand(run, &out), 0) << out;  // default: per class + cross-view check
   EXPECT_NE(out.find("per TOP1 class"), std::string::npos) << out;
   EXPECT_NE(out.find("grass: TOP1 >"), std::string::npos) << out;

@@ -13,6 +13,7 @@ namespace {
 sp::BuiltinOptions smallOptions() {
   sp::BuiltinOptions o;
   o.superpixels.region_size = 8;
+  o.scale_region_size = false;
   o.classifier.steps = 200;
   return o;
 }
@@ -365,4 +366,12 @@ TEST(ViewAgreementCheck, OutvotedRegionsAreUnkept) {
   io::Scene few = strict;
   for (int i : views) few.views[i].pseudo.kept = {1, 1};
   EXPECT_EQ(sp::applyViewAgreementCheck(few, views, 0.6, 17), std::vector<std::size_t>(3, 0));
+}
+
+TEST(BuiltinOptions, RegionSizeScalesWithTheViewArea) {
+  EXPECT_EQ(sp::scaledRegionSize(16, 800, 450), 16);
+  EXPECT_EQ(sp::scaledRegionSize(16, 1600, 900), 32);
+  EXPECT_EQ(sp::scaledRegionSize(16, 320, 180), 6);   // 6.4
+  EXPECT_EQ(sp::scaledRegionSize(16, 64, 48), 4);     // 1.5, raised to the minimum
+  EXPECT_EQ(sp::scaledRegionSize(24, 900, 400), 24);  // same area as 800x450
 }

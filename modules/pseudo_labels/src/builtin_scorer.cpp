@@ -3,6 +3,8 @@
 // label of sufficiently pure regions, of every layer).
 #include <ATen/Parallel.h>
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <set>
@@ -131,9 +133,17 @@ class BuiltinScorer : public TargetScorer {
         throw Error("<pseudo-labels builtin>", "multiscale factors (--scales)",
                     "ascending integers >= 1, e.g. 1,2,4");
       }
-      SlicOptions o = options_.superpixels;
-      o.region_size *= factors[i];
-      out.push_back([o](const io::View& v) { return slicSuperpixels(v.rgb, v.mask, o); });
+      const SlicOptions o = options_.superpixels;
+      const bool scaled = options_.scale_region_size;
+      const int factor = factors[i];
+      out.push_back([o, scaled, factor](const io::View& v) {
+        SlicOptions view_options = o;
+        // The layers keep their size ratios: the finest size is scaled, then multiplied.
+        if (scaled)
+          view_options.region_size = scaledRegionSize(o.region_size, v.rgb.width, v.rgb.height);
+        view_options.region_size *= factor;
+        return slicSuperpixels(v.rgb, v.mask, view_options);
+      });
     }
     return out;
   }
@@ -168,6 +178,11 @@ class BuiltinScorer : public TargetScorer {
 };
 
 }  // namespace
+
+int scaledRegionSize(int region_size, int width, int height) {
+  const double factor = std::sqrt(static_cast<double>(width) * height / (800.0 * 450.0));
+  return std::max(4, static_cast<int>(std::lround(region_size * factor)));
+}
 
 TargetScorer::Ptr makeBuiltinScorer(const BuiltinOptions& options) {
   return std::make_shared<BuiltinScorer>(options);

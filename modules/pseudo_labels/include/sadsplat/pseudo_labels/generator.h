@@ -74,10 +74,18 @@ enum class MaskGenerator {
   kSlicMultiscale,
 };
 
+/// \brief Superpixel size for a W x H view when BuiltinOptions::scale_region_size is set.
+int scaledRegionSize(int region_size, int width, int height);
+
 /// \brief Options of the built-in backend.
 struct BuiltinOptions {
   MaskGenerator targets = MaskGenerator::kSlic;
   SlicOptions superpixels;
+  /// superpixels.region_size is meant for an 800x450 view and scales with the image: S *
+  /// sqrt(W * H / (800 * 450)), rounded, at least 4 px, so a target covers the same share of the
+  /// ground at any resolution (at 320x180 16 px superpixels span 2.5x the ground and the scorer
+  /// fell from 90.9 % to 79.7 % right before the filter). false: region_size pixels as given.
+  bool scale_region_size = true;
   GraphSegmentationOptions graph;
   std::vector<int> multiscale{1, 2, 4};  ///< region-size factors of kSlicMultiscale, ascending
   ClassifierOptions classifier;
