@@ -54,10 +54,16 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   // By default 16 px is the size at 800x450: 4 and 8 px on the 64x48 views (4 is the minimum).
   ASSERT_EQ(test::runCommand(run + " --targets multiscale --scales 1,2", &out), 0) << out;
   EXPECT_NE(out.find("1506 targets"), std::string::npos) << out;
-  ASSERT_EQ(test::runCommand(run, &out), 0) << out;  // default: per class + cross-view check
+  // Default: per class + cross-view check; report.json says what the run did.
+  ASSERT_EQ(test::runCommand(run + " --report " + dir.file("rep"), &out), 0) << out;
   EXPECT_NE(out.find("per TOP1 class"), std::string::npos) << out;
   EXPECT_NE(out.find("grass: TOP1 >"), std::string::npos) << out;
   EXPECT_NE(out.find("cross-view check (agreement < 0.5) unkept:"), std::string::npos) << out;
+  const std::string report = test::readFile(dir.file("rep/report.json"));
+  EXPECT_NE(report.find("\"filter\": \"per-class\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"min_view_agreement\": 0.5"), std::string::npos) << report;
+  EXPECT_NE(report.find("\"cross_view_unkept\""), std::string::npos) << report;
+  EXPECT_NE(report.find("\"precision\""), std::string::npos) << report;
   ASSERT_EQ(test::runCommand(run + " --filter paper --min-view-agreement 0", &out), 0) << out;
   EXPECT_EQ(out.find("per TOP1 class"), std::string::npos) << out;
   EXPECT_EQ(out.find("cross-view check"), std::string::npos) << out;

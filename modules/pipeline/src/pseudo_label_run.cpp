@@ -3,6 +3,8 @@
 #include <chrono>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
@@ -58,6 +60,34 @@ void writeOverlay(const std::string& path, const io::View& v,
   });
 }
 #endif
+
+// What the run did, for report.json: the filter, the counts and both checks, per class.
+nlohmann::json generationJson(const pseudo_labels::PseudoLabelSummary& s,
+                              const pseudo_labels::PseudoLabelOptions& filter,
+                              const std::vector<ClassInfo>& classes) {
+  nlohmann::json g = {{"backend", s.backend},
+                      {"views", s.views},
+                      {"filter", filter.per_class ? "per-class" : "paper"},
+                      {"filter_k", filter.filter_k},
+                      {"min_view_agreement", filter.min_view_agreement},
+                      {"min_class_precision", filter.min_class_precision},
+                      {"targets", s.targets},
+                      {"kept_targets", s.kept_targets},
+                      {"kept_regions", s.kept_regions}};
+  nlohmann::json per_class = nlohmann::json::object();
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    nlohmann::json e = nlohmann::json::object();
+    if (c < s.view_check_removed.size()) e["cross_view_unkept"] = s.view_check_removed[c];
+    if (c < s.check_pixels.size()) {
+      e["labelled_view_check_pixels"] = s.check_pixels[c];
+      e["labelled_view_check_correct"] = s.check_correct[c];
+      e["removed_by_class_check"] = static_cast<bool>(s.class_rejected[c]);
+    }
+    per_class[classes[c].name] = e;
+  }
+  g["classes"] = per_class;
+  return g;
+}
 
 }  // namespace
 
@@ -133,7 +163,10 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
   io::makeDirectory(o.report_dir);
   const pseudo_labels::PseudoLabelQuality q = pseudo_labels::evaluatePseudoLabels(scene);
   const std::string text = q.toText();
-  io::writeFileAtomically(o.report_dir + "/report.json", [&](std::ostream& f) { f << q.toJson(); });
+  nlohmann::json report = nlohmann::json::parse(q.toJson());
+  report["generation"] = generationJson(s, o.filter, scene.classes);
+  io::writeFileAtomically(o.report_dir + "/report.json",
+                          [&](std::ostream& f) { f << report.dump(2) << "\n"; });
   io::writeFileAtomically(o.report_dir + "/report.txt", [&](std::ostream& f) { f << text; });
 #if SADSPLAT_HAVE_OPENCV
   io::makeDirectory(o.report_dir + "/overlays");
