@@ -366,6 +366,10 @@ TEST(ViewAgreementCheck, OutvotedRegionsAreUnkept) {
   io::Scene few = strict;
   for (int i : views) few.views[i].pseudo.kept = {1, 1};
   EXPECT_EQ(sp::applyViewAgreementCheck(few, views, 0.6, 17), std::vector<std::size_t>(3, 0));
+  // No sparse points, no evidence: nothing is unkept.
+  few.points.clear();
+  EXPECT_EQ(sp::applyViewAgreementCheck(few, views, 0.6, 1), std::vector<std::size_t>(3, 0));
+  EXPECT_EQ(few.views[0].pseudo.kept, (std::vector<std::uint8_t>{1, 1}));
 }
 
 TEST(BuiltinOptions, RegionSizeScalesWithTheViewArea) {

@@ -138,7 +138,9 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                   << " kept pixels right"
                   << (s.class_rejected[c] ? " -> pseudo-labels of this class removed" : "") << "\n";
     }
-    if (!s.view_check_removed.empty()) {
+    if (!s.view_check_removed.empty() && scene.points.empty()) {
+      *o.progress << "  cross-view check skipped: the scene has no sparse points\n";
+    } else if (!s.view_check_removed.empty()) {
       *o.progress << "  cross-view check (agreement < " << o.filter.min_view_agreement
                   << ") unkept:";
       for (std::size_t c = 0; c < s.view_check_removed.size(); ++c) {
