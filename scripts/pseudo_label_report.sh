@@ -16,6 +16,7 @@ for kind in city country port; do
       "$BIN" pseudo-labels "$cache" --out "$OUT/${kind}_${seed}_k${k}.cache" --filter-k "$k" --report "$rep" "$@" \
         > "$rep.log"
       echo "$kind $seed k=$k: $(grep '^pseudo-labels on' "$rep/report.txt")"
+      echo "$kind $seed k=$k: $(grep '^worst kept class' "$rep/report.txt" || echo 'worst kept class: none')"
       rm -f "$OUT/${kind}_${seed}_k${k}.cache"
     done
   done

@@ -112,7 +112,9 @@ TEST(PseudoLabelQuality, HandComputedPrecisionCoverageAndReliability) {
   EXPECT_DOUBLE_EQ(q.coverage, 1.0);
   EXPECT_DOUBLE_EQ(q.classes[1].precision, 0.5);
   EXPECT_DOUBLE_EQ(q.classes[2].coverage, 1.0);  // its pixel was kept (with a wrong label)
-  EXPECT_EQ(q.reliability[9].pixels, 2u);        // TOP1 0.95
+  EXPECT_EQ(q.worst_class, 1);  // class 0 at 100 %, class 1 at 50 %, class 2 labels nothing
+  EXPECT_NE(q.toText().find("worst kept class: green 50.00 %"), std::string::npos) << q.toText();
+  EXPECT_EQ(q.reliability[9].pixels, 2u);  // TOP1 0.95
   EXPECT_DOUBLE_EQ(q.reliability[9].accuracy, 1.0);
   EXPECT_EQ(q.reliability[8].pixels, 2u);  // TOP1 0.85
   EXPECT_DOUBLE_EQ(q.reliability[8].accuracy, 0.5);
@@ -120,6 +122,7 @@ TEST(PseudoLabelQuality, HandComputedPrecisionCoverageAndReliability) {
   const sp::PseudoLabelQuality q2 = sp::evaluatePseudoLabels(scene);
   EXPECT_DOUBLE_EQ(q2.precision, 1.0);
   EXPECT_DOUBLE_EQ(q2.coverage, 0.5);
+  EXPECT_EQ(q2.worst_class, 0);  // the only class that labels anything
 }
 
 // Overlapping layers resolved by hand: 6 pixels in a row, two classes.

@@ -73,6 +73,12 @@ PseudoLabelQuality evaluatePseudoLabels(const io::Scene& scene) {
   for (int c = 0; c < C; ++c) {
     q.classes[c].precision = ratio(correct_of_class[c], q.classes[c].predicted_pixels);
     q.classes[c].coverage = ratio(kept_of_gt_class[c], q.classes[c].gt_pixels);
+    const ClassQuality& k = q.classes[c];
+    if (k.predicted_pixels >= PseudoLabelQuality::kWorstClassMinShare * q.gt_pixels &&
+        k.predicted_pixels > 0 &&
+        (q.worst_class < 0 || k.precision < q.classes[q.worst_class].precision)) {
+      q.worst_class = c;
+    }
   }
   for (int b = 0; b < kBins; ++b) {
     ReliabilityBin bin;
@@ -104,6 +110,11 @@ std::string PseudoLabelQuality::toJson() const {
                             {"precision", c.precision},
                             {"coverage", c.coverage}});
   }
+  if (worst_class >= 0) {
+    j["worst_class"] = {{"name", classes[worst_class].name},
+                        {"precision", classes[worst_class].precision},
+                        {"min_share_of_labelled_pixels", kWorstClassMinShare}};
+  }
   for (const auto& b : reliability) {
     j["reliability"].push_back({{"low", b.low},
                                 {"high", b.high},
@@ -128,6 +139,13 @@ std::string PseudoLabelQuality::toText() const {
     std::snprintf(line, sizeof line, "%-16s %8.2f %% %8.2f %% %8.2f %%\n", c.name.c_str(),
                   100 * c.precision, 100 * c.coverage,
                   gt_pixels ? 100.0 * c.gt_pixels / gt_pixels : 0.0);
+    o << line;
+  }
+  if (worst_class >= 0) {
+    std::snprintf(line, sizeof line,
+                  "worst kept class: %s %.2f %% (of the classes on >= %.2f %% of the pixels)\n",
+                  classes[worst_class].name.c_str(), 100 * classes[worst_class].precision,
+                  100 * kWorstClassMinShare);
     o << line;
   }
   o << "TOP1 bin     pixels  accuracy  mean TOP1\n";

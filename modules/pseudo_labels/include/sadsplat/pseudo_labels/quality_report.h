@@ -41,6 +41,11 @@ struct PseudoLabelQuality {
   double argmax_accuracy = 0;   ///< argmax of the scores over all target pixels (no filter)
   double expected_calibration_error = 0;
   std::vector<ClassQuality> classes;
+  /// The least precise class among those pseudo-labelling at least kWorstClassMinShare of the
+  /// labelled pixels (a class with a handful of wrong pixels does not count); -1 if none. Pooled
+  /// precision hides a class that is mostly wrong; training suffers from exactly that one.
+  int worst_class = -1;
+  static constexpr double kWorstClassMinShare = 0.0005;
   std::vector<ReliabilityBin> reliability;
 
   std::string toJson() const;
