@@ -6,20 +6,24 @@
 namespace sadsplat {
 namespace io {
 
-std::vector<std::int16_t> ViewPseudoLabels::labelMap() const {
-  std::vector<std::int16_t> target_class(num_targets, -1);
+std::vector<std::int16_t> ViewPseudoLabels::targetClasses() const {
+  std::vector<std::int16_t> out(num_targets, 0);
   for (int t = 0; t < num_targets; ++t) {
-    if (!kept[t]) continue;
     const float* row = &scores[static_cast<std::size_t>(t) * num_classes];
     int best = 0;
     for (int c = 1; c < num_classes; ++c) {
       if (row[c] > row[best]) best = c;
     }
-    target_class[t] = static_cast<std::int16_t>(best);
+    out[t] = static_cast<std::int16_t>(best);
   }
+  return out;
+}
+
+std::vector<std::int16_t> ViewPseudoLabels::labelMap() const {
+  const std::vector<std::int16_t> target_class = targetClasses();
   std::vector<std::int16_t> out(region.size(), -1);
   for (std::size_t i = 0; i < region.size(); ++i) {
-    if (region[i] >= 0) out[i] = target_class[region[i]];
+    if (region[i] >= 0 && kept[region[i]]) out[i] = target_class[region[i]];
   }
   return out;
 }

@@ -85,10 +85,6 @@ TargetLayer resolveLayers(const std::vector<TargetLayer>& layers, int C,
 
 namespace {
 
-int argmax(const float* scores, int C) {
-  return static_cast<int>(std::max_element(scores, scores + C) - scores);
-}
-
 // Per-class agreement of the kept pseudo-labels with the ground truth of the labelled training
 // views; classes below options.min_class_precision (with enough evidence) are unkept everywhere.
 void checkClassReliability(io::Scene& scene, const std::vector<int>& views,
@@ -116,11 +112,9 @@ void checkClassReliability(io::Scene& scene, const std::vector<int>& views,
   }
   for (int i : views) {
     io::ViewPseudoLabels& p = scene.views[i].pseudo;
+    const std::vector<std::int16_t> target_class = p.targetClasses();
     for (int t = 0; t < p.num_targets; ++t) {
-      if (p.kept[t] &&
-          summary.class_rejected[argmax(&p.scores[static_cast<std::size_t>(t) * C], C)]) {
-        p.kept[t] = 0;
-      }
+      if (p.kept[t] && summary.class_rejected[target_class[t]]) p.kept[t] = 0;
     }
   }
 }
@@ -136,14 +130,16 @@ std::vector<std::size_t> applyViewAgreementCheck(io::Scene& scene, const std::ve
   // votes[p * C + c]: training views whose target at point p has argmax class c.
   std::vector<std::uint32_t> votes(P * C, 0), seen_by(P, 0);
   std::vector<std::vector<PointHit>> hits(views.size());
+  std::vector<std::vector<std::int16_t>> target_class(views.size());
   for (std::size_t k = 0; k < views.size(); ++k) {
     const io::View& v = scene.views[views[k]];
     if (v.pseudo.empty()) continue;
     hits[k] = visiblePoints(scene, v);
+    target_class[k] = v.pseudo.targetClasses();
     for (const PointHit& h : hits[k]) {
       const int r = v.pseudo.region[h.pixel];
       if (r < 0) continue;
-      ++votes[h.point * C + argmax(&v.pseudo.scores[static_cast<std::size_t>(r) * C], C)];
+      ++votes[h.point * C + target_class[k][r]];
       ++seen_by[h.point];
     }
   }
@@ -153,17 +149,16 @@ std::vector<std::size_t> applyViewAgreementCheck(io::Scene& scene, const std::ve
     for (const PointHit& h : hits[k]) {
       const int r = p.region[h.pixel];
       if (r < 0 || !p.kept[r]) continue;
-      const int own = argmax(&p.scores[static_cast<std::size_t>(r) * C], C);
-      // This view's own vote at the point is `own`: count the other views only.
+      // This view's own vote at the point is its target's class: count the other views only.
       total[r] += seen_by[h.point] - 1;
-      agree[r] += votes[h.point * C + own] - 1;
+      agree[r] += votes[h.point * C + target_class[k][r]] - 1;
     }
     for (int r = 0; r < p.num_targets; ++r) {
       if (!p.kept[r] || total[r] < min_votes || agree[r] >= min_agreement * total[r]) {
         continue;
       }
       p.kept[r] = 0;
-      ++removed[argmax(&p.scores[static_cast<std::size_t>(r) * C], C)];
+      ++removed[target_class[k][r]];
     }
   }
   return removed;

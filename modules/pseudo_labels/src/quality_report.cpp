@@ -26,14 +26,10 @@ PseudoLabelQuality evaluatePseudoLabels(const io::Scene& scene) {
     ++q.views;
     const io::ViewPseudoLabels& p = v.pseudo;
     const std::vector<std::int16_t> label = p.labelMap();
-    std::vector<int> argmax(p.num_targets, 0);
+    const std::vector<std::int16_t> argmax = p.targetClasses();
     std::vector<float> top1(p.num_targets, 0);
     for (int t = 0; t < p.num_targets; ++t) {
-      const float* s = &p.scores[static_cast<std::size_t>(t) * C];
-      for (int c = 0; c < C; ++c) {
-        if (s[c] > s[argmax[t]]) argmax[t] = c;
-      }
-      top1[t] = s[argmax[t]];
+      top1[t] = p.scores[static_cast<std::size_t>(t) * C + argmax[t]];
     }
     for (std::size_t i = 0; i < label.size(); ++i) {
       const int gt = v.labels.pixels[i];

@@ -55,6 +55,8 @@ struct ViewPseudoLabels {
   std::vector<std::uint8_t> kept;  ///< num_targets: 1 = passed the filter
 
   bool empty() const { return region.empty(); }
+  /// \brief Per target, kept or not: the class of its highest score (the first one on ties).
+  std::vector<std::int16_t> targetClasses() const;
   /// \brief Class of the kept target at each pixel, or -1 (not kept, no target).
   std::vector<std::int16_t> labelMap() const;
   /// \brief The confidence map's maximum over classes at each pixel (0 outside any target).
