@@ -174,14 +174,15 @@ int main(int argc, char** argv) {
                      "write report.json/.txt and overlays here");
   pseudo
       ->add_option("--filter-k", pseudo_options.filter.filter_k,
-                   "thresholds mean + k std (paper: 1)")
+                   "thresholds mean + k std (paper: 1; 0 keeps ~3x more at about the same "
+                   "precision and trained better)")
       ->capture_default_str();
   std::string pseudo_filter = "per-class";
   pseudo
       ->add_option("--filter", pseudo_filter,
                    "per-class: mean + k std over the targets of each TOP1 class (class-balanced); "
-                   "paper: over all targets (the paper's filter; with --min-view-agreement 0 "
-                   "exactly the paper)")
+                   "paper: over all targets (the paper's filter; with --filter-k 1 "
+                   "--min-view-agreement 0 exactly the paper)")
       ->check(CLI::IsMember({"per-class", "paper"}))
       ->capture_default_str();
   pseudo

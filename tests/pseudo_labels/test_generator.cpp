@@ -273,6 +273,7 @@ TEST(PseudoLabelGenerator, ClassCheckOnTheLabelledViewsRemovesAnUnreliableClass)
   ColumnScorer scorer;
   sp::PseudoLabelOptions options;
   options.per_class = false;  // the paper's filter, by hand in ColumnScorer's comment
+  options.filter_k = 1;
   sp::PseudoLabelSummary s = sp::generatePseudoLabels(scene, scorer, options);
   ASSERT_EQ(s.kept_targets, 4u);  // columns 0 and 1 of the two training views
   EXPECT_EQ(s.kept_regions, 4u);
