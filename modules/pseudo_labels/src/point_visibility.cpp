@@ -7,20 +7,10 @@
 namespace sadsplat {
 namespace pseudo_labels {
 
-void rotationFromQuat(const std::array<double, 4>& q, double R[9]) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  const double a = w / n, b = x / n, c = y / n, d = z / n;
-  R[0] = 1 - 2 * (c * c + d * d), R[1] = 2 * (b * c - a * d), R[2] = 2 * (b * d + a * c);
-  R[3] = 2 * (b * c + a * d), R[4] = 1 - 2 * (b * b + d * d), R[5] = 2 * (c * d - a * b);
-  R[6] = 2 * (b * d - a * c), R[7] = 2 * (c * d + a * b), R[8] = 1 - 2 * (b * b + c * c);
-}
-
 std::vector<PointHit> visiblePoints(const io::Scene& scene, const io::View& view, int cell) {
   const int W = view.camera.width, H = view.camera.height;
   cell = std::max(1, cell);
-  double R[9];
-  rotationFromQuat(view.camera.qvec, R);
+  const std::array<double, 9> R = view.camera.rotation();
   const auto& t = view.camera.tvec;
   const int CW = (W + cell - 1) / cell, CH = (H + cell - 1) / cell;
   std::vector<float> zbuf(static_cast<std::size_t>(CW) * CH, std::numeric_limits<float>::max());

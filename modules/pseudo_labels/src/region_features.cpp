@@ -42,8 +42,7 @@ SceneGeometry SceneGeometry::fromScene(const io::Scene& scene) {
   SceneGeometry g;
   std::array<double, 3> up{0, 0, 0};
   for (const io::View& v : scene.views) {
-    double R[9];
-    rotationFromQuat(v.camera.qvec, R);
+    const std::array<double, 9> R = v.camera.rotation();
     // Camera viewing direction in world = third row of R (R^T e_z); up is its opposite.
     for (int k = 0; k < 3; ++k) up[k] -= R[6 + k];
   }

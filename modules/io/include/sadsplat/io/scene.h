@@ -24,6 +24,9 @@ struct PinholeCamera {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::array<double, 4> qvec{1, 0, 0, 0};
   std::array<double, 3> tvec{0, 0, 0};
+
+  /// \brief R(qvec), row-major (qvec is normalised first, so any non-zero quaternion works).
+  std::array<double, 9> rotation() const;
 };
 
 /// \brief An 8-bit image, row-major, channels interleaved.

@@ -23,8 +23,5 @@ struct PointHit {
 /// more than 2 % nearer
 std::vector<PointHit> visiblePoints(const io::Scene& scene, const io::View& view, int cell = 4);
 
-/// \brief The rotation matrix (row-major) of a unit quaternion (w, x, y, z), as COLMAP stores it.
-void rotationFromQuat(const std::array<double, 4>& q, double R[9]);
-
 }  // namespace pseudo_labels
 }  // namespace sadsplat
