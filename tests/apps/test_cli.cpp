@@ -62,6 +62,7 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   const std::string report = test::readFile(dir.file("rep/report.json"));
   EXPECT_NE(report.find("\"filter\": \"per-class\""), std::string::npos) << report;
   EXPECT_NE(report.find("\"min_view_agreement\": 0.5"), std::string::npos) << report;
+  EXPECT_NE(report.find("\"filter_k\": 0.0"), std::string::npos) << report;
   EXPECT_NE(report.find("\"cross_view_unkept\""), std::string::npos) << report;
   EXPECT_NE(report.find("\"precision\""), std::string::npos) << report;
   ASSERT_EQ(test::runCommand(run + " --filter paper --min-view-agreement 0", &out), 0) << out;
