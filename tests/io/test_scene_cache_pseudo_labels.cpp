@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/file_info.h"
 #include "sadsplat/io/scene_cache.h"
 #include "test_support/test_support.h"
 
@@ -66,4 +67,24 @@ TEST(SceneCachePseudoLabels, InvalidPseudoLabelsAreRejected) {
   } catch (const sadsplat::Error& e) {
     EXPECT_NE(std::string(e.what()).find("scores"), std::string::npos) << e.what();
   }
+}
+
+// `sadsplat info` on a cache with pseudo-labels: one view of 6 pixels has them, target 0 (class a,
+// 2 pixels) kept, target 1 not: 1 of 2 targets, 2 of 6 pixels = 33.3 %.
+TEST(SceneCachePseudoLabels, InfoSummarisesThePseudoLabels) {
+  sadsplat::test::TempDir dir;
+  io::writeSceneCache(dir.file("s.cache"), sceneWithPseudoLabels());
+  const std::string info = io::describeFile(dir.file("s.cache"));
+  EXPECT_NE(info.find("pseudo-labels: 1 views (builtin), 1 of 2 targets kept, 33.3 % of their "
+                      "pixels labelled"),
+            std::string::npos)
+      << info;
+  EXPECT_NE(info.find("0 a rgb(1,2,3) \"a\", 2 pseudo-labelled pixels"), std::string::npos) << info;
+  EXPECT_NE(info.find("1 b rgb(4,5,6) \"b\", 0 pseudo-labelled pixels"), std::string::npos) << info;
+
+  io::Scene plain = sceneWithPseudoLabels();
+  plain.views[0].pseudo = {};
+  io::writeSceneCache(dir.file("plain.cache"), plain);
+  const std::string plain_info = io::describeFile(dir.file("plain.cache"));
+  EXPECT_EQ(plain_info.find("pseudo"), std::string::npos) << plain_info;
 }

@@ -71,11 +71,37 @@ void describeScene(std::ostream& out, const Scene& scene) {
   }
   out << "sparse points: " << scene.points.size() << "\n";
   describeBounds(out, scene.points, [](const ScenePoint& p) { return p.xyz; });
+  // Kept pseudo-label pixels per class, over the views that have pseudo-labels.
+  std::vector<std::size_t> kept_pixels(scene.classes.size(), 0);
+  std::size_t pseudo_views = 0, targets = 0, kept_targets = 0, pixels = 0, kept = 0;
+  std::string backend;
+  for (const auto& v : scene.views) {
+    if (v.pseudo.empty()) continue;
+    ++pseudo_views;
+    backend = v.pseudo.backend;
+    targets += static_cast<std::size_t>(v.pseudo.num_targets);
+    kept_targets += static_cast<std::size_t>(
+        std::count(v.pseudo.kept.begin(), v.pseudo.kept.end(), static_cast<std::uint8_t>(1)));
+    for (std::int16_t l : v.pseudo.labelMap()) {
+      ++pixels;
+      if (l < 0) continue;
+      ++kept;
+      if (static_cast<std::size_t>(l) < kept_pixels.size()) ++kept_pixels[l];
+    }
+  }
+  if (pseudo_views > 0) {
+    std::ostringstream share;
+    share << std::fixed << std::setprecision(1) << 100.0 * kept / pixels;
+    out << "pseudo-labels: " << pseudo_views << " views (" << backend << "), " << kept_targets
+        << " of " << targets << " targets kept, " << share.str() << " % of their pixels labelled\n";
+  }
   out << "classes: " << scene.classes.size() << "\n";
   for (std::size_t i = 0; i < scene.classes.size(); ++i) {
     const auto& c = scene.classes[i];
     out << "  " << i << " " << c.name << " rgb(" << int(c.color[0]) << "," << int(c.color[1]) << ","
-        << int(c.color[2]) << ") \"" << c.prompt << "\"\n";
+        << int(c.color[2]) << ") \"" << c.prompt << "\"";
+    if (pseudo_views > 0) out << ", " << kept_pixels[i] << " pseudo-labelled pixels";
+    out << "\n";
   }
 }
 
