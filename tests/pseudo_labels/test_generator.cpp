@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "pseudo_labels/toy_scene.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/pseudo_labels/generator.h"
@@ -78,6 +80,28 @@ TEST(PseudoLabelGenerator, GroundTruthOverridesPseudoLabels) {
   const io::View& other = scene.views[1];
   EXPECT_EQ(io::supervisionLabels(other), other.pseudo.labelMap());
   for (std::int16_t l : io::supervisionLabels(other, false)) EXPECT_EQ(l, -1);
+}
+
+TEST(PseudoLabelGenerator, BadOptionsAreErrorsNamingTheOption) {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene();
+  auto scorer = sp::makeBuiltinScorer(smallOptions());
+  auto message = [&](const sp::PseudoLabelOptions& o) -> std::string {
+    try {
+      sp::generatePseudoLabels(scene, *scorer, o);
+    } catch (const sadsplat::Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  sp::PseudoLabelOptions o;
+  o.filter_k = std::nan("");
+  EXPECT_NE(message(o).find("--filter-k"), std::string::npos) << message(o);
+  o = {};
+  o.min_view_agreement = 1.5;
+  EXPECT_NE(message(o).find("--min-view-agreement"), std::string::npos) << message(o);
+  o = {};
+  o.min_class_precision = -0.1;
+  EXPECT_NE(message(o).find("--min-class-precision"), std::string::npos) << message(o);
 }
 
 TEST(PseudoLabelGenerator, WithoutLabelledViewsTheBuiltinBackendStops) {

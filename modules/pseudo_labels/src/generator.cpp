@@ -1,6 +1,7 @@
 #include "sadsplat/pseudo_labels/generator.h"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 
 #include "sadsplat/common/error.h"
@@ -167,6 +168,18 @@ std::vector<std::size_t> applyViewAgreementCheck(io::Scene& scene, const std::ve
 PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                                         const PseudoLabelOptions& options,
                                         const ProgressFn& progress) {
+  if (!std::isfinite(options.filter_k)) {
+    throw Error("<pseudo-labels>", "filter k (--filter-k)", "a finite number",
+                std::to_string(options.filter_k));
+  }
+  if (!(options.min_view_agreement >= 0 && options.min_view_agreement <= 1)) {
+    throw Error("<pseudo-labels>", "min view agreement (--min-view-agreement)", "a share in [0, 1]",
+                std::to_string(options.min_view_agreement));
+  }
+  if (!(options.min_class_precision >= 0 && options.min_class_precision <= 1)) {
+    throw Error("<pseudo-labels>", "min class precision (--min-class-precision)",
+                "a share in [0, 1]", std::to_string(options.min_class_precision));
+  }
   const int C = static_cast<int>(scene.classes.size());
   if (C < 2) throw Error(scene.source, "classes", "at least 2 classes for pseudo-labels");
   std::vector<int> views;
