@@ -6,4 +6,9 @@ set -euo pipefail
 out="${OUT:-/tmp/sadsplat-gpu-out}"
 bash "$(dirname "$0")/build.sh"
 export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
-ctest --test-dir build-gpu --output-on-failure -j 8 "$@" 2>&1 | tee "$out/gpu_ctest.log"
+# Eight test processes of LibTorch's default 16 intra-op threads each oversubscribed the 16 cores
+# (session 6: CPU trainer tests took 140-312 s there, ~1 s on a 2-core dev machine, and the suite
+# ran past 330 s): give each process its share of the cores.
+jobs=8
+export OMP_NUM_THREADS=$(( $(nproc) / jobs > 0 ? $(nproc) / jobs : 1 ))
+ctest --test-dir build-gpu --output-on-failure -j "$jobs" "$@" 2>&1 | tee "$out/gpu_ctest.log"
