@@ -11,6 +11,7 @@
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/file_info.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -33,19 +34,24 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-pcl::PointCloud<sadsplat::GaussianPoint> loadGaussians(const std::string& path) {
-  if (sadsplat::io::endsWith(path, ".pcd")) return sadsplat::io::loadGaussianPcd(path);
-  return sadsplat::io::readGaussianPly(path);
+// `convert`: Gaussian clouds between .ply and .pcd, semantic clouds between .ply and .pcd.
+void convertCloud(const std::string& in, const std::string& out) {
+  using namespace sadsplat::io;
+  if (cloudKind(in) == CloudKind::kSemantic) {
+    writeSemanticCloud(out, readSemanticCloud(in));
+  } else {
+    writeGaussians(out, readGaussians(in));
+  }
 }
 
-void saveGaussians(const std::string& path, const pcl::PointCloud<sadsplat::GaussianPoint>& cloud) {
-  if (sadsplat::io::endsWith(path, ".pcd")) {
-    sadsplat::io::savePcd(path, cloud);
-  } else if (sadsplat::io::endsWith(path, ".ply")) {
-    sadsplat::io::writeGaussianPly(path, cloud);
-  } else {
-    throw sadsplat::Error(path, "output file name", "a name ending in .ply or .pcd");
-  }
+// `extract`: the points of one class (or all others) of a Gaussian or a semantic cloud.
+template <typename PointT>
+std::size_t extractClass(const pcl::PointCloud<PointT>& in,
+                         sadsplat::semantic_drop::ClassExtraction<PointT>& filter,
+                         pcl::PointCloud<PointT>* out) {
+  filter.setInputCloud(std::make_shared<pcl::PointCloud<PointT>>(in));
+  filter.filter(*out);
+  return in.size();
 }
 
 struct SynthArgs {
@@ -271,10 +277,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // --help / --version print and succeed; every usage error exits with 2 (CLI11's own codes
-    // vary by error kind).
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
+    // --help / --version print and succeed; every usage error is one line and exit status 2
+    // (CLI11's own codes vary by error kind, and it prints two lines).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "sadsplat: usage error: " << e.what() << " (see sadsplat --help)\n";
+    return 2;
   }
   try {
     if (*info) {
@@ -286,16 +293,14 @@ int main(int argc, char** argv) {
       std::cout << "imported " << scene.views.size() << " views, " << scene.points.size()
                 << " points into " << import_out << " in " << secondsSince(start) << " s\n";
     } else if (*convert) {
-      saveGaussians(convert_out, loadGaussians(convert_in));
+      convertCloud(convert_in, convert_out);
     } else if (*extract) {
       if (sadsplat::io::isDirectory(extract_in)) {
         // A run directory: its model and its class list.
         if (extract_classes.empty()) extract_classes = extract_in + "/classes.json";
         extract_in += "/model.ply";
       }
-      auto cloud =
-          std::make_shared<pcl::PointCloud<sadsplat::GaussianPoint>>(loadGaussians(extract_in));
-      sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> filter;
+      std::uint32_t class_id = 0;
       if (extract_classes.empty()) {
         std::size_t used = 0;
         unsigned long id = 0;
@@ -304,23 +309,38 @@ int main(int argc, char** argv) {
         } catch (const std::exception&) {
           used = 0;
         }
-        if (used != extract_class.size()) {
+        if (used != extract_class.size() || id >= sadsplat::kUnlabelled) {
           throw sadsplat::Error(extract_class, "--class",
                                 "a class id, or --classes FILE to use names");
         }
-        filter.setClassId(static_cast<std::uint32_t>(id));
+        class_id = static_cast<std::uint32_t>(id);
       } else {
         const auto classes = sadsplat::io::isSceneCache(extract_classes)
                                  ? sadsplat::io::readSceneCache(extract_classes).classes
                                  : sadsplat::io::readClassesJson(extract_classes);
-        filter.setClassName(extract_class, classes);
+        sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> by_name;
+        by_name.setClassName(extract_class, classes);
+        class_id = by_name.getClassId();
       }
-      filter.setInputCloud(cloud);
-      filter.setNegative(extract_negative);
-      pcl::PointCloud<sadsplat::GaussianPoint> out;
-      filter.filter(out);
-      saveGaussians(extract_out, out);
-      std::cout << "kept " << out.size() << " of " << cloud->size() << " Gaussians\n";
+      std::size_t kept = 0, total = 0;
+      if (sadsplat::io::cloudKind(extract_in) == sadsplat::io::CloudKind::kSemantic) {
+        sadsplat::semantic_drop::ClassExtraction<pcl::PointXYZRGBL> filter;
+        filter.setClassId(class_id);
+        filter.setNegative(extract_negative);
+        pcl::PointCloud<pcl::PointXYZRGBL> out;
+        total = extractClass(sadsplat::io::readSemanticCloud(extract_in), filter, &out);
+        sadsplat::io::writeSemanticCloud(extract_out, out);
+        kept = out.size();
+      } else {
+        sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> filter;
+        filter.setClassId(class_id);
+        filter.setNegative(extract_negative);
+        pcl::PointCloud<sadsplat::GaussianPoint> out;
+        total = extractClass(sadsplat::io::readGaussians(extract_in), filter, &out);
+        sadsplat::io::writeGaussians(extract_out, out);
+        kept = out.size();
+      }
+      std::cout << "kept " << kept << " of " << total << " points\n";
     } else if (*synth_cmd) {
       if (synth_args.out.empty() && synth_args.cache.empty()) {
         throw sadsplat::Error("<command line>", "synth", "--out DIR and/or --cache FILE");

@@ -1,6 +1,9 @@
 // The CLI: subcommands listed, info summaries, clear errors with non-zero exits, demo.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
+#include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_import.h"
@@ -37,6 +40,9 @@ TEST(Cli, BadInputGivesOneMessageAndNonZeroExit) {
   EXPECT_EQ(test::runCommand(kCli + " info " + dir.file("bad.ply"), &out), 1);
   EXPECT_NE(out.find("bad.ply: magic: expected"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(kCli + " frobnicate", &out), 2);
+  // A usage error is one line in sadsplat's form, like every other error.
+  EXPECT_EQ(out.rfind("sadsplat: usage error: ", 0), 0u) << out;
+  EXPECT_EQ(out.find('\n'), out.size() - 1) << out;
 }
 
 // The pseudo-label options reach the built-in backend (committed fixture cache: no OpenCV needed);
@@ -141,6 +147,31 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   std::size_t roads = 0;
   for (const auto& p : io::readGaussianPly(run + "/model.ply")) roads += p.label == 0;
   EXPECT_EQ(io::readGaussianPly(dir.file("road.ply")).size(), roads);
+  // sadsplat reads every cloud it writes: info, convert and extract take each of them.
+  const std::string n = std::to_string(io::readGaussianPly(run + "/model.ply").size());
+  for (const char* f : {"model.ply", "model.pcd", "model_semantic.pcd", "model_semantic.ply"}) {
+    ASSERT_EQ(test::runCommand(kCli + " info " + run + "/" + f, &out), 0) << f << out;
+    EXPECT_NE(out.find(": " + n + "\n"), std::string::npos) << f << out;
+  }
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " convert " + run + "/model_semantic.pcd " + dir.file("conv/semantic.ply"), &out),
+      0)
+      << out;
+  EXPECT_EQ(io::readSemanticCloud(dir.file("conv/semantic.ply")).size(),
+            io::readSemanticCloud(run + "/model_semantic.ply").size());
+  ASSERT_EQ(
+      test::runCommand(kCli + " convert " + run + "/model.pcd " + dir.file("conv/m.ply"), &out), 0)
+      << out;
+  EXPECT_EQ(io::readGaussianPly(dir.file("conv/m.ply")).size(),
+            io::readGaussians(run + "/model.pcd").size());
+  ASSERT_EQ(
+      test::runCommand(kCli + " extract " + run + "/model_semantic.pcd --class road --classes " +
+                           run + "/classes.json --out " + dir.file("road_sem.pcd"),
+                       &out),
+      0)
+      << out;
+  EXPECT_EQ(io::readSemanticCloud(dir.file("road_sem.pcd")).size(), roads);
   EXPECT_EQ(test::runCommand(
                 kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out),
             1);
@@ -153,8 +184,13 @@ TEST(Cli, DemoRunsTheMethodAndTheBaseline) {
   if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
   test::TempDir dir;
   std::string out;
-  ASSERT_EQ(test::runCommand(kCli + " demo --iterations 20 --out " + dir.file("full"), &out), 0)
+  // The README's first run: from a directory without out/, into a nested path that does not exist.
+  ASSERT_EQ(
+      test::runCommand(
+          "cd " + dir.path() + " && " + kCli + " demo --iterations 20 --out out/nested/full", &out),
+      0)
       << out;
+  ASSERT_EQ(std::rename(dir.file("out/nested/full").c_str(), dir.file("full").c_str()), 0);
   EXPECT_NE(out.find("60 pseudo-labelled views"), std::string::npos) << out;
   EXPECT_NE(out.find("[drop] iteration 5: removed"), std::string::npos) << out;
   EXPECT_NE(out.find("| mIoU |"), std::string::npos) << out;

@@ -2,6 +2,7 @@
 // the readers of PCL and Open3D.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -68,7 +69,7 @@ TEST(GaussianPly, WritesTheStandardLayoutThenSemanticProperties) {
   for (int k = 0; k < 3; ++k) want += "property float scale_" + std::to_string(k) + "\n";
   for (int k = 0; k < 4; ++k) want += "property float rot_" + std::to_string(k) + "\n";
   for (int k = 0; k < 32; ++k) want += "property float feature_" + std::to_string(k) + "\n";
-  want += "property float log_alpha\nproperty float confidence\nproperty uint label\nend_header\n";
+  want += "property float log_alpha\nproperty float confidence\nproperty int label\nend_header\n";
   EXPECT_EQ(headerOf(dir.file("a.ply")), want);
   // 62 standard floats + 34 semantic floats + 1 uint per vertex.
   EXPECT_EQ(test::readFile(dir.file("a.ply")).size(), want.size() + 3 * 97 * 4);
@@ -193,7 +194,74 @@ TEST(GaussianPly, ErrorsNameTheFileAndTheProblem) {
 }
 
 TEST(GaussianPly, FailedWriteLeavesNoFileBehind) {
-  EXPECT_THROW(writeGaussianPly("/nonexistent-dir/a.ply", test::randomGaussians(1, 1)), Error);
+  test::TempDir dir;
+  test::writeFile(dir.file("plain"), "a file, not a directory");
+  EXPECT_THROW(writeGaussianPly(dir.file("plain/a.ply"), test::randomGaussians(1, 1)), Error);
+  // A missing directory is created: outputs may name nested paths that do not exist yet.
+  writeGaussianPly(dir.file("new/nested/a.ply"), test::randomGaussians(2, 1));
+  EXPECT_EQ(readGaussianPly(dir.file("new/nested/a.ply")).size(), 2u);
+}
+
+// Counts in a header are checked against the bytes present before they allocate or loop: the
+// inputs a fuzzer found (huge counts, a huge element before the vertices, counts that are not
+// decimal) are one-line errors, not bad_alloc, a hang or a silently wrong count.
+TEST(GaussianPly, HeaderCountsAreCheckedAgainstTheFile) {
+  test::TempDir dir;
+  writeGaussianPly(dir.file("ok.ply"), test::randomGaussians(3, 2));
+  const std::string ok = test::readFile(dir.file("ok.ply"));
+  const auto edit = [&](const std::string& from, const std::string& to) {
+    std::string bytes = ok;
+    bytes.replace(bytes.find(from), from.size(), to);
+    return bytes;
+  };
+  test::writeFile(dir.file("huge.ply"), edit("element vertex 3", "element vertex 5000000000"));
+  expectReadError(dir.file("huge.ply"), "element vertex: expected 5000000000 items");
+  test::writeFile(dir.file("toolarge.ply"),
+                  edit("element vertex 3", "element vertex 99999999999999999999"));
+  expectReadError(dir.file("toolarge.ply"), "decimal count");
+  test::writeFile(dir.file("hex.ply"), edit("element vertex 3", "element vertex 0x28"));
+  expectReadError(dir.file("hex.ply"), "decimal count");
+  test::writeFile(dir.file("suffix.ply"), edit("element vertex 3", "element vertex 1abc"));
+  expectReadError(dir.file("suffix.ply"), "decimal count");
+  // An element without properties before the vertices, with a huge count, used to loop forever.
+  test::writeFile(dir.file("empty_elem.ply"),
+                  edit("element vertex 3", "element junk 900000000000\nelement vertex 3"));
+  const auto start = std::chrono::steady_clock::now();
+  const auto back = readGaussianPly(dir.file("empty_elem.ply"));
+  EXPECT_EQ(back.size(), 3u);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  test::writeFile(
+      dir.file("big_elem.ply"),
+      edit("element vertex 3", "element junk 90000000\nproperty float a\nelement vertex 3"));
+  expectReadError(dir.file("big_elem.ply"), "element junk: expected 90000000 items");
+  // A list whose length runs past the end of the file.
+  std::string list =
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int idx\n"
+      "element vertex 0\n";
+  for (const char* n : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0",
+                        "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
+    list += std::string("property float ") + n + "\n";
+  }
+  test::writeFile(dir.file("list.ply"), list + "end_header\n200 1 2\n");
+  expectReadError(dir.file("list.ply"), "list idx");
+}
+
+TEST(GaussianPly, LabelIsAnIntWithMinusOneForNoClass) {
+  test::TempDir dir;
+  auto cloud = test::randomGaussians(4, 3);
+  cloud[0].label = kUnlabelled;
+  cloud[1].label = 2;
+  writeGaussianPly(dir.file("a.ply"), cloud);
+  EXPECT_NE(headerOf(dir.file("a.ply")).find("property int label\n"), std::string::npos);
+  const auto back = readGaussianPly(dir.file("a.ply"));
+  EXPECT_EQ(back[0].label, kUnlabelled);
+  EXPECT_EQ(back[1].label, 2u);
+}
+
+TEST(GaussianPly, AFifoIsAnErrorNotABlockingRead) {
+  test::TempDir dir;
+  ASSERT_EQ(test::runCommand("mkfifo " + dir.file("pipe.ply")), 0);
+  expectReadError(dir.file("pipe.ply"), "a regular file");
 }
 
 #if SADSPLAT_HAVE_PCL_IO
@@ -224,12 +292,15 @@ TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
   }
   test::TempDir dir;
   auto cloud = test::randomGaussians(6, 9);
+  cloud[0].label = kUnlabelled;
+  cloud[1].label = 3;
   writeGaussianPly(dir.file("a.ply"), cloud);
   const std::string script =
       "import open3d as o3d, sys\n"
       "pc = o3d.t.io.read_point_cloud(sys.argv[1])\n"
       "print(len(pc.point.positions), float(pc.point.opacity[2][0].item()), "
-      "float(pc.point.feature_31[4][0].item()), float(pc.point.f_rest_44[0][0].item()))\n";
+      "float(pc.point.feature_31[4][0].item()), float(pc.point.f_rest_44[0][0].item()), "
+      "int(pc.point.label[1][0].item()), int(pc.point.label[0][0].item()))\n";
   test::writeFile(dir.file("probe.py"), script);
   std::string out;
   ASSERT_EQ(
@@ -239,7 +310,11 @@ TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
   std::istringstream in(out.substr(out.find_last_of('\n', out.size() - 2) + 1));
   std::size_t n = 0;
   float opacity = 0, feature = 0, rest = 0;
-  in >> n >> opacity >> feature >> rest;
+  int label1 = 0, label0 = 0;
+  in >> n >> opacity >> feature >> rest >> label1 >> label0;
+  // Open3D 0.16 skips `uint` properties: the label is an int so that it survives.
+  EXPECT_EQ(label1, 3) << out;
+  EXPECT_EQ(label0, -1) << out;
   EXPECT_EQ(n, 6u) << out;
   EXPECT_FLOAT_EQ(opacity, cloud[2].opacity);
   EXPECT_FLOAT_EQ(feature, cloud[4].feature[31]);

@@ -10,15 +10,26 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/filesystem.h"
 
 namespace sadsplat {
 namespace io {
 
 void writeViaTemporaryPath(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write) {
+  // An output path names what the user wants; its missing parent directories are made here, so
+  // every writer accepts a nested path that does not exist yet (`--out out/a/b/model.ply`).
+  makeParentDirectory(path);
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
   try {
-    write(tmp);
+    try {
+      write(tmp);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      // Third-party writers (PCL, OpenCV) throw their own types: keep the one-line error form.
+      throw Error(path, "write", "success", e.what());
+    }
     struct stat st {};
     if (::stat(tmp.c_str(), &st) != 0) {
       throw Error(path, "write", "the file to be written", "the writer produced nothing");
@@ -45,6 +56,7 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
 }
 
 std::string readWholeFile(const std::string& path) {
+  requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "file", "an existing, readable file", "cannot open it");
   std::ostringstream buffer;

@@ -1,11 +1,14 @@
 #include "sadsplat/io/file_info.h"
 
 #include <algorithm>
+#include <array>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
@@ -53,6 +56,26 @@ void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& 
   }
   out << "labelled gaussians: " << labelled;
   if (labelled) out << " (class ids up to " << max_label << ")";
+  out << "\n";
+}
+
+void describeSemantic(std::ostream& out, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud) {
+  out << "points: " << cloud.size() << "\n";
+  describeBounds(out, cloud, [](const pcl::PointXYZRGBL& p) {
+    return std::array<float, 3>{p.x, p.y, p.z};
+  });
+  std::map<std::uint32_t, std::size_t> per_label;
+  for (const auto& p : cloud) ++per_label[p.label];
+  out << "points per class id:";
+  for (const auto& [label, n] : per_label) {
+    out << " ";
+    if (label == kUnlabelled) {
+      out << "none";
+    } else {
+      out << label;
+    }
+    out << "=" << n;
+  }
   out << "\n";
 }
 
@@ -116,7 +139,11 @@ std::string describeFile(const std::string& path) {
   } else if (isSceneCache(path)) {
     out << path << ": scene cache (version " << kSceneCacheVersion << ")\n";
     describeScene(out, readSceneCache(path));
-  } else if (endsWith(path, ".ply")) {
+  } else if ((lowerExtension(path) == ".ply" || lowerExtension(path) == ".pcd") &&
+             cloudKind(path) == CloudKind::kSemantic) {
+    out << path << ": semantic point cloud (x y z colour label)\n";
+    describeSemantic(out, readSemanticCloud(path));
+  } else if (lowerExtension(path) == ".ply") {
     PlyFileInfo info;
     const auto cloud = readGaussianPly(path, &info);
     out << path << ": 3DGS PLY (" << info.format << ")\n"
@@ -129,7 +156,7 @@ std::string describeFile(const std::string& path) {
       out << "\n";
     }
     describeGaussians(out, cloud);
-  } else if (endsWith(path, ".pcd")) {
+  } else if (lowerExtension(path) == ".pcd") {
     out << path << ": PCD of GaussianPoint\n";
     describeGaussians(out, loadGaussianPcd(path));
   } else {

@@ -17,6 +17,7 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/semantic_ply.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
@@ -59,10 +60,10 @@ void writeModel(const std::string& dir, const gaussians::Trainer& trainer,
                 const std::vector<ClassInfo>& classes) {
   const auto cloud = trainer.toCloud();
   io::writeGaussianPly(dir + "/model.ply", cloud);
-  if (io::havePcdSupport()) {
-    io::savePcd(dir + "/model.pcd", cloud);
-    io::savePcd(dir + "/model_semantic.pcd", toSemanticCloud(cloud, classes));
-  }
+  io::savePcd(dir + "/model.pcd", cloud);
+  const auto semantic = toSemanticCloud(cloud, classes);
+  io::savePcd(dir + "/model_semantic.pcd", semantic);
+  io::writeSemanticPly(dir + "/model_semantic.ply", semantic);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace io {
 /// \brief Writes `path` atomically: `write` fills a temporary file in the same directory, which
 /// is flushed and then renamed over `path`. On any failure the temporary file is removed, `path`
 /// is left as it was, and sadsplat::Error is thrown.
-/// \param[in] path destination file; its directory must exist
+/// \param[in] path destination file; missing parent directories are created
 /// \param[in] write callback that writes the whole content to the stream (binary mode)
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
@@ -23,7 +23,8 @@ void writeViaTemporaryPath(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write);
 
 /// \brief Reads a whole file into memory.
-/// \throws sadsplat::Error naming the file if it is missing or unreadable
+/// \throws sadsplat::Error naming the file if it is missing, unreadable or not a regular file
+/// (a FIFO or device would block or never end)
 std::string readWholeFile(const std::string& path);
 
 }  // namespace io

@@ -1,6 +1,7 @@
 #pragma once
 /// \file filesystem.h
-/// \brief The few file-system questions sadsplat asks, answered in one place.
+/// \brief The few file-system questions sadsplat asks, answered in one place (std::filesystem),
+/// with failures turned into sadsplat::Error.
 
 #include <string>
 
@@ -11,13 +12,22 @@ namespace io {
 bool pathExists(const std::string& path);
 /// \brief Whether `path` is a directory.
 bool isDirectory(const std::string& path);
-/// \brief Whether `path` is a regular file.
+/// \brief Whether `path` is a regular file (not a directory, FIFO, device or socket).
 bool isRegularFile(const std::string& path);
-/// \brief Creates `dir` (its parent must exist); an existing directory is fine.
-/// \throws sadsplat::Error naming the directory if it cannot be created
+/// \brief Creates `dir` and every missing parent; an existing directory is fine.
+/// \throws sadsplat::Error naming the directory if it cannot be created (or is a file)
 void makeDirectory(const std::string& dir);
+/// \brief Creates the missing parent directories of the file `path` (nothing if it has none).
+/// \throws sadsplat::Error naming the directory if it cannot be created
+void makeParentDirectory(const std::string& path);
+/// \brief Throws unless `path` is an existing regular file: readers call this first, so that a
+/// FIFO, a device or a directory is an error instead of a blocking or endless read.
+/// \throws sadsplat::Error naming the file and what it is
+void requireRegularFile(const std::string& path);
 /// \brief Whether `text` ends with `suffix`.
 bool endsWith(const std::string& text, const std::string& suffix);
+/// \brief The file name extension of `path` in lower case, with its dot (".ply"), or "".
+std::string lowerExtension(const std::string& path);
 
 }  // namespace io
 }  // namespace sadsplat

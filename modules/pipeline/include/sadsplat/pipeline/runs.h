@@ -5,7 +5,8 @@
 /// A run directory holds: config.json (the exact configuration), run.json (scene path, device,
 /// iterations done, training seconds), checkpoint.bin (latest training state, written every
 /// checkpoint_interval iterations and at the end), model.ply (3DGS PLY with semantic
-/// properties), model.pcd and model_semantic.pcd (with pcl_io), classes.json, and after evaluation
+/// properties), model.pcd (the same Gaussians as PCD), model_semantic.pcd and model_semantic.ply
+/// (the plain semantic cloud: centre, class colour, class id), classes.json, and after evaluation
 /// metrics.json and panels/*.png.
 
 #include <functional>
