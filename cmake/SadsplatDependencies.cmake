@@ -9,42 +9,14 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(Boost REQUIRED)
 find_package(Threads REQUIRED)
 
-# --- LibTorch -------------------------------------------------------------------------------
+# --- LibTorch and PCL (non-I/O) as the imported targets sadsplat::torch / sadsplat::pcl ---------
+# The same file defines them for a project that uses the installed package (sadsplatConfig.cmake).
 find_package(Torch REQUIRED)
-# TORCH_LIBRARIES carries the whole of libtorch; modules link it PRIVATE unless a header needs it.
-add_library(sadsplat_torch INTERFACE)
-target_link_libraries(sadsplat_torch INTERFACE ${TORCH_LIBRARIES})
-target_include_directories(sadsplat_torch SYSTEM INTERFACE ${TORCH_INCLUDE_DIRS})
-add_library(sadsplat::torch ALIAS sadsplat_torch)
+include(SadsplatImportedDeps)
 
-# --- PCL (by hand) --------------------------------------------------------------------------
-set(_pcl_hints)
-if(SADSPLAT_PCL_ROOT)
-  list(APPEND _pcl_hints ${SADSPLAT_PCL_ROOT}/usr ${SADSPLAT_PCL_ROOT})
-endif()
-find_path(SADSPLAT_PCL_INCLUDE_DIR pcl/point_types.h
-          HINTS ${_pcl_hints} PATH_SUFFIXES include/pcl-1.13 include/pcl-1.14 include/pcl-1.12
-          REQUIRED)
-find_path(SADSPLAT_FLANN_INCLUDE_DIR flann/flann.hpp HINTS ${_pcl_hints} PATH_SUFFIXES include
-          REQUIRED)
-find_path(SADSPLAT_LZ4_INCLUDE_DIR lz4.h HINTS ${_pcl_hints} PATH_SUFFIXES include REQUIRED)
-
-add_library(sadsplat_pcl INTERFACE)
-target_include_directories(sadsplat_pcl SYSTEM INTERFACE
-  ${SADSPLAT_PCL_INCLUDE_DIR} ${SADSPLAT_FLANN_INCLUDE_DIR} ${SADSPLAT_LZ4_INCLUDE_DIR})
-target_link_libraries(sadsplat_pcl INTERFACE Eigen3::Eigen Boost::headers)
-foreach(_lib common kdtree search octree filters sample_consensus)
-  find_library(SADSPLAT_PCL_${_lib}_LIBRARY NAMES pcl_${_lib}
-               HINTS ${_pcl_hints} PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
-  target_link_libraries(sadsplat_pcl INTERFACE ${SADSPLAT_PCL_${_lib}_LIBRARY})
-endforeach()
-find_library(SADSPLAT_FLANN_LIBRARY NAMES flann_cpp HINTS ${_pcl_hints}
-             PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
-# FLANN's headers call LZ4 (index serialisation), so code instantiating KdTreeFLANN needs it.
-find_library(SADSPLAT_LZ4_LIBRARY NAMES lz4 HINTS ${_pcl_hints}
-             PATH_SUFFIXES lib/x86_64-linux-gnu lib REQUIRED)
-target_link_libraries(sadsplat_pcl INTERFACE ${SADSPLAT_FLANN_LIBRARY} ${SADSPLAT_LZ4_LIBRARY})
-add_library(sadsplat::pcl ALIAS sadsplat_pcl)
+# The viz module (VTK views and plots) sets these when it is built.
+set(SADSPLAT_HAVE_VIZ OFF)
+set(SADSPLAT_VTK_COMPONENTS "")
 
 set(SADSPLAT_HAVE_PCL_IO OFF)
 if(SADSPLAT_WITH_VTK)
@@ -53,6 +25,7 @@ if(SADSPLAT_WITH_VTK)
   find_library(SADSPLAT_PCL_io_ply_LIBRARY NAMES pcl_io_ply HINTS ${_pcl_hints}
                PATH_SUFFIXES lib/x86_64-linux-gnu lib)
   if(SADSPLAT_PCL_io_LIBRARY AND SADSPLAT_PCL_io_ply_LIBRARY)
+    # Only the tests link pcl_io (to check that PCL's own readers take sadsplat's files).
     add_library(sadsplat_pcl_io INTERFACE)
     target_link_libraries(sadsplat_pcl_io INTERFACE sadsplat::pcl ${SADSPLAT_PCL_io_LIBRARY}
                                                     ${SADSPLAT_PCL_io_ply_LIBRARY})
@@ -117,4 +90,18 @@ target_compile_definitions(sadsplat_build_flags INTERFACE
   SADSPLAT_COMPILE_CUDA=$<BOOL:${SADSPLAT_COMPILE_CUDA}>)
 target_compile_options(sadsplat_build_flags INTERFACE
   $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wno-unused-parameter>)
+# Modules link it as $<BUILD_INTERFACE:...>: a project using the installed package gets neither
+# these warnings nor these definitions (no public header reads them).
 add_library(sadsplat::build_flags ALIAS sadsplat_build_flags)
+
+# A module library: public headers from include/ (installed to include/), exported as
+# sadsplat::<export_name>.
+include(GNUInstallDirs)
+function(sadsplat_module_target target export_name)
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${export_name})
+  set_property(GLOBAL APPEND PROPERTY SADSPLAT_MODULE_TARGETS ${target})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endfunction()
