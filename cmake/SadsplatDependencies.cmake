@@ -14,9 +14,21 @@ find_package(Threads REQUIRED)
 find_package(Torch REQUIRED)
 include(SadsplatImportedDeps)
 
-# The viz module (VTK views and plots) sets these when it is built.
+# --- VTK: the viz module (3D views of Gaussian clouds, training plots) -----------------------
 set(SADSPLAT_HAVE_VIZ OFF)
-set(SADSPLAT_VTK_COMPONENTS "")
+set(SADSPLAT_VTK_COMPONENTS
+    CommonCore CommonDataModel CommonColor RenderingCore RenderingOpenGL2 RenderingAnnotation
+    RenderingFreeType RenderingContext2D RenderingContextOpenGL2 InteractionStyle ChartsCore
+    ViewsContext2D IOImage)
+if(SADSPLAT_WITH_VTK)
+  find_package(VTK COMPONENTS ${SADSPLAT_VTK_COMPONENTS})
+  if(VTK_FOUND)
+    set(SADSPLAT_HAVE_VIZ ON)
+  else()
+    message(FATAL_ERROR "SADSPLAT_WITH_VTK=ON but VTK (${SADSPLAT_VTK_COMPONENTS}) was not found "
+                        "(install libvtk9-dev, or configure with -DSADSPLAT_WITH_VTK=OFF)")
+  endif()
+endif()
 
 set(SADSPLAT_HAVE_PCL_IO OFF)
 if(SADSPLAT_WITH_VTK)
@@ -87,6 +99,7 @@ target_compile_definitions(sadsplat_build_flags INTERFACE
   SADSPLAT_HAVE_OPENCV=$<BOOL:${SADSPLAT_HAVE_OPENCV}>
   SADSPLAT_HAVE_PCL_IO=$<BOOL:${SADSPLAT_HAVE_PCL_IO}>
   SADSPLAT_HAVE_CUDA=$<BOOL:${SADSPLAT_HAVE_CUDA}>
+  SADSPLAT_HAVE_VIZ=$<BOOL:${SADSPLAT_HAVE_VIZ}>
   SADSPLAT_COMPILE_CUDA=$<BOOL:${SADSPLAT_COMPILE_CUDA}>)
 target_compile_options(sadsplat_build_flags INTERFACE
   $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wno-unused-parameter>)

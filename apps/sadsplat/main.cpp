@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <sstream>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
@@ -24,6 +25,15 @@
 #include "sadsplat/synth/aerial_benchmark.h"
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/scene_writer.h"
+#endif
+#if SADSPLAT_HAVE_VIZ
+#include <unistd.h>
+
+#include <cstdlib>
+
+#include "sadsplat/viz/display.h"
+#include "sadsplat/viz/splat_view.h"
+#include "sadsplat/viz/training_report.h"
 #endif
 
 namespace {
@@ -104,6 +114,36 @@ int runSynth(const SynthArgs& a) {
   std::cout << "\nwrote " << (a.out.empty() ? a.cache : a.out) << "\n";
   return 0;
 }
+
+#if SADSPLAT_HAVE_VIZ
+// VTK renders through X only here. An offscreen job (a screenshot, a report) on a machine with
+// no display runs itself again under xvfb-run when that is installed, so that it simply works.
+void rerunUnderXvfbIfHeadless(int argc, char** argv) {
+  if (sadsplat::viz::haveDisplay() || std::getenv("SADSPLAT_UNDER_XVFB") != nullptr) return;
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) return;  // requireDisplay says why
+  setenv("SADSPLAT_UNDER_XVFB", "1", 1);
+  std::vector<char*> args = {const_cast<char*>("xvfb-run"), const_cast<char*>("-a"),
+                             const_cast<char*>("-s"),
+                             const_cast<char*>("-screen 0 3840x2160x24 -nolisten tcp")};
+  for (int i = 0; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execvp("xvfb-run", args.data());  // returns only on failure: then the display error follows
+}
+
+// "1280x720" -> width, height.
+void parseSize(const std::string& text, int* width, int* height) {
+  const auto x = text.find('x');
+  try {
+    std::size_t used_w = 0, used_h = 0;
+    if (x == std::string::npos) throw std::invalid_argument("no x");
+    *width = std::stoi(text.substr(0, x), &used_w);
+    *height = std::stoi(text.substr(x + 1), &used_h);
+    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("trailing");
+  } catch (const std::exception&) {
+    throw sadsplat::Error("<command line>", "--size", "WIDTHxHEIGHT, e.g. 1280x720", text);
+  }
+}
+#endif
 
 }  // namespace
 
@@ -274,6 +314,32 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
 
+#if SADSPLAT_HAVE_VIZ
+  auto* view = app.add_subcommand(
+      "view", "Look at a model in 3D (VTK): splats by class, colour, confidence, gate or opacity");
+  std::string view_model, view_compare, view_color = "class", view_classes, view_size = "1280x720";
+  sadsplat::viz::SplatViewOptions view_options;
+  view->add_option("MODEL", view_model, "run directory, or a .ply / .pcd cloud")->required();
+  view->add_option("--color", view_color, "class, rgb, confidence, gate or opacity")
+      ->capture_default_str();
+  view->add_option("--class", view_classes,
+                   "show only these classes (names or ids, comma-separated)");
+  view->add_option("--view", view_options.view,
+                   "start at this camera of the run's scene (e.g. view_042)");
+  view->add_option("--compare", view_compare, "a second model beside it, cameras linked");
+  view->add_option("--screenshot", view_options.screenshot, "write this PNG (offscreen) and exit");
+  view->add_option("--size", view_size, "window / screenshot size")->capture_default_str();
+  view->add_option("--splat-scale", view_options.splat_scale, "factor on every splat's radius")
+      ->capture_default_str();
+
+  auto* report = app.add_subcommand(
+      "report", "Plots and report.md of a training run (loss, Gaussians, drops, IoU per class)");
+  sadsplat::viz::ReportOptions report_options;
+  report->add_option("RUN", report_options.run, "run directory")->required();
+  report->add_option("--baseline", report_options.baseline, "a run to compare with");
+  report->add_option("--out", report_options.out, "output directory (default RUN/report)");
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -382,6 +448,22 @@ int main(int argc, char** argv) {
       std::cout << sadsplat::pipeline::pseudoLabelRun(pseudo_options);
     } else if (*evaluate) {
       std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
+#if SADSPLAT_HAVE_VIZ
+    } else if (*view) {
+      if (!view_options.screenshot.empty()) rerunUnderXvfbIfHeadless(argc, argv);
+      view_options.color = sadsplat::viz::parseColorMode(view_color);
+      parseSize(view_size, &view_options.width, &view_options.height);
+      std::stringstream names(view_classes);
+      for (std::string name; std::getline(names, name, ',');) {
+        if (!name.empty()) view_options.classes.push_back(name);
+      }
+      std::vector<sadsplat::viz::ViewModel> models = {sadsplat::viz::loadViewModel(view_model)};
+      if (!view_compare.empty()) models.push_back(sadsplat::viz::loadViewModel(view_compare));
+      sadsplat::viz::showModels(models, view_options, &std::cout);
+    } else if (*report) {
+      rerunUnderXvfbIfHeadless(argc, argv);
+      std::cout << "wrote " << sadsplat::viz::writeTrainingReport(report_options) << "\n";
+#endif
     } else if (*demo) {
       return sadsplat::pipeline::runDemo(demo_out, demo_iterations, std::cout, demo_baseline);
     }

@@ -18,6 +18,7 @@
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/io/semantic_ply.h"
+#include "sadsplat/io/train_log.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
@@ -64,6 +65,40 @@ void writeModel(const std::string& dir, const gaussians::Trainer& trainer,
   const auto semantic = toSemanticCloud(cloud, classes);
   io::savePcd(dir + "/model_semantic.pcd", semantic);
   io::writeSemanticPly(dir + "/model_semantic.ply", semantic);
+}
+
+// The train log's records of one step: a drop and a closed-gate removal when they happened, and
+// the losses every 10 iterations (as the progress line) and at the last one.
+void logStep(io::TrainLogWriter& log, const gaussians::StepStats& s, double seconds, bool last) {
+  if (s.dropped > 0) {
+    io::TrainLogRecord r;
+    r.type = "drop";
+    r.iteration = s.iteration;
+    r.removed = s.dropped;
+    r.gaussians = s.num_gaussians;
+    r.low_confidence = s.drop.removed_low_confidence;
+    r.unseen = s.drop.removed_unseen;
+    r.closed_gate = s.drop.removed_closed_gate;
+    log.append(r);
+  }
+  if (s.removed_closed_gates > 0) {
+    io::TrainLogRecord r;
+    r.type = "closed_gates";
+    r.iteration = s.iteration;
+    r.removed = s.removed_closed_gates;
+    r.gaussians = s.num_gaussians;
+    log.append(r);
+  }
+  if (s.iteration % 10 == 0 || last) {
+    io::TrainLogRecord r;
+    r.iteration = s.iteration;
+    r.loss = s.loss;
+    r.rgb_loss = s.rgb_loss;
+    r.semantic_loss = s.semantic_loss;
+    r.gaussians = s.num_gaussians;
+    r.seconds = seconds;
+    log.append(r);
+  }
 }
 
 }  // namespace
@@ -120,9 +155,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count();
   };
   const int first = trainer.iteration();
+  io::TrainLogWriter log(o.out + "/train_log.jsonl", o.resume ? first : -1);
   while (trainer.iteration() < config.iterations) {
     const gaussians::StepStats stats = trainer.step();
     const int it = stats.iteration;
+    logStep(log, stats, seconds(), it == config.iterations);
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("

@@ -1,0 +1,85 @@
+#include "sadsplat/io/train_log.h"
+
+#include <nlohmann/json.hpp>
+
+#include <sstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
+
+namespace sadsplat {
+namespace io {
+
+TrainLogWriter::TrainLogWriter(const std::string& path, int resume_iteration) : path_(path) {
+  std::string kept;
+  if (resume_iteration >= 0 && isRegularFile(path)) {
+    std::istringstream lines(readWholeFile(path));
+    for (std::string line; std::getline(lines, line);) {
+      const auto j = nlohmann::json::parse(line, nullptr, false);
+      if (j.is_discarded() || !j.is_object()) continue;  // a line cut short by a crash
+      const auto it = j.find("iteration");
+      if (it != j.end() && it->is_number() && it->get<int>() <= resume_iteration) {
+        kept += line + "\n";
+      }
+    }
+  }
+  writeFileAtomically(path, [&](std::ostream& out) { out << kept; });
+  out_.open(path, std::ios::app);
+  if (!out_) throw Error(path, "open for appending", "a writable file");
+}
+
+void TrainLogWriter::append(const TrainLogRecord& r) {
+  nlohmann::json j = {{"type", r.type}, {"iteration", r.iteration}, {"gaussians", r.gaussians}};
+  if (r.type == "step") {
+    j["loss"] = r.loss;
+    j["rgb_loss"] = r.rgb_loss;
+    j["semantic_loss"] = r.semantic_loss;
+    j["seconds"] = r.seconds;
+  } else {
+    j["removed"] = r.removed;
+  }
+  if (r.type == "drop") {
+    j["low_confidence"] = r.low_confidence;
+    j["unseen"] = r.unseen;
+    j["closed_gate"] = r.closed_gate;
+  }
+  out_ << j.dump() << "\n" << std::flush;
+  if (!out_) throw Error(path_, "write", "all bytes written", "a stream error (disk full?)");
+}
+
+std::vector<TrainLogRecord> readTrainLog(const std::string& path) {
+  std::vector<TrainLogRecord> records;
+  std::istringstream lines(readWholeFile(path));
+  int line_no = 0;
+  for (std::string line; std::getline(lines, line);) {
+    ++line_no;
+    if (line.empty()) continue;
+    const auto j = nlohmann::json::parse(line, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("type") || !j["type"].is_string() ||
+        !j.contains("iteration") || !j["iteration"].is_number_integer()) {
+      throw Error(path, "line " + std::to_string(line_no),
+                  "a JSON object with \"type\" and an integer \"iteration\"", line.substr(0, 60));
+    }
+    const auto number = [&](const char* key) {
+      return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+    };
+    TrainLogRecord r;
+    r.type = j["type"].get<std::string>();
+    r.iteration = j["iteration"].get<int>();
+    r.loss = number("loss");
+    r.rgb_loss = number("rgb_loss");
+    r.semantic_loss = number("semantic_loss");
+    r.seconds = number("seconds");
+    r.gaussians = static_cast<long long>(number("gaussians"));
+    r.removed = static_cast<long long>(number("removed"));
+    r.low_confidence = static_cast<long long>(number("low_confidence"));
+    r.unseen = static_cast<long long>(number("unseen"));
+    r.closed_gate = static_cast<long long>(number("closed_gate"));
+    records.push_back(r);
+  }
+  return records;
+}
+
+}  // namespace io
+}  // namespace sadsplat
