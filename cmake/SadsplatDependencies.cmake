@@ -8,6 +8,8 @@
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(Boost REQUIRED)
 find_package(Threads REQUIRED)
+# zlib: the gzip layer of .spz files.
+find_package(ZLIB REQUIRED)
 
 # --- LibTorch and PCL (non-I/O) as the imported targets sadsplat::torch / sadsplat::pcl ---------
 # The same file defines them for a project that uses the installed package (sadsplatConfig.cmake).

@@ -37,7 +37,7 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 # The libraries are static and the package config finds LibTorch, PCL, Eigen, JSON (and OpenCV,
 # VTK when built with them) on the user's machine: the -dev packages are the dependencies.
 set(_sadsplat_deb_depends
-    "libtorch-dev, libpcl-dev, libflann-dev, liblz4-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev")
+    "libtorch-dev, libpcl-dev, libflann-dev, liblz4-dev, libeigen3-dev, libboost-dev, nlohmann-json3-dev, zlib1g-dev")
 if(SADSPLAT_HAVE_OPENCV)
   string(APPEND _sadsplat_deb_depends ", libopencv-dev")
 endif()

@@ -5,13 +5,16 @@
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/semantic_ply.h"
+#include "sadsplat/io/splat_formats.h"
 
 namespace sadsplat {
 namespace io {
 namespace {
 
 [[noreturn]] void unknownExtension(const std::string& path, const std::string& kind) {
-  throw Error(path, "file name", "a " + kind + " file ending in .ply or .pcd",
+  throw Error(path, "file name",
+              "a " + kind + " file ending in .ply or .pcd" +
+                  (kind == "Gaussian cloud" ? std::string(" (or .splat, .spz)") : std::string()),
               lowerExtension(path).empty() ? "no extension" : lowerExtension(path));
 }
 
@@ -19,6 +22,10 @@ namespace {
 
 CloudKind cloudKind(const std::string& path) {
   const std::string ext = lowerExtension(path);
+  if (ext == ".splat" || ext == ".spz") {
+    requireRegularFile(path);
+    return CloudKind::kGaussians;
+  }
   if (ext == ".ply") return isSemanticPly(path) ? CloudKind::kSemantic : CloudKind::kGaussians;
   if (ext == ".pcd") {
     switch (pcdContent(path)) {
@@ -40,6 +47,8 @@ pcl::PointCloud<GaussianPoint> readGaussians(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext == ".ply") return readGaussianPly(path);
   if (ext == ".pcd") return loadGaussianPcd(path);
+  if (ext == ".splat") return readSplat(path);
+  if (ext == ".spz") return readSpz(path);
   unknownExtension(path, "Gaussian cloud");
 }
 
@@ -49,6 +58,10 @@ void writeGaussians(const std::string& path, const pcl::PointCloud<GaussianPoint
     writeGaussianPly(path, cloud);
   } else if (ext == ".pcd") {
     savePcd(path, cloud);
+  } else if (ext == ".splat") {
+    writeSplat(path, cloud);
+  } else if (ext == ".spz") {
+    writeSpz(path, cloud);
   } else {
     unknownExtension(path, "Gaussian cloud");
   }

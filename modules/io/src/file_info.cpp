@@ -156,11 +156,16 @@ std::string describeFile(const std::string& path) {
       out << "\n";
     }
     describeGaussians(out, cloud);
+  } else if (lowerExtension(path) == ".splat" || lowerExtension(path) == ".spz") {
+    out << path << ": " << (lowerExtension(path) == ".spz" ? "SPZ" : ".splat")
+        << " web-viewer splats (no semantic fields)\n";
+    describeGaussians(out, readGaussians(path));
   } else if (lowerExtension(path) == ".pcd") {
     out << path << ": PCD of GaussianPoint\n";
     describeGaussians(out, loadGaussianPcd(path));
   } else {
-    throw Error(path, "file type", "a .ply, a .pcd, a scene cache or a scene directory");
+    throw Error(path, "file type",
+                "a .ply, .pcd, .splat or .spz file, a scene cache or a scene directory");
   }
   return out.str();
 }

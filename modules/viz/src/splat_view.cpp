@@ -340,8 +340,13 @@ class SplatScene {
     for (const GaussianPoint& p : m.gaussians) {
       if (!visible(model, p.label)) continue;
       points->InsertNextPoint(p.x, p.y, p.z);
-      const float largest = std::max({p.scale[0], p.scale[1], p.scale[2]});
-      radius->InsertNextValue(static_cast<float>(std::exp(largest) * options_.splat_scale));
+      // A disc cannot show an ellipsoid's shape: its radius is the geometric mean of the two
+      // largest axes (a flat Gaussian seen face-on covers about that area; the largest axis
+      // alone made every elongated Gaussian a large disc).
+      float s[3] = {p.scale[0], p.scale[1], p.scale[2]};
+      std::sort(s, s + 3);
+      radius->InsertNextValue(
+          static_cast<float>(std::exp(0.5f * (s[1] + s[2])) * options_.splat_scale));
       opacity->InsertNextValue(1.0f / (1.0f + std::exp(-p.opacity)));
       if (isScalarMode(options_.color)) {
         values->InsertNextValue(scalarValue(p, options_.color));

@@ -7,6 +7,8 @@
 /// |-----------|-------------------------------------|-------------------------------------|
 /// | .ply      | 3DGS PLY + semantic properties      | x y z red green blue label          |
 /// | .pcd      | PCD, every GaussianPoint field      | PCD x y z rgba label                |
+/// | .splat    | 32-byte web viewer records (lossy)  | -                                   |
+/// | .spz      | Niantic SPZ v3, gzip (lossy)        | -                                   |
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
