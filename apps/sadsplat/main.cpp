@@ -19,6 +19,7 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/splat_formats.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
@@ -45,10 +46,12 @@ double secondsSince(Clock::time_point start) {
 }
 
 // `convert`: Gaussian clouds between .ply and .pcd, semantic clouds between .ply and .pcd.
-void convertCloud(const std::string& in, const std::string& out) {
+void convertCloud(const std::string& in, const std::string& out, int spz_version) {
   using namespace sadsplat::io;
   if (cloudKind(in) == CloudKind::kSemantic) {
     writeSemanticCloud(out, readSemanticCloud(in));
+  } else if (lowerExtension(out) == ".spz") {
+    writeSpz(out, readGaussians(in), sadsplat::kMaxShDegree, spz_version);
   } else {
     writeGaussians(out, readGaussians(in));
   }
@@ -165,10 +168,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   import->add_option("--max-width", import_options.max_width, "cap on image width (0 = none)");
 
-  auto* convert = app.add_subcommand("convert", "Convert a Gaussian cloud between .ply and .pcd");
+  auto* convert = app.add_subcommand(
+      "convert", "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz, semantic clouds .ply/.pcd");
   std::string convert_in, convert_out;
-  convert->add_option("IN", convert_in, "input .ply or .pcd")->required();
-  convert->add_option("OUT", convert_out, "output .ply or .pcd")->required();
+  convert->add_option("IN", convert_in, "input .ply, .pcd, .splat or .spz")->required();
+  convert->add_option("OUT", convert_out, "output .ply, .pcd, .splat or .spz")->required();
+  int convert_spz_version = 3;
+  convert
+      ->add_option("--spz-version", convert_spz_version,
+                   ".spz: 3 (precise rotations) or 2 (what older web viewers read)")
+      ->check(CLI::IsMember({2, 3}))
+      ->capture_default_str();
 
   auto* extract = app.add_subcommand("extract", "Write the Gaussians of one class");
   std::string extract_in, extract_out, extract_class, extract_classes;
@@ -359,7 +369,7 @@ int main(int argc, char** argv) {
       std::cout << "imported " << scene.views.size() << " views, " << scene.points.size()
                 << " points into " << import_out << " in " << secondsSince(start) << " s\n";
     } else if (*convert) {
-      convertCloud(convert_in, convert_out);
+      convertCloud(convert_in, convert_out, convert_spz_version);
     } else if (*extract) {
       if (sadsplat::io::isDirectory(extract_in)) {
         // A run directory: its model and its class list.

@@ -95,6 +95,22 @@ TEST(SplatFormats, SpzRoundTripWithinItsQuantisation) {
   EXPECT_LT(test::readFile(dir.file("m.spz")).size(), 300u * 80);
 }
 
+// Version 2 (for older viewers): the same except the quaternion, whose w is derived from x y z.
+TEST(SplatFormats, SpzVersion2ReadsBack) {
+  test::TempDir dir;
+  auto cloud = plausibleGaussians(100);
+  for (auto& p : cloud) p.rot[0] = std::max(std::fabs(p.rot[0]), 0.8f);  // w well away from 0
+  io::writeSpz(dir.file("v2.spz"), cloud, 3, 2);
+  const auto back = io::readSpz(dir.file("v2.spz"));
+  ASSERT_EQ(back.size(), cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto qa = unit(cloud[i].rot), qb = unit(back[i].rot);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(qa[k], qb[k], 0.02) << i;
+    EXPECT_NEAR(cloud[i].x, back[i].x, 0.5 / 4096 + 1e-5);
+  }
+  EXPECT_THROW(io::writeSpz(dir.file("v4.spz"), cloud, 3, 4), Error);
+}
+
 TEST(SplatFormats, BadFilesAreErrors) {
   test::TempDir dir;
   test::writeFile(dir.file("odd.splat"), std::string(33, '\0'));

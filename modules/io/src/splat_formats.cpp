@@ -158,14 +158,20 @@ pcl::PointCloud<GaussianPoint> readSplat(const std::string& path) {
   return cloud;
 }
 
-void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud, int sh_degree) {
+void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud, int sh_degree,
+              int version) {
   if (sh_degree < 0 || sh_degree > kMaxShDegree) {
     throw Error(path, "sh_degree", "0..3", std::to_string(sh_degree));
   }
+  if (version != 2 && version != 3) {
+    throw Error(path, "SPZ version", "2 or 3", std::to_string(version));
+  }
+  const std::size_t rotation_bytes = version == 3 ? 4 : 3;
   const std::size_t n = cloud.size();
   const int rest = shCoefficientsForDegree(sh_degree) - 1;  // per channel
-  std::vector<std::uint8_t> data(16 + n * (9 + 1 + 3 + 3 + 4 + 3 * rest));
-  const std::uint32_t header[3] = {kSpzMagic, 3, static_cast<std::uint32_t>(n)};
+  std::vector<std::uint8_t> data(16 + n * (9 + 1 + 3 + 3 + rotation_bytes + 3 * rest));
+  const std::uint32_t header[3] = {kSpzMagic, static_cast<std::uint32_t>(version),
+                                   static_cast<std::uint32_t>(n)};
   std::memcpy(data.data(), header, 12);
   data[12] = static_cast<std::uint8_t>(sh_degree);
   data[13] = kSpzFractionalBits;
@@ -176,7 +182,7 @@ void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& clo
   std::uint8_t* colors = alphas + n;
   std::uint8_t* scales = colors + 3 * n;
   std::uint8_t* rotations = scales + 3 * n;
-  std::uint8_t* sh = rotations + 4 * n;
+  std::uint8_t* sh = rotations + rotation_bytes * n;
   const float fixed = static_cast<float>(1 << kSpzFractionalBits);
   for (std::size_t i = 0; i < n; ++i) {
     const GaussianPoint& p = cloud[i];
@@ -200,6 +206,12 @@ void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& clo
     // the other three as sign + 9-bit magnitude in units of 1/sqrt(2) (the largest is made
     // positive, so its sign needs no bit); the last component ends in the low bits.
     const auto u = unitQuaternion(p);
+    if (version == 2) {  // x y z of the quaternion with w >= 0; w is derived on reading
+      const float sign = u[0] < 0 ? -1.0f : 1.0f;
+      for (int k = 0; k < 3; ++k) {
+        rotations[3 * i + k] = toByte(127.5f + 127.5f * sign * u[1 + k]);
+      }
+    }
     const float q[4] = {u[1], u[2], u[3], u[0]};
     unsigned largest = 0;
     for (unsigned k = 1; k < 4; ++k) {
@@ -214,7 +226,9 @@ void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& clo
           511u, static_cast<std::uint32_t>(511.0f * std::fabs(q[k]) / 0.70710678f + 0.5f));
       comp = (comp << 10) | (sign << 9) | mag;
     }
-    for (int b = 0; b < 4; ++b) rotations[4 * i + b] = (comp >> (8 * b)) & 0xff;
+    if (version == 3) {
+      for (int b = 0; b < 4; ++b) rotations[4 * i + b] = (comp >> (8 * b)) & 0xff;
+    }
     for (int k = 0; k < rest; ++k) {
       // Fewer significant bits for higher degrees (buckets of 8 and 16), as SPZ's own writer.
       const int bucket = k < 3 ? 8 : 16;

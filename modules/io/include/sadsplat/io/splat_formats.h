@@ -35,9 +35,12 @@ void writeSplat(const std::string& path, const pcl::PointCloud<GaussianPoint>& c
 /// \throws sadsplat::Error when the size is not a multiple of 32 or a value is not finite
 pcl::PointCloud<GaussianPoint> readSplat(const std::string& path);
 
-/// \brief Writes `.spz` version 3 (atomically) with SH up to `sh_degree` (0..3).
+/// \brief Writes `.spz` (atomically) with SH up to `sh_degree` (0..3). Version 3 (default, the
+/// format's current one) stores quaternions to 0.002; version 2 (x y z bytes, w derived) is
+/// what older viewers read (e.g. @mkkellogg/gaussian-splats-3d 0.4.7), less precise where w is
+/// small.
 void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
-              int sh_degree = 3);
+              int sh_degree = 3, int version = 3);
 /// \brief Reads `.spz` version 2 (x y z quaternion bytes) or 3 (smallest three).
 /// \throws sadsplat::Error naming the file and the field on a bad header, corrupt gzip data, or
 /// a size that does not match the count
