@@ -32,6 +32,17 @@ if(SADSPLAT_WITH_VTK)
   endif()
 endif()
 
+# --- Open3D (C++): the interop module ----------------------------------------------------
+set(SADSPLAT_HAVE_OPEN3D OFF)
+if(SADSPLAT_WITH_OPEN3D STREQUAL "AUTO")
+  find_package(Open3D QUIET)
+elseif(SADSPLAT_WITH_OPEN3D)
+  find_package(Open3D REQUIRED)
+endif()
+if(Open3D_FOUND AND SADSPLAT_WITH_OPEN3D)
+  set(SADSPLAT_HAVE_OPEN3D ON)
+endif()
+
 set(SADSPLAT_HAVE_PCL_IO OFF)
 if(SADSPLAT_WITH_VTK)
   find_library(SADSPLAT_PCL_io_LIBRARY NAMES pcl_io HINTS ${_pcl_hints}

@@ -1,13 +1,16 @@
 // building_footprints: the objects of one class of a trained sadsplat model, with PCL.
 //
 //   building_footprints MODEL.ply|pcd CLASSES.json CLASS OUT_DIR [TOLERANCE_M] [MIN_POINTS]
+//                       [GROUND_CLASS]
 //
 // 1. read the semantic Gaussians (sadsplat::io::readGaussians),
 // 2. keep one class (sadsplat::semantic_drop::ClassExtraction, a pcl::FilterIndices),
 // 3. remove outliers (pcl::StatisticalOutlierRemoval on the centres),
 // 4. split into objects (pcl::EuclideanClusterExtraction),
 // 5. write OUT_DIR/object_<id>.pcd (the object's Gaussians, every field) and OUT_DIR/objects.csv:
-//    id, Gaussians, centroid, and the oriented bounding box (pcl::MomentOfInertiaEstimation).
+//    id, Gaussians, centroid, and the oriented bounding box (pcl::MomentOfInertiaEstimation);
+// 6. with Open3D (sadsplat::interop): the ground plane of GROUND_CLASS (default road) by Open3D's
+//    RANSAC plane segmentation, and each object's height above it (column height_m).
 #include <pcl/common/centroid.h>
 #include <pcl/common/io.h>
 #include <pcl/features/moment_of_inertia_estimation.h>
@@ -27,8 +30,33 @@
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/scene.h"
 #include "sadsplat/semantic_drop/class_extraction.h"
+#if WITH_OPEN3D
+#include "sadsplat/interop/open3d_conversion.h"
+#endif
 
 using Gaussians = pcl::PointCloud<sadsplat::GaussianPoint>;
+
+// The ground plane (a, b, c, d with c >= 0, |(a, b, c)| = 1) of one class, by Open3D's RANSAC;
+// false without Open3D or when the class has too few Gaussians.
+bool groundPlane(const std::shared_ptr<Gaussians>& all, const std::string& ground_class,
+                 const std::vector<sadsplat::ClassInfo>& classes, Eigen::Vector4d* plane) {
+#if WITH_OPEN3D
+  sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> by_class;
+  by_class.setClassName(ground_class, classes);
+  by_class.setInputCloud(all);
+  Gaussians ground;
+  by_class.filter(ground);
+  if (ground.size() < 10) return false;
+  const auto legacy = sadsplat::interop::toOpen3d(ground).ToLegacy();
+  const auto fit = legacy.SegmentPlane(0.2, 3, 500);
+  *plane = std::get<0>(fit) / std::get<0>(fit).head<3>().norm();
+  if (plane->z() < 0) *plane = -*plane;
+  return true;
+#else
+  (void)all, (void)ground_class, (void)classes, (void)plane;
+  return false;
+#endif
+}
 
 int main(int argc, char** argv) {
   if (argc < 5) {
@@ -40,11 +68,13 @@ int main(int argc, char** argv) {
   const std::filesystem::path out_dir = argv[4];
   const double tolerance = argc > 5 ? std::stod(argv[5]) : 1.0;
   const int min_points = argc > 6 ? std::stoi(argv[6]) : 20;
+  const std::string ground_class = argc > 7 ? argv[7] : "road";
   try {
     // 1-2: the Gaussians of one class.
     auto all = std::make_shared<Gaussians>(sadsplat::io::readGaussians(model));
     sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> by_class;
-    by_class.setClassName(class_name, sadsplat::io::readClassesJson(classes_json));
+    const auto classes = sadsplat::io::readClassesJson(classes_json);
+    by_class.setClassName(class_name, classes);
     by_class.setInputCloud(all);
     auto of_class = std::make_shared<Gaussians>();
     by_class.filter(*of_class);
@@ -70,11 +100,16 @@ int main(int argc, char** argv) {
     clusters.setMinClusterSize(min_points);
     clusters.extract(objects);
 
+    // 6 (first: the table has the column): the ground plane.
+    Eigen::Vector4d plane;
+    const bool have_ground = groundPlane(all, ground_class, classes, &plane);
+
     // 5: one PCD of Gaussians per object, and the table.
     std::filesystem::create_directories(out_dir);
     std::ofstream csv(out_dir / "objects.csv");
     csv << "id,gaussians,centroid_x,centroid_y,centroid_z,obb_x,obb_y,obb_z,obb_size_x,"
-           "obb_size_y,obb_size_z,obb_qw,obb_qx,obb_qy,obb_qz\n";
+           "obb_size_y,obb_size_z,obb_qw,obb_qx,obb_qy,obb_qz"
+        << (have_ground ? ",height_m" : "") << "\n";
     for (std::size_t id = 0; id < objects.size(); ++id) {
       auto indices = std::make_shared<pcl::PointIndices>(objects[id]);
       Gaussians object;
@@ -99,11 +134,23 @@ int main(int argc, char** argv) {
       csv << id << "," << object.size() << "," << centroid.x() << "," << centroid.y() << ","
           << centroid.z() << "," << position.x << "," << position.y << "," << position.z << ","
           << hi.x - lo.x << "," << hi.y - lo.y << "," << hi.z - lo.z << "," << q.w() << "," << q.x()
-          << "," << q.y() << "," << q.z() << "\n";
+          << "," << q.y() << "," << q.z();
+      if (have_ground) {  // the highest centre of the object above the ground plane
+        double top = -1e30;
+        for (const auto& p : object) {
+          top = std::max(top, plane.dot(Eigen::Vector4d(p.x, p.y, p.z, 1.0)));
+        }
+        csv << "," << top;
+      }
+      csv << "\n";
     }
     std::cout << class_name << ": " << of_class->size() << " of " << all->size() << " Gaussians, "
               << inliers->size() << " after outlier removal, " << objects.size() << " objects -> "
               << (out_dir / "objects.csv").string() << "\n";
+    if (have_ground) {
+      std::cout << "ground plane of " << ground_class << " (Open3D RANSAC): " << plane.transpose()
+                << "\n";
+    }
   } catch (const sadsplat::Error& e) {
     std::cerr << "building_footprints: error: " << e.what() << "\n";
     return 1;
