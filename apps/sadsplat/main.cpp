@@ -2,7 +2,9 @@
 // sadsplat::Error become one message on stderr and exit status 1 (2 for usage errors).
 #include <CLI/CLI.hpp>
 
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <iostream>
 #include <sstream>
@@ -147,6 +149,10 @@ void parseSize(const std::string& text, int* width, int* height) {
   }
 }
 #endif
+
+// SIGINT / SIGTERM during training: stop after the current iteration with a checkpoint.
+std::atomic<bool> g_stop{false};
+extern "C" void requestStop(int) { g_stop = true; }
 
 }  // namespace
 
@@ -440,6 +446,9 @@ int main(int argc, char** argv) {
       options.scale = train_scale;
       options.resume = train_resume;
       options.progress = &std::cout;
+      options.stop = &g_stop;
+      std::signal(SIGINT, requestStop);
+      std::signal(SIGTERM, requestStop);
       const double seconds = sadsplat::pipeline::trainRun(options, config);
       std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
     } else if (*pseudo) {
@@ -477,6 +486,9 @@ int main(int argc, char** argv) {
     } else if (*demo) {
       return sadsplat::pipeline::runDemo(demo_out, demo_iterations, std::cout, demo_baseline);
     }
+  } catch (const sadsplat::pipeline::TrainingInterrupted& e) {
+    std::cerr << "\nsadsplat: interrupted: " << e.what() << "\n";
+    return 130;
   } catch (const sadsplat::Error& e) {
     std::cerr << "sadsplat: error: " << e.what() << "\n";
     return 1;

@@ -2,8 +2,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <c10/util/Exception.h>
+
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <iomanip>
 #include <sstream>
@@ -103,6 +107,12 @@ void logStep(io::TrainLogWriter& log, const gaussians::StepStats& s, double seco
 
 }  // namespace
 
+TrainingInterrupted::TrainingInterrupted(const std::string& run, int iteration)
+    : Error(run, "training", "to run to the end",
+            "an interrupt at iteration " + std::to_string(iteration) +
+                "; checkpoint written, continue with `sadsplat train ... --resume`"),
+      iteration_(iteration) {}
+
 io::Scene loadScene(const std::string& path, double scale) {
   if (isDirectory(path)) {
     io::ImportOptions options;
@@ -156,9 +166,38 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   };
   const int first = trainer.iteration();
   io::TrainLogWriter log(o.out + "/train_log.jsonl", o.resume ? first : -1);
+  // Fault injection for the crash tests (tests/apps/test_faults.cpp): the process kills itself
+  // with SIGKILL right after this iteration's step, before its checkpoint.
+  const char* kill_at_text = std::getenv("SADSPLAT_FAULT_KILL_AT_ITERATION");
+  const int kill_at = kill_at_text ? std::atoi(kill_at_text) : -1;
+  int last_checkpoint = first;
   while (trainer.iteration() < config.iterations) {
-    const gaussians::StepStats stats = trainer.step();
+    if (o.stop != nullptr && o.stop->load()) {
+      trainer.saveCheckpoint(checkpoint);
+      writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), seconds());
+      throw TrainingInterrupted(o.out, trainer.iteration());
+    }
+    gaussians::StepStats stats;
+    try {
+      stats = trainer.step();
+    } catch (const c10::Error& e) {
+      if (std::string(e.what()).find("out of memory") == std::string::npos) throw;
+      throw Error(o.out, "training at iteration " + std::to_string(trainer.iteration() + 1),
+                  "enough GPU memory for " + std::to_string(trainer.numGaussians()) +
+                      " Gaussians (lower max_gaussians or raise densify_grad_threshold in "
+                      "--config, train at a smaller --scale, or free the GPU)",
+                  "CUDA out of memory");
+    }
     const int it = stats.iteration;
+    if (!std::isfinite(stats.loss)) {
+      const std::string kept = last_checkpoint > 0 ? "; checkpoint.bin keeps iteration " +
+                                                         std::to_string(last_checkpoint)
+                                                   : "; no checkpoint was written yet";
+      throw Error(o.out, "training at iteration " + std::to_string(it), "a finite loss",
+                  std::string(std::isnan(stats.loss) ? "NaN" : "infinity") + " (diverged" + kept +
+                      "; lower the learning rates in the configuration)");
+    }
+    if (it == kill_at) std::raise(SIGKILL);
     logStep(log, stats, seconds(), it == config.iterations);
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
@@ -189,6 +228,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
         it < config.iterations) {
       trainer.saveCheckpoint(checkpoint);
       writeRunJson(o.out, o.scene, o.scale, config.device, it, seconds());
+      last_checkpoint = it;
     }
   }
   if (o.progress) *o.progress << "\n";

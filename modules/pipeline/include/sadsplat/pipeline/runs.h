@@ -9,10 +9,12 @@
 /// (the plain semantic cloud: centre, class colour, class id), classes.json, and after evaluation
 /// metrics.json and panels/*.png.
 
+#include <atomic>
 #include <functional>
 #include <ostream>
 #include <string>
 
+#include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/scene.h"
 
@@ -29,10 +31,30 @@ struct TrainRunOptions {
   double scale = 0.5;   ///< import scale for scene directories (paper: half resolution)
   bool resume = false;  ///< continue from out/checkpoint.bin
   std::ostream* progress = nullptr;  ///< live progress line (carriage returns), or none
+  /// Set (e.g. by a SIGINT / SIGTERM handler) to stop after the current iteration: the run
+  /// writes its checkpoint and run.json, then throws TrainingInterrupted.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+/// \brief Thrown by trainRun when `stop` was set: the checkpoint of `iteration` is written and
+/// `sadsplat train --resume` continues exactly.
+class TrainingInterrupted : public Error {
+ public:
+  TrainingInterrupted(const std::string& run, int iteration);
+  int iteration() const { return iteration_; }
+
+ private:
+  int iteration_;
 };
 
 /// \brief Trains and writes the run directory. Returns the training time in seconds.
-/// \throws sadsplat::Error on bad input
+///
+/// Faults lose nothing: the checkpoint, model and logs are written atomically; a non-finite loss
+/// stops the run with an error naming the iteration, before the next checkpoint, so the last
+/// checkpoint holds the last good state; running out of CUDA memory is an error naming the
+/// Gaussian count and what to change.
+/// \throws sadsplat::Error on bad input, a diverged training or no GPU memory;
+/// TrainingInterrupted when `stop` was set
 double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& config);
 
 /// \brief Evaluates a run directory on its scene (or `scene_override`): writes metrics.json and
