@@ -8,7 +8,7 @@ Run where the weights and packages can be downloaded (pip install torch segment-
       --clip-model ViT-B-32 --clip-checkpoint RS5M_ViT-B-32.pt --classes SCENE/classes.json --out models/
 The text side is encoded here, for the prompts of that classes.json (C++ needs no tokenizer).
 
-NOT RUN in this repository's sessions (no internet there): written against the public APIs of
+NOT RUN where this project is developed (no internet there): written against the public APIs of
 segment_anything and open_clip; the C++ side is tested only with the tiny models of
 scripts/make_tiny_foundation_models.py."""
 import argparse

@@ -7,7 +7,7 @@ out="${OUT:-/tmp/sadsplat-gpu-out}"
 bash "$(dirname "$0")/build.sh"
 export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 # Eight test processes of LibTorch's default 16 intra-op threads each oversubscribed the 16 cores
-# (session 6: CPU trainer tests took 140-312 s there, ~1 s on a 2-core dev machine, and the suite
+# (round 6: CPU trainer tests took 140-312 s there, ~1 s on a 2-core dev machine, and the suite
 # ran past 330 s): give each process its share of the cores.
 jobs=8
 export OMP_NUM_THREADS=$(( $(nproc) / jobs > 0 ? $(nproc) / jobs : 1 ))

@@ -105,7 +105,7 @@ struct PseudoLabelOptions {
   /// TOP1 and dTOP are above their mean and whose entropy is below it. k = 1 keeps ~16 % of the
   /// pixels by construction; k = 0 keeps 48-61 % at about the same precision (98.6-99.3 % vs
   /// 98.8-99.7 % on the nine benchmark scenes) and trained to +0.6 to +5.4 mIoU over k = 1 on
-  /// six of them (H100; docs/measurements/h100_filter_k_session6). k < 0 tightens the entropy
+  /// six of them (H100; docs/measurements/h100_filter_k). k < 0 tightens the entropy
   /// threshold while loosening the others (worse on city 2).
   double filter_k = 0.0;
   /// Where TOP1 / dTOP are measured. Both backends score with softmax probabilities; on the

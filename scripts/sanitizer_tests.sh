@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The test suite once more, built with AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g,
+# build-asan/). Any ASan/UBSan report or leak in sadsplat's code fails the run (LeakSanitizer
+# suppressions for third-party libraries in tests/sanitizers/). The CUDA sources and the
+# install/package test are left out (no GPU here; the package test builds a second project).
+#   bash scripts/sanitizer_tests.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+  -DCMAKE_C_FLAGS_DEBUG="-O1 -g" -DSADSPLAT_SANITIZE=address,undefined \
+  -DSADSPLAT_WITH_CUDA=OFF >/dev/null
+cmake --build build-asan
+supp=$(pwd)/tests/sanitizers
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_odr_violation=0:allocator_may_return_null=1"
+export LSAN_OPTIONS="suppressions=$supp/lsan_suppressions.txt:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan_suppressions.txt"
+ctest --test-dir build-asan --output-on-failure -j 2 -E "^Package\." --timeout 900
