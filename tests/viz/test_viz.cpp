@@ -225,7 +225,9 @@ bool nonBlank(const std::string& path) {
 // A short run with the full drop, evaluated; the report holds every plot, non-blank, linked.
 TEST(Report, HoldsEveryPlotAndLinksThem) {
   test::TempDir dir;
-  const std::string run = dir.file("run"), base = dir.file("base");
+  // Both runs called "run" (as `sadsplat demo` names them): their names and plot columns must
+  // not collide (a vtkTable column of the same name replaced the first one).
+  const std::string run = dir.file("full/run"), base = dir.file("base/run");
   test::writeFile(dir.file("cfg.json"), "{\"drop\": \"full\", \"drop_interval\": 10}");
   const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
   std::string out;
@@ -245,6 +247,7 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
     EXPECT_TRUE(nonBlank(run + "/report/" + png)) << png;
   }
   EXPECT_NE(md.find("| mIoU (%) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| | full/run | base/run |"), std::string::npos) << md;
   EXPECT_NE(md.find("](../panels/view_002.png)"), std::string::npos) << md;
   EXPECT_NE(md.find("| 10 | "), std::string::npos) << md;  // the drop event at iteration 10
   EXPECT_EQ(test::runCommand(kCli + " report " + dir.file("nothing"), &out), 1);

@@ -78,7 +78,7 @@ void writeLineChart(const std::string& path, const ChartFrame& frame,
     vtkNew<vtkTable> table;
     vtkNew<vtkDoubleArray> xs, ys;
     xs->SetName("x");
-    ys->SetName(s.name.c_str());
+    ys->SetName("y");
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       xs->InsertNextValue(s.x[i]);
       ys->InsertNextValue(s.y[i]);
@@ -87,6 +87,7 @@ void writeLineChart(const std::string& path, const ChartFrame& frame,
     table->AddColumn(ys);
     vtkPlot* plot = chart->AddPlot(s.markers_only ? vtkChart::POINTS : vtkChart::LINE);
     plot->SetInputData(table, 0, 1);
+    plot->SetLabel(s.name);
     plot->SetColor(s.color[0], s.color[1], s.color[2], 255);
     plot->SetWidth(s.markers_only ? 6.0f : 2.0f);
   }
@@ -116,15 +117,19 @@ void writeBarChart(const std::string& path, const ChartFrame& frame,
   xs->SetName("category");
   for (std::size_t i = 0; i < categories.size(); ++i) xs->InsertNextValue(static_cast<double>(i));
   table->AddColumn(xs);
-  for (const auto& s : series) {
+  // Columns get their own names (a vtkTable replaces a column of the same name); the series'
+  // names are the plots' labels.
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const auto& s = series[k];
     vtkNew<vtkDoubleArray> ys;
-    ys->SetName(s.name.c_str());
+    ys->SetName(("series " + std::to_string(k)).c_str());
     for (double v : s.y) ys->InsertNextValue(v);
     table->AddColumn(ys);
   }
   for (std::size_t k = 0; k < series.size(); ++k) {
     vtkPlot* plot = chart->AddPlot(vtkChart::BAR);
     plot->SetInputData(table, 0, static_cast<vtkIdType>(k + 1));
+    plot->SetLabel(series[k].name);
     plot->SetColor(series[k].color[0], series[k].color[1], series[k].color[2], 255);
   }
   vtkNew<vtkDoubleArray> ticks;

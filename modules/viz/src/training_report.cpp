@@ -34,8 +34,10 @@ RunFacts loadRun(const std::string& dir) {
   }
   RunFacts r;
   r.dir = dir;
-  r.name = fs::path(dir).lexically_normal().filename().string();
-  if (r.name.empty()) r.name = fs::path(dir).lexically_normal().parent_path().filename().string();
+  // Named by its last two path components ("demo/run"): runs are often all called "run".
+  fs::path normal = fs::absolute(fs::path(dir)).lexically_normal();
+  if (normal.filename().empty()) normal = normal.parent_path();
+  r.name = (normal.parent_path().filename() / normal.filename()).generic_string();
   const std::string log = (fs::path(dir) / "train_log.jsonl").string();
   if (!io::isRegularFile(log)) {
     throw Error(log, "file", "the train log that `sadsplat train` writes", "missing");

@@ -67,9 +67,11 @@ ViewModel loadViewModel(const std::string& path) {
   }
   const std::string beside = (fs::path(model).parent_path() / "classes.json").string();
   if (io::isRegularFile(beside)) classes_json = beside;
-  m.name = io::isDirectory(path) ? fs::path(path).filename().string()
-                                 : fs::path(path).filename().string();
-  if (m.name.empty()) m.name = path;
+  // Named by the last two path components ("demo/run", "demo/model.ply"): runs and models are
+  // often all called "run" and "model.ply".
+  fs::path normal = fs::absolute(fs::path(path)).lexically_normal();
+  if (normal.filename().empty()) normal = normal.parent_path();
+  m.name = (normal.parent_path().filename() / normal.filename()).generic_string();
   if (io::cloudKind(model) == io::CloudKind::kSemantic) {
     m.gaussians = pointsAsGaussians(io::readSemanticCloud(model));
     m.semantic_only = true;
