@@ -25,6 +25,10 @@ command -v ninja >/dev/null && generator=(-G Ninja)
   nvcc --version | tail -2; g++ --version | head -1; cmake --version | head -1
 } 2>&1 | tee "$out/gpu_env.log"
 
+# zlib (.spz): the machine's own when it has the headers, else the unpacked Debian package.
+zlib_args=()
+[ -f /usr/include/zlib.h ] || zlib_args=(-DZLIB_ROOT="$prefix/usr")
+
 start=$(date +%s)
 cmake -S . -B build-gpu "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$torch_cmake" \
@@ -32,6 +36,7 @@ cmake -S . -B build-gpu "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
   -Dnlohmann_json_DIR="$prefix/usr/share/cmake/nlohmann_json" \
   -DCLI11_DIR="$prefix/usr/share/cmake/CLI11" \
   -DSADSPLAT_WITH_CUDA=ON -DSADSPLAT_WITH_OPENCV=OFF -DSADSPLAT_WITH_VTK=OFF \
+  -DSADSPLAT_WITH_OPEN3D=OFF "${zlib_args[@]}" \
   2>&1 | tee "$out/gpu_configure.log"
 cmake --build build-gpu -j "$(nproc)" 2>&1 | tee "$out/gpu_build.log"
 echo "build seconds: $(( $(date +%s) - start ))" | tee -a "$out/gpu_build.log"

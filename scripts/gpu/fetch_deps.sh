@@ -8,5 +8,5 @@ mkdir -p .deps/debs
 cd .deps/debs
 apt-get download -qq libpcl-dev libpcl-common1.13 libpcl-kdtree1.13 libpcl-search1.13 \
   libpcl-octree1.13 libpcl-filters1.13 libpcl-sample-consensus1.13 libflann-dev libflann1.9 \
-  liblz4-dev liblz4-1 nlohmann-json3-dev libcli11-dev 2>&1 | grep -v '^W: Download is performed unsandboxed' || true
+  liblz4-dev liblz4-1 nlohmann-json3-dev libcli11-dev zlib1g-dev zlib1g 2>&1 | grep -v '^W: Download is performed unsandboxed' || true
 ls -1 *.deb | wc -l
