@@ -125,7 +125,7 @@ TEST(Pcd, CorruptCompressedDataIsAnError) {
 
 TEST(Pcd, MissingFileOrFieldIsAnError) {
   test::TempDir dir;
-  expectPcdError(dir.file("none.pcd"), "no such file");
+  expectPcdError(dir.file("none.pcd"), "got missing");
   test::writeFile(dir.file("xyz.pcd"), std::string(kXyzHeader) + "DATA ascii\n1 2 3\n");
   try {
     io::loadGaussianPcd(dir.file("xyz.pcd"));

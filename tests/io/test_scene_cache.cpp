@@ -151,6 +151,21 @@ TEST(SceneCache, ChecksSemanticValidityOfWellFormedFiles) {
   io::writeSceneCache(dir.file("nan.cache"), scene);
   expectCacheError(dir.file("nan.cache"), "fx: expected a finite number");
 
+  // Values that parse but are no camera or class list (found by hand-made caches that trained
+  // without a word): a zero quaternion, a denormal focal length, more classes than a byte holds.
+  scene = syntheticScene();
+  scene.views[1].camera.qvec = {0, 0, 0, 0};
+  io::writeSceneCache(dir.file("quat.cache"), scene);
+  expectCacheError(dir.file("quat.cache"), "qvec: expected a non-zero rotation quaternion");
+  scene = syntheticScene();
+  scene.views[0].camera.fy = 5e-324;
+  io::writeSceneCache(dir.file("focal.cache"), scene);
+  expectCacheError(dir.file("focal.cache"), "focal lengths of at least 0.001 px");
+  scene = syntheticScene();
+  scene.classes.resize(5000, scene.classes[0]);
+  io::writeSceneCache(dir.file("classes.cache"), scene);
+  expectCacheError(dir.file("classes.cache"), "1 to 255 classes");
+
   scene = syntheticScene();
   scene.views[0].labels.pixels[3] = 7;  // only 2 classes
   io::writeSceneCache(dir.file("label.cache"), scene);

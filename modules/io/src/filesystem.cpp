@@ -45,8 +45,7 @@ void makeParentDirectory(const std::string& path) {
 void requireRegularFile(const std::string& path) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st))
-    throw Error(path, "file", "an existing, readable file", "no such file");
+  if (ec || !fs::exists(st)) throw Error(path, "file", "an existing, readable file", "missing");
   if (fs::is_directory(st)) throw Error(path, "file", "a regular file", "a directory");
   if (!fs::is_regular_file(st)) {
     throw Error(path, "file", "a regular file", "a FIFO, socket or device");

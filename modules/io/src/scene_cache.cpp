@@ -251,6 +251,10 @@ Scene readSceneCache(const std::string& path) {
       scene.source = c.getString("source");
     } else if (tag == "CLAS") {
       const auto n = c.get<std::uint32_t>("class count");
+      // Label maps are bytes with 255 = ignore: at most 255 classes (as classes.json).
+      if (n == 0 || n > 255) {
+        throw Error(path, "chunk CLAS class count", "1 to 255 classes", std::to_string(n));
+      }
       for (std::uint32_t i = 0; i < n; ++i) {
         ClassInfo cls;
         cls.name = c.getString("class name");
@@ -276,8 +280,18 @@ Scene readSceneCache(const std::string& path) {
       v.labelled = roles & 4;
       const bool has_labels = c.get<std::uint8_t>("has labels") != 0;
       const int w = v.camera.width, h = v.camera.height;
-      if (w <= 0 || h <= 0 || v.camera.fx <= 0 || v.camera.fy <= 0) {
-        throw Error(path, "view " + v.name + " camera", "positive size and focal lengths");
+      // Focal lengths below a thousandth of a pixel or a zero quaternion are no cameras: they
+      // would train on NaN rays without a word.
+      if (w <= 0 || h <= 0 || !(v.camera.fx >= 1e-3) || !(v.camera.fy >= 1e-3)) {
+        throw Error(path, "view " + v.name + " camera",
+                    "a positive size and focal lengths of at least 0.001 px",
+                    std::to_string(w) + "x" + std::to_string(h) + ", f " +
+                        std::to_string(v.camera.fx) + " " + std::to_string(v.camera.fy));
+      }
+      double qnorm2 = 0;
+      for (double q : v.camera.qvec) qnorm2 += q * q;
+      if (!(qnorm2 > 1e-12)) {
+        throw Error(path, "view " + v.name + " qvec", "a non-zero rotation quaternion", "zero");
       }
       v.rgb = readImage(c, w, h, 3, "rgb");
       v.mask = readImage(c, w, h, 1, "mask");

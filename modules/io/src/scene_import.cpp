@@ -11,6 +11,7 @@
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #endif
@@ -88,6 +89,7 @@ bool isDistorted(const ColmapCamera& c) {
 }
 
 cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
+  requireRegularFile(path);  // imread would block on a FIFO
   cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw Error(path, "image data", "a readable PNG label map", "cannot decode");
   if (raw.depth() != CV_8U) {
@@ -139,6 +141,8 @@ cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& clas
 }  // namespace
 
 Scene importScene(const std::string& dir, const ImportOptions& options) {
+  // OpenCV's own warnings (a damaged PNG) would precede sadsplat's one-line error.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   if (!(options.scale > 0.0 && options.scale <= 1.0)) {
     throw Error("<import options>", "scale", "a value in (0, 1]", std::to_string(options.scale));
   }
@@ -174,6 +178,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   for (const ColmapImage* im : images) {
     const ColmapCamera& cam = *cameras.at(im->camera_id);
     const std::string image_path = dir + "/images/" + im->name;
+    requireRegularFile(image_path);
     cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
       throw Error(image_path, "image data", "a readable image named in sparse/0/images",
