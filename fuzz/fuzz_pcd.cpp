@@ -1,13 +1,7 @@
-// Fuzz target: the PCD codec (ascii, binary, binary_compressed), as Gaussians and as a semantic
-// cloud.
-#include "fuzz_support.h"
-#include "sadsplat/io/pcd.h"
+// libFuzzer program for fuzz::fuzz_pcd (fuzz_targets.h).
+#include "fuzz_targets.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace sadsplat;
-  const std::string path = fuzz::inputFile("input.pcd");
-  fuzz::writeInput(path, data, size);
-  fuzz::expectOnlySadsplatErrors([&] { io::loadGaussianPcd(path); });
-  fuzz::expectOnlySadsplatErrors([&] { io::loadSemanticPcd(path); });
+  sadsplat::fuzz::fuzz_pcd(data, size);
   return 0;
 }

@@ -14,4 +14,10 @@ supp=$(pwd)/tests/sanitizers
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_odr_violation=0:allocator_may_return_null=1"
 export LSAN_OPTIONS="suppressions=$supp/lsan_suppressions.txt:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan_suppressions.txt"
-ctest --test-dir build-asan --output-on-failure -j 2 -E "^Package\." --timeout 900
+# The views and reports render through Mesa's software OpenGL, whose JIT-compiled code LSan sees
+# as leaks from an unknown module (no stack to suppress by): those tests run with ASan and UBSan
+# but without the leak check.
+viz_tests="^(ViewScreenshot|Report)\."
+ctest --test-dir build-asan --output-on-failure -j 2 -E "^Package\.|$viz_tests" --timeout 900
+ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \
+  ctest --test-dir build-asan --output-on-failure -j 2 -R "$viz_tests" --timeout 900
