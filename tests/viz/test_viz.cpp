@@ -250,6 +250,24 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
   EXPECT_NE(md.find("| | full/run | base/run |"), std::string::npos) << md;
   EXPECT_NE(md.find("](../panels/view_002.png)"), std::string::npos) << md;
   EXPECT_NE(md.find("| 10 | "), std::string::npos) << md;  // the drop event at iteration 10
+  // The run's own cameras: a view from test camera view_002 shows the scene.
+  ASSERT_EQ(test::runCommand(kCli + " view " + run +
+                                 " --view view_002 --color rgb --size 160x120 "
+                                 "--screenshot " +
+                                 dir.file("cam.png"),
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::runCommand(kCli + " view " + run + " --color rgb --size 160x120 --screenshot " +
+                                 dir.file("aerial.png"),
+                             &out),
+            0)
+      << out;
+  const Png cam = readPng(dir.file("cam.png")), aerial = readPng(dir.file("aerial.png"));
+  EXPECT_LT(share(cam, 0, cam.width, kBackground), 0.99) << "the camera sees some Gaussians";
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < cam.pixels.size(); ++i) differ += cam.pixels[i] != aerial.pixels[i];
+  EXPECT_GT(differ, cam.pixels.size() / 50) << "the view from view_002 is not the aerial view";
   EXPECT_EQ(test::runCommand(kCli + " report " + dir.file("nothing"), &out), 1);
   EXPECT_NE(out.find("run directory"), std::string::npos) << out;
 }
