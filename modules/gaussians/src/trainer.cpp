@@ -99,7 +99,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for 1e99999
     throw Error(origin, "JSON syntax", "valid JSON", e.what());
   }
   if (!j.is_object()) throw Error(origin, "top level", "a JSON object", j.type_name());

@@ -81,7 +81,8 @@ class ByteReader {
   std::vector<T> getArray(std::size_t n, const char* field) {
     if (n > remaining() / sizeof(T)) need(remaining() + 1, field);
     std::vector<T> v(n);
-    if (n > 0) std::memcpy(v.data(), data_ + pos_, n * sizeof(T));  // data() of an empty vector is null
+    if (n > 0)
+      std::memcpy(v.data(), data_ + pos_, n * sizeof(T));  // data() of an empty vector is null
     pos_ += n * sizeof(T);
     return v;
   }

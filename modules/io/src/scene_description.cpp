@@ -14,7 +14,7 @@ nlohmann::json parseJsonFile(const std::string& path) {
   const std::string text = readWholeFile(path);
   try {
     return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for 1e99999
     throw Error(path, "JSON syntax", "valid JSON", e.what());
   }
 }

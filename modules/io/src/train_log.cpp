@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
@@ -10,16 +11,29 @@
 
 namespace sadsplat {
 namespace io {
+namespace {
+
+// A line as JSON, or a discarded value: nlohmann throws out_of_range (not a discarded value) for
+// numbers that overflow a double, even when asked not to throw (found by fuzzing).
+nlohmann::json parseLine(const std::string& line) {
+  try {
+    return nlohmann::json::parse(line, nullptr, false);
+  } catch (const nlohmann::json::exception&) {
+    return nlohmann::json(nlohmann::json::value_t::discarded);
+  }
+}
+
+}  // namespace
 
 TrainLogWriter::TrainLogWriter(const std::string& path, int resume_iteration) : path_(path) {
   std::string kept;
   if (resume_iteration >= 0 && isRegularFile(path)) {
     std::istringstream lines(readWholeFile(path));
     for (std::string line; std::getline(lines, line);) {
-      const auto j = nlohmann::json::parse(line, nullptr, false);
+      const auto j = parseLine(line);
       if (j.is_discarded() || !j.is_object()) continue;  // a line cut short by a crash
       const auto it = j.find("iteration");
-      if (it != j.end() && it->is_number() && it->get<int>() <= resume_iteration) {
+      if (it != j.end() && it->is_number() && it->get<double>() <= resume_iteration) {
         kept += line + "\n";
       }
     }
@@ -55,9 +69,10 @@ std::vector<TrainLogRecord> readTrainLog(const std::string& path) {
   for (std::string line; std::getline(lines, line);) {
     ++line_no;
     if (line.empty()) continue;
-    const auto j = nlohmann::json::parse(line, nullptr, false);
+    const auto j = parseLine(line);
     if (j.is_discarded() || !j.is_object() || !j.contains("type") || !j["type"].is_string() ||
-        !j.contains("iteration") || !j["iteration"].is_number_integer()) {
+        !j.contains("iteration") || !j["iteration"].is_number_integer() ||
+        std::abs(j["iteration"].get<double>()) > 2e9) {
       throw Error(path, "line " + std::to_string(line_no),
                   "a JSON object with \"type\" and an integer \"iteration\"", line.substr(0, 60));
     }

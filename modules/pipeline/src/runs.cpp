@@ -71,6 +71,18 @@ void writeModel(const std::string& dir, const gaussians::Trainer& trainer,
   io::writeSemanticPly(dir + "/model_semantic.ply", semantic);
 }
 
+// RUN/run.json as a JSON object, or a sadsplat::Error naming it.
+nlohmann::json readRunJson(const std::string& run_dir) {
+  const std::string path = run_dir + "/run.json";
+  try {
+    nlohmann::json j = nlohmann::json::parse(io::readWholeFile(path));
+    if (!j.is_object()) throw Error(path, "top level", "a JSON object", j.type_name());
+    return j;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, "JSON", "the run.json that `sadsplat train` writes", e.what());
+  }
+}
+
 // The train log's records of one step: a drop and a closed-gate removal when they happened, and
 // the losses every 10 iterations (as the progress line) and at the last one.
 void logStep(io::TrainLogWriter& log, const gaussians::StepStats& s, double seconds, bool last) {
@@ -134,8 +146,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     config = gaussians::TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"),
                                               o.out + "/config.json");
     config.iterations = config_in.iterations;
-    const auto run = nlohmann::json::parse(io::readWholeFile(o.out + "/run.json"));
-    previous_seconds = run.value("train_seconds", 0.0);
+    const auto run = readRunJson(o.out);
+    previous_seconds = run.contains("train_seconds") && run["train_seconds"].is_number()
+                           ? run["train_seconds"].get<double>()
+                           : 0.0;
   }
   const io::Scene scene = loadScene(o.scene, o.scale);
   if (o.progress) {
@@ -241,10 +255,16 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
 }
 
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
-  const auto run = nlohmann::json::parse(io::readWholeFile(run_dir + "/run.json"));
+  const auto run = readRunJson(run_dir);
+  if (scene_override.empty() && !(run.contains("scene") && run["scene"].is_string())) {
+    throw Error(run_dir + "/run.json", "scene", "the path of the run's scene (a string)");
+  }
   const std::string scene_path =
-      scene_override.empty() ? run.at("scene").get<std::string>() : scene_override;
-  const double run_scale = scene_override.empty() ? run.value("scale", scale) : scale;
+      scene_override.empty() ? run["scene"].get<std::string>() : scene_override;
+  const double run_scale =
+      scene_override.empty() && run.contains("scale") && run["scale"].is_number()
+          ? run["scale"].get<double>()
+          : scale;
   const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
       io::readWholeFile(run_dir + "/config.json"), run_dir + "/config.json");
   const io::Scene scene = loadScene(scene_path, run_scale);

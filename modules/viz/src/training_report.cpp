@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_text.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
@@ -45,7 +47,7 @@ RunFacts loadRun(const std::string& dir) {
   r.log = io::readTrainLog(log);
   const std::string metrics = (fs::path(dir) / "metrics.json").string();
   if (io::isRegularFile(metrics)) {
-    r.metrics = nlohmann::json::parse(io::readWholeFile(metrics), nullptr, false);
+    r.metrics = parseOrDiscard(io::readWholeFile(metrics));
     if (r.metrics.is_discarded() || !r.metrics.is_object()) {
       throw Error(metrics, "JSON", "the object `sadsplat eval` writes", "unparsable text");
     }

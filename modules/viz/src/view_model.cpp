@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_text.h"
+
 #include <cmath>
 #include <filesystem>
 
@@ -52,7 +54,7 @@ ViewModel loadViewModel(const std::string& path) {
     }
     const std::string run_json = (fs::path(path) / "run.json").string();
     if (io::isRegularFile(run_json)) {
-      const auto run = nlohmann::json::parse(io::readWholeFile(run_json), nullptr, false);
+      const auto run = parseOrDiscard(io::readWholeFile(run_json));
       if (!run.is_discarded() && run.contains("scene") && run["scene"].is_string()) {
         std::string scene = run["scene"].get<std::string>();
         if (io::isRegularFile(scene) && io::isSceneCache(scene)) {
