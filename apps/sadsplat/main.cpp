@@ -59,14 +59,20 @@ void convertCloud(const std::string& in, const std::string& out, int spz_version
   }
 }
 
-// `extract`: the points of one class (or all others) of a Gaussian or a semantic cloud.
-template <typename PointT>
-std::size_t extractClass(const pcl::PointCloud<PointT>& in,
-                         sadsplat::semantic_drop::ClassExtraction<PointT>& filter,
-                         pcl::PointCloud<PointT>* out) {
-  filter.setInputCloud(std::make_shared<pcl::PointCloud<PointT>>(in));
-  filter.filter(*out);
-  return in.size();
+// `extract`: the points of one class (or of all others) of a Gaussian or a semantic cloud,
+// read and written with the given functions.
+template <typename PointT, typename Read, typename Write>
+void extractClass(const std::string& in, const std::string& out, std::uint32_t class_id,
+                  bool negative, Read read, Write write) {
+  const auto cloud = std::make_shared<pcl::PointCloud<PointT>>(read(in));
+  sadsplat::semantic_drop::ClassExtraction<PointT> filter;
+  filter.setClassId(class_id);
+  filter.setNegative(negative);
+  filter.setInputCloud(cloud);
+  pcl::PointCloud<PointT> kept;
+  filter.filter(kept);
+  write(out, kept);
+  std::cout << "kept " << kept.size() << " of " << cloud->size() << " points\n";
 }
 
 struct SynthArgs {
@@ -404,25 +410,15 @@ int main(int argc, char** argv) {
         by_name.setClassName(extract_class, classes);
         class_id = by_name.getClassId();
       }
-      std::size_t kept = 0, total = 0;
       if (sadsplat::io::cloudKind(extract_in) == sadsplat::io::CloudKind::kSemantic) {
-        sadsplat::semantic_drop::ClassExtraction<pcl::PointXYZRGBL> filter;
-        filter.setClassId(class_id);
-        filter.setNegative(extract_negative);
-        pcl::PointCloud<pcl::PointXYZRGBL> out;
-        total = extractClass(sadsplat::io::readSemanticCloud(extract_in), filter, &out);
-        sadsplat::io::writeSemanticCloud(extract_out, out);
-        kept = out.size();
+        extractClass<pcl::PointXYZRGBL>(extract_in, extract_out, class_id, extract_negative,
+                                        sadsplat::io::readSemanticCloud,
+                                        sadsplat::io::writeSemanticCloud);
       } else {
-        sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> filter;
-        filter.setClassId(class_id);
-        filter.setNegative(extract_negative);
-        pcl::PointCloud<sadsplat::GaussianPoint> out;
-        total = extractClass(sadsplat::io::readGaussians(extract_in), filter, &out);
-        sadsplat::io::writeGaussians(extract_out, out);
-        kept = out.size();
+        extractClass<sadsplat::GaussianPoint>(extract_in, extract_out, class_id, extract_negative,
+                                              sadsplat::io::readGaussians,
+                                              sadsplat::io::writeGaussians);
       }
-      std::cout << "kept " << kept << " of " << total << " points\n";
     } else if (*synth_cmd) {
       if (synth_args.out.empty() && synth_args.cache.empty()) {
         throw sadsplat::Error("<command line>", "synth", "--out DIR and/or --cache FILE");

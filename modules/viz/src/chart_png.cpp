@@ -7,7 +7,6 @@
 #include <vtkContextView.h>
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
-#include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
 #include <vtkPlotBar.h>
@@ -16,11 +15,11 @@
 #include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
-#include <vtkWindowToImageFilter.h>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/viz/display.h"
+#include "window_png.h"
 
 namespace sadsplat {
 namespace viz {
@@ -43,18 +42,7 @@ void render(const std::string& path, vtkContextView* view, const ChartFrame& f) 
   view->GetRenderWindow()->SetOffScreenRendering(1);
   view->GetRenderWindow()->SetSize(f.width, f.height);
   view->GetRenderWindow()->SetMultiSamples(0);
-  view->GetRenderWindow()->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(view->GetRenderWindow());
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
-    vtkNew<vtkPNGWriter> writer;
-    writer->SetFileName(tmp.c_str());
-    writer->SetInputConnection(grab->GetOutputPort());
-    writer->Write();
-  });
+  saveWindowPng(view->GetRenderWindow(), path);
 }
 
 }  // namespace

@@ -8,7 +8,6 @@
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
-#include <vtkPNGWriter.h>
 #include <vtkPlaneSource.h>
 #include <vtkPointData.h>
 #include <vtkPointGaussianMapper.h>
@@ -23,7 +22,6 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
-#include <vtkWindowToImageFilter.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -37,6 +35,7 @@
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/viz/display.h"
+#include "window_png.h"
 
 namespace sadsplat {
 namespace viz {
@@ -302,20 +301,7 @@ class SplatScene {
     return true;
   }
 
-  void saveScreenshot(const std::string& path) {
-    window_->Render();
-    vtkNew<vtkWindowToImageFilter> grab;
-    grab->SetInput(window_);
-    grab->SetInputBufferTypeToRGB();
-    grab->ReadFrontBufferOff();
-    grab->Update();
-    io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
-      vtkNew<vtkPNGWriter> writer;
-      writer->SetFileName(tmp.c_str());
-      writer->SetInputConnection(grab->GetOutputPort());
-      writer->Write();
-    });
-  }
+  void saveScreenshot(const std::string& path) { saveWindowPng(window_, path); }
 
  private:
   bool visible(std::size_t model, std::uint32_t label) const {
