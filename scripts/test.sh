@@ -1,8 +1,13 @@
 #!/usr/bin/env bash
-# Installs what is missing (Debian bookworm, root), builds everything, runs the test suite.
+# Installs what is missing (Debian bookworm, root), builds everything, runs the test suite, then
+# runs it once more built with AddressSanitizer + UndefinedBehaviorSanitizer
+# (scripts/sanitizer_tests.sh; SADSPLAT_SKIP_SANITIZERS=1 skips that second pass).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup_debian.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build
 ctest --test-dir build --output-on-failure -j 2
+if [ "${SADSPLAT_SKIP_SANITIZERS:-0}" != 1 ]; then
+  bash scripts/sanitizer_tests.sh
+fi
