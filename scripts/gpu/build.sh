@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Run ON THE GPU MACHINE (Ubuntu 24.04, LibTorch 2.11 + CUDA 13, no PCL/OpenCV/VTK) from the
-# repository root, with .deps/debs carried (scripts/gpu/fetch_deps.sh makes it here):
+# repository root, with .deps/debs copied along (scripts/gpu/fetch_deps.sh makes it here):
 #   bash scripts/gpu/build.sh
 # Builds the CUDA-enabled project without OpenCV/VTK into build-gpu/. Logs go to
-# $OUT (when set) so that they come back from the device call.
+# $OUT (when set) so that they can be collected from one folder.
 set -euo pipefail
 out="${OUT:-/tmp/sadsplat-gpu-out}"
 mkdir -p "$out"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run ON THE GPU MACHINE from the repository root, with .deps/debs carried:
+# Run ON THE GPU MACHINE from the repository root, with .deps/debs copied along:
 #   bash scripts/gpu/build_and_test.sh [extra ctest args]
 # Builds (scripts/gpu/build.sh) and runs the test suite; logs go to $OUT when set.
 set -euo pipefail

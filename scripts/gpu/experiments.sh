@@ -5,7 +5,7 @@
 # Builds build-gpu/ if missing, generates the scene at 800x450 as a cache, runs
 # `sadsplat pseudo-labels` on it (report kept), then trains + evaluates each RUN (default: all
 # below, most important first) with 7000 iterations. No run starts after DEADLINE_S seconds and
-# every run is stopped at it, so a device call returns in time with what finished.
+# every run is stopped at it, so a run on the GPU machine returns in time with what finished.
 # Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
 #        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
 #        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt

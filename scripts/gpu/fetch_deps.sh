@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Run HERE (Debian bookworm, root): downloads the Debian packages the GPU build needs into
-# .deps/debs (git-ignored). The device call carries that folder; scripts/gpu/build_and_test.sh
+# .deps/debs (git-ignored). The GPU-machine run carries that folder; scripts/gpu/build_and_test.sh
 # unpacks it there. PCL's non-I/O libraries + FLANN + LZ4, and the header-only JSON and CLI libs.
 set -euo pipefail
 cd "$(dirname "$0")/../.."

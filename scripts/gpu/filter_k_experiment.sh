@@ -41,6 +41,6 @@ for k in "${ks[@]}"; do
 done
 wait
 for k in "${ks[@]}"; do grep -h 'none_\|precision\|not started\|stopped' "$OUT/summary_${kind}_${seed}_k$k.txt" | head -4; done
-# At most 8 files come back from a device call: the summaries stay, the rest goes into one tarball.
+# At most 8 files come back from a run on the GPU machine: the summaries stay, the rest goes into one tarball.
 (cd "$OUT" && tar -czf "all_${kind}_${seed}.tar.gz" --remove-files results_*.tar.gz log_*.txt gpu_*.log 2>/dev/null)
 echo "total $(( $(date +%s) - start )) s"
