@@ -20,5 +20,15 @@ TEST(Error, ControlCharactersAreEscaped) {
   EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
 }
 
+// Binary data (bytes that are not UTF-8) is escaped too; UTF-8 text is kept.
+TEST(Error, InvalidUtf8IsEscapedValidUtf8Kept) {
+  const Error e("Straße.ply", "f", "x",
+                std::string("\xff\xfe"
+                            "caf\xc3\xa9"
+                            "\xc3",
+                            8));
+  EXPECT_STREQ(e.what(), "Straße.ply: f: expected x, got \\xff\\xfecaf\xc3\xa9\\xc3");
+}
+
 }  // namespace
 }  // namespace sadsplat

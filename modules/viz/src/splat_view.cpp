@@ -190,11 +190,11 @@ class SplatScene {
           (!m.has_semantic || m.semantic_only)) {
         throw Error(m.name, "--color " + colorModeName(mode),
                     "a model with sadsplat's semantic fields (a trained model.ply / model.pcd)",
-                    m.semantic_only ? "a plain semantic cloud" : "a PLY without them");
+                    m.semantic_only ? "a plain semantic cloud" : "a file without them");
       }
       if (mode == ColorMode::kClass && !m.has_semantic) {
         throw Error(m.name, "--color class", "a model with class labels (sadsplat's model.ply)",
-                    "a PLY without semantic properties (try --color rgb)");
+                    "a file without semantic properties (try --color rgb)");
       }
     }
   }

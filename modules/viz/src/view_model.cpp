@@ -84,7 +84,9 @@ ViewModel loadViewModel(const std::string& path) {
     m.has_semantic = info.has_semantic;
   } else {
     m.gaussians = io::readGaussians(model);
-    for (const std::string& f : io::pcdFieldNames(model)) m.has_semantic |= f == "label";
+    if (io::lowerExtension(model) == ".pcd") {  // .splat and .spz have no semantic fields
+      for (const std::string& f : io::pcdFieldNames(model)) m.has_semantic |= f == "label";
+    }
   }
   if (!classes_json.empty()) m.classes = io::readClassesJson(classes_json);
   return m;
