@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -21,7 +22,7 @@ namespace fuzz {
 inline std::string inputFile(const std::string& name) {
   static const std::string dir = [] {
     std::string d = "/tmp/sadsplat_fuzz_" + std::to_string(::getpid());
-    std::system(("mkdir -p " + d).c_str());
+    std::filesystem::create_directories(d);
     return d;
   }();
   return dir + "/" + name;

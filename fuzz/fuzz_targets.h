@@ -5,6 +5,7 @@
 // success or a sadsplat::Error (anything else aborts).
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <vector>
 
 #include "fuzz_support.h"
@@ -98,7 +99,8 @@ inline void fuzz_colmap(const std::uint8_t* data, std::size_t size) {
   }
   parts.emplace_back(begin, static_cast<std::size_t>(end - begin));
   const std::string dir = fuzz::inputFile(binary ? "bin" : "text");
-  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  // The same three files are rewritten each time (no shell: the fuzzer runs ~100x faster).
+  std::filesystem::create_directories(dir);
   const char* names[3] = {"cameras", "images", "points3D"};
   for (int k = 0; k < 3; ++k) {
     fuzz::writeInput(dir + "/" + names[k] + (binary ? ".bin" : ".txt"), parts[k].first,
