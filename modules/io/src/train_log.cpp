@@ -79,6 +79,16 @@ std::vector<TrainLogRecord> readTrainLog(const std::string& path) {
     const auto number = [&](const char* key) {
       return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
     };
+    // Counts: whole numbers in [0, 2^53], checked before the conversion (a double beyond the
+    // range of long long converts with undefined behaviour; found by fuzzing).
+    const auto count = [&](const char* key) {
+      const double v = number(key);
+      if (!(v >= 0 && v <= 9007199254740992.0) || v != std::floor(v)) {
+        throw Error(path, "line " + std::to_string(line_no) + " " + key,
+                    "a count (a whole number >= 0)", std::to_string(v));
+      }
+      return static_cast<long long>(v);
+    };
     TrainLogRecord r;
     r.type = j["type"].get<std::string>();
     r.iteration = j["iteration"].get<int>();
@@ -86,11 +96,11 @@ std::vector<TrainLogRecord> readTrainLog(const std::string& path) {
     r.rgb_loss = number("rgb_loss");
     r.semantic_loss = number("semantic_loss");
     r.seconds = number("seconds");
-    r.gaussians = static_cast<long long>(number("gaussians"));
-    r.removed = static_cast<long long>(number("removed"));
-    r.low_confidence = static_cast<long long>(number("low_confidence"));
-    r.unseen = static_cast<long long>(number("unseen"));
-    r.closed_gate = static_cast<long long>(number("closed_gate"));
+    r.gaussians = count("gaussians");
+    r.removed = count("removed");
+    r.low_confidence = count("low_confidence");
+    r.unseen = count("unseen");
+    r.closed_gate = count("closed_gate");
     records.push_back(r);
   }
   return records;
