@@ -20,12 +20,15 @@ cmake --build build-fuzz --target fuzzers >/dev/null
 for t in "${targets[@]}"; do
   mkdir -p "build-fuzz/corpus/$t" "build-fuzz/crashes/$t"
   log="build-fuzz/fuzz_$t.log"
+  touch "$log.start"
   start=$(date +%s)
   # ASan's leak check stays on: a leak is a failure like a crash.
   "build-fuzz/bin/fuzz_$t" "build-fuzz/corpus/$t" "fuzz/corpus/$t" -max_total_time="$seconds" \
     -timeout=10 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 \
     -artifact_prefix="build-fuzz/crashes/$t/" >"$log" 2>&1 || true
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  # Only the findings of this run (the folder keeps those of earlier runs).
+  new=$(find "build-fuzz/crashes/$t" -type f -newer "$log.start" -printf '%f ' 2>/dev/null || true)
   echo "$t: $(($(date +%s) - start)) s, $execs executions, corpus $(ls "build-fuzz/corpus/$t" | wc -l) files," \
-       "crashes: $(ls "build-fuzz/crashes/$t" | tr '\n' ' ')"
+       "new findings: ${new:-none}"
 done
