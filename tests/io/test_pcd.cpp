@@ -76,7 +76,9 @@ TEST(Pcd, PclReadsOurSemanticCloud) {
   for (std::size_t i = 0; i < back.size(); ++i) {
     EXPECT_EQ(back[i].x, cloud[i].x);
     EXPECT_EQ(back[i].label, cloud[i].label);
-    if (cloud[i].label != kUnlabelled) EXPECT_EQ(back[i].b, kClasses[cloud[i].label].color[2]);
+    if (cloud[i].label != kUnlabelled) {
+      EXPECT_EQ(back[i].b, kClasses[cloud[i].label].color[2]);
+    }
   }
 }
 

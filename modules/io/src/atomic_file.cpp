@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <sys/stat.h>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -53,6 +54,20 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
     out.flush();
     if (!out) throw Error(path, "write", "all bytes written", "a stream error (disk full?)");
   });
+}
+
+std::string readFileStart(const std::string& path, std::size_t max_bytes) {
+  requireRegularFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "file", "an existing, readable file", "cannot open it");
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<std::size_t>(std::max<std::streamoff>(0, in.tellg()));
+  in.seekg(0, std::ios::beg);
+  std::string bytes(std::min(size, max_bytes), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(max_bytes));
+  if (in.bad()) throw Error(path, "file", "a readable file", "a read error");
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
+  return bytes;
 }
 
 std::string readWholeFile(const std::string& path) {

@@ -165,8 +165,6 @@ pcl::PointCloud<PointT> loadTable(const std::string& path, const pcd::Table& t,
 
 }  // namespace
 
-bool havePcdSupport() { return true; }
-
 PcdContent pcdContent(const std::string& path) {
   const pcd::Table t = pcd::readHeader(path);
   const bool xyz = t.find("x") && t.find("y") && t.find("z");

@@ -19,6 +19,8 @@ constexpr std::size_t kMaxCount = 1 << 16;
 constexpr std::size_t kMaxFields = 1 << 12;
 // LZF turns at most 3 input bytes into 264 output bytes (a long back-reference).
 constexpr std::size_t kMaxLzfRatio = 100;
+// More than any real header (a field name per FIELDS entry, at most 4096 of them).
+constexpr std::size_t kMaxHeaderBytes = std::size_t{1} << 24;
 
 bool parseUnsigned(const std::string& text, std::size_t limit, std::size_t* value) {
   if (text.empty() || text.size() > 12) return false;
@@ -399,7 +401,10 @@ bool lzfDecompress(const std::uint8_t* in, std::size_t in_size, std::uint8_t* ou
   return op == out_size;
 }
 
-Table readHeader(const std::string& path) { return parseHeader(path, readWholeFile(path)).table; }
+Table readHeader(const std::string& path) {
+  // Only the header: telling a Gaussian PCD from a semantic one must not read the points.
+  return parseHeader(path, readFileStart(path, kMaxHeaderBytes)).table;
+}
 
 Table read(const std::string& path) {
   const std::string bytes = readWholeFile(path);

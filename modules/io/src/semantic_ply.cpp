@@ -107,7 +107,8 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
 }
 
 bool isSemanticPly(const std::string& path) {
-  const std::string bytes = readWholeFile(path);
+  // Only the header (16 MiB is more than any real one): the vertices are not needed to tell.
+  const std::string bytes = readFileStart(path, std::size_t{1} << 24);
   const ply::PlyHeader header = ply::parseHeader(path, bytes);
   const ply::PlyElement* vertex = findVertex(header);
   return vertex != nullptr && hasProperty(*vertex, "label") && hasProperty(*vertex, "red") &&

@@ -185,10 +185,15 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   const char* kill_at_text = std::getenv("SADSPLAT_FAULT_KILL_AT_ITERATION");
   const int kill_at = kill_at_text ? std::atoi(kill_at_text) : -1;
   int last_checkpoint = first;
+  // The checkpoint and run.json go together: run.json says which iteration the checkpoint holds.
+  const auto checkpointNow = [&] {
+    trainer.saveCheckpoint(checkpoint);
+    writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), seconds());
+    last_checkpoint = trainer.iteration();
+  };
   while (trainer.iteration() < config.iterations) {
     if (o.stop != nullptr && o.stop->load()) {
-      trainer.saveCheckpoint(checkpoint);
-      writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), seconds());
+      checkpointNow();
       throw TrainingInterrupted(o.out, trainer.iteration());
     }
     gaussians::StepStats stats;
@@ -240,9 +245,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     }
     if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 &&
         it < config.iterations) {
-      trainer.saveCheckpoint(checkpoint);
-      writeRunJson(o.out, o.scene, o.scale, config.device, it, seconds());
-      last_checkpoint = it;
+      checkpointNow();
     }
   }
   if (o.progress) *o.progress << "\n";

@@ -150,7 +150,7 @@ class SplatScene {
  public:
   SplatScene(const std::vector<ViewModel>& models, const SplatViewOptions& options)
       : models_(models), options_(options) {
-    for (const auto& m : models_) hidden_.emplace_back();
+    hidden_.resize(models_.size());
     for (std::size_t i = 0; i < models_.size(); ++i) {
       const auto shown = selectedClasses(models_[i], options_.classes);
       if (!shown.empty()) {
@@ -158,7 +158,6 @@ class SplatScene {
           if (!shown.count(c)) hidden_[i].insert(c);
         }
         hidden_[i].insert(kUnlabelled);
-        for (std::uint32_t c : shown) hidden_[i].erase(c);
         // Labels beyond the list are hidden as well when a selection is given.
         only_[i] = shown;
       }

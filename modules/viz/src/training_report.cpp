@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "json_text.h"
+#include "short_name.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -36,10 +37,7 @@ RunFacts loadRun(const std::string& dir) {
   }
   RunFacts r;
   r.dir = dir;
-  // Named by its last two path components ("demo/run"): runs are often all called "run".
-  fs::path normal = fs::absolute(fs::path(dir)).lexically_normal();
-  if (normal.filename().empty()) normal = normal.parent_path();
-  r.name = (normal.parent_path().filename() / normal.filename()).generic_string();
+  r.name = shortName(dir);
   const std::string log = (fs::path(dir) / "train_log.jsonl").string();
   if (!io::isRegularFile(log)) {
     throw Error(log, "file", "the train log that `sadsplat train` writes", "missing");

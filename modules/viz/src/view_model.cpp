@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "json_text.h"
+#include "short_name.h"
 
 #include <cmath>
 #include <filesystem>
@@ -69,11 +70,7 @@ ViewModel loadViewModel(const std::string& path) {
   }
   const std::string beside = (fs::path(model).parent_path() / "classes.json").string();
   if (io::isRegularFile(beside)) classes_json = beside;
-  // Named by the last two path components ("demo/run", "demo/model.ply"): runs and models are
-  // often all called "run" and "model.ply".
-  fs::path normal = fs::absolute(fs::path(path)).lexically_normal();
-  if (normal.filename().empty()) normal = normal.parent_path();
-  m.name = (normal.parent_path().filename() / normal.filename()).generic_string();
+  m.name = shortName(path);
   if (io::cloudKind(model) == io::CloudKind::kSemantic) {
     m.gaussians = pointsAsGaussians(io::readSemanticCloud(model));
     m.semantic_only = true;

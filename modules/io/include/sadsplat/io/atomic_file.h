@@ -2,6 +2,7 @@
 /// \file atomic_file.h
 /// \brief Writing a file so that readers see either the old or the complete new content.
 
+#include <cstddef>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -21,6 +22,11 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
 /// by throwing or by leaving no file at the temporary path.
 void writeViaTemporaryPath(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write);
+
+/// \brief Reads the first `max_bytes` of a file (all of it if it is shorter): enough for a
+/// format's header, without reading the data that follows it.
+/// \throws sadsplat::Error naming the file if it is missing, unreadable or not a regular file
+std::string readFileStart(const std::string& path, std::size_t max_bytes);
 
 /// \brief Reads a whole file into memory.
 /// \throws sadsplat::Error naming the file if it is missing, unreadable or not a regular file

@@ -19,9 +19,6 @@
 namespace sadsplat {
 namespace io {
 
-/// \brief Whether this build can read and write PCD files (always, since the own codec).
-bool havePcdSupport();
-
 /// \brief What a PCD file holds, judged by its fields.
 enum class PcdContent {
   kGaussians,  ///< GaussianPoint fields (x y z f_dc opacity scale rot ...)
