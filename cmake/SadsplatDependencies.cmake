@@ -100,6 +100,25 @@ if(SADSPLAT_COMPILE_CUDA)
   endif()
 endif()
 
+# --- OpenMP ---------------------------------------------------------------------------------
+# at::parallel_for is a header template: it runs on several threads only in code compiled with
+# OpenMP, LibTorch's CPU parallel backend (without it the CPU rasterizer used one core). Not with
+# a CUDA LibTorch: the PyTorch wheels bundle their own libgomp, and a second OpenMP runtime in the
+# process would fight it for the cores.
+set(SADSPLAT_HAVE_OPENMP OFF)
+if(NOT SADSPLAT_HAVE_CUDA)
+  find_package(OpenMP COMPONENTS CXX)
+  if(OpenMP_CXX_FOUND)
+    set(SADSPLAT_HAVE_OPENMP ON)
+  endif()
+endif()
+# Modules whose sources call at::parallel_for: sadsplat_link_openmp(target).
+function(sadsplat_link_openmp target)
+  if(SADSPLAT_HAVE_OPENMP)
+    target_link_libraries(${target} PRIVATE OpenMP::OpenMP_CXX)
+  endif()
+endfunction()
+
 # --- GoogleTest -----------------------------------------------------------------------------
 if(SADSPLAT_BUILD_TESTS)
   find_package(GTest REQUIRED)

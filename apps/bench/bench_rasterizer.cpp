@@ -18,6 +18,7 @@
 #include <cuda_runtime_api.h>
 #endif
 
+#include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/rasterizer.h"
 
 namespace {
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
   app.add_option("--warmup", warmup)->capture_default_str();
   app.add_option("--threads", threads, "CPU threads")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  at::set_num_threads(std::max(1, threads));
+  sadsplat::gaussians::setCpuThreads(std::max(1, threads));
   const at::Device device = device_name == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU);
   if (device.is_cuda() && !at::hasCUDA()) {
     std::fprintf(stderr, "sadsplat_bench_rasterizer: no CUDA device\n");

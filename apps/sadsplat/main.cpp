@@ -11,6 +11,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/io/atomic_file.h"
@@ -207,6 +208,7 @@ int main(int argc, char** argv) {
   long long train_seed = -1;
   double train_scale = 0.5;
   bool train_resume = false;
+  bool train_profile = false;
   train->add_option("SCENE", train_scene, "scene directory or scene cache")->required();
   train->add_option("--out", train_out, "run directory")->required();
   train->add_option("--config", train_config_file, "JSON file with TrainConfig keys");
@@ -216,6 +218,9 @@ int main(int argc, char** argv) {
   train->add_option("--scale", train_scale, "image scale when importing a directory")
       ->capture_default_str();
   train->add_flag("--resume", train_resume, "continue from RUN/checkpoint.bin");
+  train->add_flag("--profile", train_profile,
+                  "time each phase of the iterations (waits for the GPU at every phase "
+                  "boundary) and write RUN/profile.md");
   std::string train_drop;
   double train_p_base = -1;
   train->add_option("--drop", train_drop, "semantic-aware drop: none, semantic, structure or full");
@@ -371,6 +376,7 @@ int main(int argc, char** argv) {
     std::cerr << "sadsplat: usage error: " << e.what() << " (see sadsplat --help)\n";
     return 2;
   }
+  sadsplat::gaussians::setCpuThreads();
   try {
     if (*info) {
       std::cout << sadsplat::io::describeFile(info_path);
@@ -441,6 +447,7 @@ int main(int argc, char** argv) {
       options.out = train_out;
       options.scale = train_scale;
       options.resume = train_resume;
+      options.profile = train_profile;
       options.progress = &std::cout;
       options.stop = &g_stop;
       std::signal(SIGINT, requestStop);

@@ -177,6 +177,7 @@ struct Trainer::State {
   std::vector<Param> params;
   at::Tensor confidence;  // [N] last semantic confidence computed by the drop (0 before)
   std::shared_ptr<const DropStrategy> drop;
+  StepProfile::Ptr profile;
   // Densification statistics.
   at::Tensor grad_accum, denom, max_radii;
   std::int64_t adam_step = 0;
@@ -441,6 +442,8 @@ void Trainer::setDropStrategy(std::shared_ptr<const DropStrategy> strategy) {
   state_->drop = std::move(strategy);
 }
 
+void Trainer::setProfile(StepProfile::Ptr profile) { state_->profile = std::move(profile); }
+
 Trainer::~Trainer() = default;
 
 int Trainer::iteration() const { return state_->iteration; }
@@ -452,6 +455,8 @@ StepStats Trainer::step() {
   State& s = *state_;
   const TrainConfig& c = s.config;
   const int it = s.iteration;
+  StepProfile* profile = s.profile.get();
+  enterPhase(profile, "views and parameters");
   // Position learning rate: exponential from init to final over the run (3DGS).
   const double t = std::min(1.0, static_cast<double>(it) / std::max(1, c.iterations));
   s.p("means").lr =
@@ -483,20 +488,26 @@ StepStats Trainer::step() {
   GaussianParams g = s.gaussians();
   if (s.drop) g.opacity_gate = s.drop->trainingGate(s.p("log_alpha").value, it);
   at::Tensor total;
-  double rgb_sum = 0, sem_sum = 0;
+  // Loss values stay on the device until the end of the step: one host synchronisation per step.
+  at::Tensor rgb_sum, sem_sum;
+  auto accumulate = [](at::Tensor& sum, const at::Tensor& value) {
+    sum = sum.defined() ? sum + value.detach() : value.detach();
+  };
   std::vector<RenderResult> renders;
   std::int64_t dropped = 0, closed_at_end = 0;
   DropDecision decision;
   for (int v : views) {
+    enterPhase(profile, "render forward");
     RenderResult r = render(g, s.cameras[v], settings);
     r.means2d.retain_grad();
+    enterPhase(profile, "losses forward");
     const at::Tensor& gt = s.images[v];
     const at::Tensor mask = s.masks[v].unsqueeze(2);
     const at::Tensor l1 = ((r.rgb - gt).abs() * mask).mean();
     const at::Tensor rgb_loss =
         (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
     at::Tensor loss = c.lambda_rgb * rgb_loss;
-    rgb_sum += rgb_loss.item<double>();
+    accumulate(rgb_sum, rgb_loss);
     const at::Tensor& labels = s.labels[v];
     if (labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
@@ -510,7 +521,7 @@ StepStats Trainer::step() {
                                  ? semanticLoss(r.features, labels, w, b)
                                  : semanticLoss(r.features, labels, w.detach(), b.detach());
       loss = loss + s.semantic_weight[v] * sem;
-      sem_sum += sem.item<double>();
+      accumulate(sem_sum, sem);
     }
     total = total.defined() ? total + loss : loss;
     renders.push_back(r);
@@ -519,10 +530,12 @@ StepStats Trainer::step() {
     const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value);
     if (reg.defined()) total = total + reg;
   }
+  enterPhase(profile, "backward");
   total.backward();
 
   {
     c10::AutoGradMode no_grad(false);
+    enterPhase(profile, "densification statistics");
     // Densification statistics: NDC-space screen gradient of visible Gaussians (3DGS).
     for (std::size_t k = 0; k < renders.size(); ++k) {
       const RenderResult& r = renders[k];
@@ -535,6 +548,7 @@ StepStats Trainer::step() {
       s.denom += visible.to(at::kFloat);
       s.max_radii = at::where(visible, at::max(s.max_radii, r.radii.to(at::kFloat)), s.max_radii);
     }
+    enterPhase(profile, "optimiser");
     // Adam (own implementation so densification can reshape its state).
     ++s.adam_step;
     const double b1 = 0.9, b2 = 0.999, eps = 1e-15;
@@ -551,6 +565,7 @@ StepStats Trainer::step() {
     }
     s.iteration = it + 1;
     const int done = s.iteration;
+    enterPhase(profile, "drop");
     if (s.drop && s.drop->dropNow(done)) {
       DropInputs in;
       in.means = s.p("means").value.detach();
@@ -576,6 +591,7 @@ StepStats Trainer::step() {
         if (closed_at_end > 0) s.resize(open, {});
       }
     }
+    enterPhase(profile, "densify, prune, reset");
     if (done <= c.densify_until) {
       if (done > c.densify_from && done % c.densify_interval == 0) {
         s.densifyAndPrune(done > c.opacity_reset_interval);
@@ -588,11 +604,21 @@ StepStats Trainer::step() {
       }
     }
   }
+  enterPhase(profile, "loss values to host");
+  const at::Tensor zero = at::zeros({}, total.options());
+  const at::Tensor values = at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero})
+                                .to(at::kDouble)
+                                .cpu();
+  const double* value = values.data_ptr<double>();
+  if (profile) {
+    profile->leave();
+    profile->countIteration();
+  }
   StepStats stats;
   stats.iteration = s.iteration;
-  stats.rgb_loss = rgb_sum / views.size();
-  stats.semantic_loss = sem_sum;
-  stats.loss = total.item<double>();
+  stats.rgb_loss = value[1] / views.size();
+  stats.semantic_loss = value[2];
+  stats.loss = value[0];
   stats.num_gaussians = s.n();
   stats.dropped = dropped;
   stats.removed_closed_gates = closed_at_end;

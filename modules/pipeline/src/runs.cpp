@@ -174,6 +174,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   if (o.resume) trainer.loadCheckpoint(checkpoint);
   writeText(o.out + "/config.json", trainer.config().toJson());
+  gaussians::StepProfile::Ptr profile;
+  if (o.profile) {
+    profile = std::make_shared<gaussians::StepProfile>(
+        config.device == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU));
+    trainer.setProfile(profile);
+  }
   const auto start = Clock::now();
   auto seconds = [&] {
     return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count();
@@ -217,6 +223,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                       "; lower the learning rates in the configuration)");
     }
     if (it == kill_at) std::raise(SIGKILL);
+    gaussians::enterPhase(profile.get(), "log and progress");
     logStep(log, stats, seconds(), it == config.iterations);
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
@@ -245,10 +252,18 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     }
     if (config.checkpoint_interval > 0 && it % config.checkpoint_interval == 0 &&
         it < config.iterations) {
+      gaussians::enterPhase(profile.get(), "checkpoints");
       checkpointNow();
     }
+    if (profile) profile->leave();
   }
   if (o.progress) *o.progress << "\n";
+  if (profile) {
+    const std::string table = "Training time per phase (" + config.device +
+                              ", each phase boundary waits for the device):\n\n" + profile->table();
+    writeText(o.out + "/profile.md", table);
+    if (o.progress) *o.progress << table;
+  }
   const double total = seconds();
   trainer.saveCheckpoint(checkpoint);
   writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);

@@ -15,6 +15,7 @@
 
 #include "sadsplat/common/gaussian_point.h"
 #include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/gaussians/step_profile.h"
 #include "sadsplat/io/scene.h"
 
 namespace sadsplat {
@@ -163,6 +164,8 @@ class Trainer {
 
   /// \brief Installs the semantic-aware drop (none by default).
   void setDropStrategy(std::shared_ptr<const DropStrategy> strategy);
+  /// \brief Times the phases of every following step() in `profile` (null: stop timing).
+  void setProfile(StepProfile::Ptr profile);
 
   /// \brief One optimisation step (render, loss, backward, Adam, densification schedule). With a
   /// drop strategy, densification prunes by the opacity a Gaussian renders with at evaluation

@@ -34,6 +34,9 @@ struct TrainRunOptions {
   /// Set (e.g. by a SIGINT / SIGTERM handler) to stop after the current iteration: the run
   /// writes its checkpoint and run.json, then throws TrainingInterrupted.
   const std::atomic<bool>* stop = nullptr;
+  /// Time every phase of every iteration (synchronising the device at each boundary) and write
+  /// the table to out/profile.md and to `progress`.
+  bool profile = false;
 };
 
 /// \brief Thrown by trainRun when `stop` was set: the checkpoint of `iteration` is written and
