@@ -16,7 +16,6 @@ bin=build-gpu/bin/sadsplat
 work=/tmp/sadsplat-profile
 mkdir -p "$work"
 summary="$out/summary.txt"
-git log --oneline -1 >> "$summary" 2>/dev/null || true
 for scene in "${scenes[@]}"; do
   kind=${scene%_*}; seed=${scene##*_}
   cache="$work/${scene}_800x450.cache"
@@ -25,12 +24,12 @@ for scene in "${scenes[@]}"; do
   for run in full_plain full_profile none_profile; do
     drop=${run%_*}; flags=(); [ "${run#*_}" = profile ] && flags=(--profile)
     dir="$work/${scene}_$run"; rm -rf "$dir"
-    start=$(date +%s.%N)
+    start=$(date +%s%N)
     "$bin" train "$cache" --device cuda --iterations "$iterations" --drop "$drop" --out "$dir" \
       "${flags[@]}" > "$out/train_${scene}_$run.log" 2>&1
-    wall=$(echo "$(date +%s.%N) - $start" | bc)
+    wall=$(( ($(date +%s%N) - start) / 1000000 ))
     gaussians=$(tr '\r' '\n' < "$out/train_${scene}_$run.log" | grep -o 'gaussians [0-9]*' | tail -1)
-    echo "$scene $run: wall ${wall} s (process), $(grep -o 'trained in [0-9.]* s' "$out/train_${scene}_$run.log"), $gaussians" | tee -a "$summary"
+    echo "$scene $run: wall ${wall} ms (process), $(grep -o 'trained in [0-9.]* s' "$out/train_${scene}_$run.log"), $gaussians" | tee -a "$summary"
     [ -f "$dir/profile.md" ] && cp "$dir/profile.md" "$out/profile_${scene}_$run.md"
     if [ "$run" = full_plain ]; then
       "$bin" eval "$dir" > "$out/metrics_${scene}_$run.json" 2>"$out/eval_${scene}_$run.log" || true
