@@ -288,6 +288,32 @@ TEST(Rasterizer, TiledRenderEqualsABruteForceComposite) {
   EXPECT_GT(out[1].max().item<double>(), 0.5);  // the scene does cover the image
 }
 
+// Without features and depth (what training renders for a view with no semantic loss) the colour,
+// alpha and every colour gradient are those of the full render; features get no gradient.
+TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {
+  const RasterCamera cam = frontCamera(40, 30, 36.0);
+  GaussianParams g = randomScene(30, 5, 17);
+  for (at::Tensor* t : {&g.means, &g.sh, &g.opacity_logits, &g.features}) {
+    *t = t->detach().requires_grad_(true);
+  }
+  RenderSettings lean;
+  lean.features = false;
+  lean.depth = false;
+  const auto full = gaussians::render(g, cam);
+  const auto slim = gaussians::render(g, cam, lean);
+  EXPECT_FALSE(slim.depth.defined());
+  EXPECT_EQ(slim.features.size(2), 0);
+  EXPECT_TRUE(at::allclose(full.rgb, slim.rgb, 1e-12, 1e-12));
+  EXPECT_TRUE(at::allclose(full.alpha, slim.alpha, 1e-12, 1e-12));
+  const auto a = torch::autograd::grad({(full.rgb * full.rgb).sum()},
+                                       {g.means, g.sh, g.opacity_logits}, {}, false, false, true);
+  const auto b =
+      torch::autograd::grad({(slim.rgb * slim.rgb).sum()},
+                            {g.means, g.sh, g.opacity_logits, g.features}, {}, false, false, true);
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(at::allclose(a[k], b[k], 1e-10, 1e-12)) << k;
+  EXPECT_FALSE(b[3].defined()) << "features were not rendered";
+}
+
 TEST(Rasterizer, ScreenSpaceGradientReachesMeans2d) {
   const RasterCamera cam = frontCamera(32, 32, 30.0);
   auto g = randomScene(10, 0, 8);

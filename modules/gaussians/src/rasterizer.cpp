@@ -344,13 +344,15 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
                     std::to_string(settings.sh_degree),
                 std::to_string(g.sh.size(1)));
   }
+  if (g.features.defined()) expectTensor(g.features, "features", n, {-1}, g.means);
   const at::Tensor features =
-      g.features.defined() ? g.features : at::zeros({n, 0}, g.means.options());
-  expectTensor(features, "features", n, {-1}, g.means);
+      g.features.defined() && settings.features ? g.features : at::zeros({n, 0}, g.means.options());
 
   auto [means2d, conics, depths, radii] = projectGaussians(g.means, g.quats, g.log_scales, camera);
   const at::Tensor colors = evaluateSh(g.sh, g.means, camera.centre(), settings.sh_degree);
-  const at::Tensor values = at::cat({colors, features, depths.unsqueeze(1)}, 1);
+  const at::Tensor values = settings.depth ? at::cat({colors, features, depths.unsqueeze(1)}, 1)
+                            : features.size(1) > 0 ? at::cat({colors, features}, 1)
+                                                   : colors;
   at::Tensor opacities = at::sigmoid(g.opacity_logits);
   if (g.opacity_gate.defined()) {
     expectTensor(g.opacity_gate, "opacity_gate", n, {}, g.means);
@@ -366,8 +368,10 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   RenderResult result;
   result.rgb = image.slice(2, 0, 3) + (1.0 - alpha).unsqueeze(2) * background;
   result.features = image.slice(2, 3, 3 + C);
-  const at::Tensor depth_sum = image.select(2, 3 + C);
-  result.depth = at::where(alpha > 0, depth_sum / alpha.clamp_min(1e-10), at::zeros_like(alpha));
+  if (settings.depth) {
+    const at::Tensor depth_sum = image.select(2, 3 + C);
+    result.depth = at::where(alpha > 0, depth_sum / alpha.clamp_min(1e-10), at::zeros_like(alpha));
+  }
   result.alpha = alpha;
   result.means2d = means2d;
   result.radii = radii;

@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/adam.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -498,6 +499,11 @@ StepStats Trainer::step() {
   DropDecision decision;
   for (int v : views) {
     enterPhase(profile, "render forward");
+    const at::Tensor& labels = s.labels[v];
+    const bool semantic = labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0;
+    // Training uses no depth, and features only where a semantic loss reads them.
+    settings.features = semantic;
+    settings.depth = false;
     RenderResult r = render(g, s.cameras[v], settings);
     r.means2d.retain_grad();
     enterPhase(profile, "losses forward");
@@ -508,8 +514,7 @@ StepStats Trainer::step() {
         (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
     at::Tensor loss = c.lambda_rgb * rgb_loss;
     accumulate(rgb_sum, rgb_loss);
-    const at::Tensor& labels = s.labels[v];
-    if (labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0) {
+    if (semantic) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
       // class-score space of the built-in backend), averaged over supervised pixels only.
       const bool ground_truth =
@@ -549,19 +554,15 @@ StepStats Trainer::step() {
       s.max_radii = at::where(visible, at::max(s.max_radii, r.radii.to(at::kFloat)), s.max_radii);
     }
     enterPhase(profile, "optimiser");
-    // Adam (own implementation so densification can reshape its state).
+    // Adam (own, fused implementation so densification can reshape its state). The features
+    // take a step with a zero gradient when no view of this iteration rendered them: their
+    // momentum carries on, as when they were rendered (and got zero gradient) on every view.
     ++s.adam_step;
-    const double b1 = 0.9, b2 = 0.999, eps = 1e-15;
-    const double bc1 = 1 - std::pow(b1, static_cast<double>(s.adam_step));
-    const double bc2 = 1 - std::pow(b2, static_cast<double>(s.adam_step));
     for (Param& q : s.params) {
-      at::Tensor grad = q.value.grad();
-      if (!grad.defined()) continue;
-      q.m.mul_(b1).add_(grad, 1 - b1);
-      q.v.mul_(b2).addcmul_(grad, grad, 1 - b2);
-      const at::Tensor update = (q.m / bc1) / ((q.v / bc2).sqrt() + eps);
-      q.value.sub_(update * q.lr);
-      q.value.mutable_grad().reset();
+      const at::Tensor grad = q.value.grad();
+      if (!grad.defined() && q.name != "features") continue;
+      adamStep(q.value, grad, q.m, q.v, q.lr, s.adam_step);
+      if (grad.defined()) q.value.mutable_grad().reset();
     }
     s.iteration = it + 1;
     const int done = s.iteration;

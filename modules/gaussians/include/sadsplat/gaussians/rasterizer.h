@@ -36,6 +36,11 @@ struct RasterCamera {
 struct RenderSettings {
   int sh_degree = 3;                         ///< 0..3; sh must hold (degree+1)^2 coefficients
   std::array<float, 3> background{0, 0, 0};  ///< RGB behind the Gaussians
+  /// Render the semantic features (false: RenderResult::features has 0 channels and the
+  /// rasterizer blends 32 fewer channels; the features get no gradient from this render).
+  bool features = true;
+  /// Render the expected depth (false: RenderResult::depth is undefined; one channel fewer).
+  bool depth = true;
 };
 
 /// \brief The Gaussians to render: N rows, float32 (or float64 on CPU), one device.
@@ -55,6 +60,7 @@ struct RenderResult {
   at::Tensor features;  ///< [H, W, C]
   at::Tensor alpha;     ///< [H, W] accumulated opacity
   at::Tensor depth;     ///< [H, W] expected depth (alpha-weighted mean camera z), 0 where alpha = 0
+                        ///< (undefined when RenderSettings::depth is false)
   at::Tensor means2d;   ///< [N, 2] projected centres (pixels); call retain_grad() before backward
                         ///< to read the screen-space gradient
   at::Tensor radii;     ///< [N] int32 screen radius, 0 = culled

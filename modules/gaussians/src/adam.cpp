@@ -1,0 +1,89 @@
+#include "sadsplat/gaussians/adam.h"
+
+#include <ATen/Parallel.h>
+
+#include <cmath>
+#include <string>
+
+#if SADSPLAT_HAVE_CUDA
+#include <c10/cuda/CUDAGuard.h>
+#include <c10/cuda/CUDAStream.h>
+#endif
+
+#include "adam_math.h"
+#include "sadsplat/common/error.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace adam {
+#if SADSPLAT_HAVE_CUDA
+void stepCuda(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v,
+              const Coefficients<float>& c, void* stream);
+#endif
+}  // namespace adam
+
+namespace {
+
+void expectLike(const at::Tensor& t, const at::Tensor& value, const char* name) {
+  if (!t.defined() || !t.sizes().equals(value.sizes()) || t.scalar_type() != value.scalar_type() ||
+      t.device() != value.device() || !t.is_contiguous()) {
+    throw Error("<adam>", name, "a contiguous tensor shaped, typed and placed like the value");
+  }
+}
+
+template <typename T>
+adam::Coefficients<T> coefficients(double lr, std::int64_t step, const AdamSettings& s) {
+  const double k = static_cast<double>(step);
+  return {T(s.beta1),
+          T(1 - s.beta1),
+          T(s.beta2),
+          T(1 - s.beta2),
+          T(1 - std::pow(s.beta1, k)),
+          T(1 - std::pow(s.beta2, k)),
+          T(s.eps),
+          T(lr)};
+}
+
+}  // namespace
+
+void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
+              std::int64_t step, const AdamSettings& settings) {
+  if (!value.defined() || !value.is_contiguous()) {
+    throw Error("<adam>", "value", "a defined, contiguous tensor");
+  }
+  if (step < 1) throw Error("<adam>", "step", ">= 1", std::to_string(step));
+  expectLike(m, value, "m");
+  expectLike(v, value, "v");
+  const at::Tensor g = grad.defined() ? grad.contiguous() : grad;
+  if (g.defined()) expectLike(g, value, "grad");
+  // The update runs outside autograd: value is a leaf that requires grad.
+  at::Tensor data = value.detach();
+  if (value.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+    if (value.scalar_type() != at::kFloat) {
+      throw Error("<adam>", "value", "float32 on CUDA", c10::toString(value.scalar_type()));
+    }
+    const c10::cuda::CUDAGuard guard(value.device());
+    adam::stepCuda(data, g, m, v, coefficients<float>(lr, step, settings),
+                   c10::cuda::getCurrentCUDAStream().stream());
+    return;
+#else
+    throw Error("<adam>", "device", "cpu (this build has no CUDA)", "cuda");
+#endif
+  }
+  AT_DISPATCH_FLOATING_TYPES(value.scalar_type(), "adamStep", [&] {
+    const adam::Coefficients<scalar_t> c = coefficients<scalar_t>(lr, step, settings);
+    scalar_t* x = data.data_ptr<scalar_t>();
+    scalar_t* mm = m.data_ptr<scalar_t>();
+    scalar_t* vv = v.data_ptr<scalar_t>();
+    const scalar_t* gg = g.defined() ? g.data_ptr<scalar_t>() : nullptr;
+    at::parallel_for(0, value.numel(), 1 << 15, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        adam::update(x + i, gg ? gg[i] : scalar_t(0), mm + i, vv + i, c);
+      }
+    });
+  });
+}
+
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,37 @@
+// The fused Adam step on CUDA: one thread per element (adam_math.h holds the arithmetic).
+#include <ATen/ATen.h>
+#include <cuda_runtime.h>
+
+#include "adam_math.h"
+#include "sadsplat/common/error.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace adam {
+namespace {
+
+__global__ void stepKernel(float* value, const float* grad, float* m, float* v, int64_t n,
+                           Coefficients<float> c) {
+  const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  update(value + i, grad != nullptr ? grad[i] : 0.0f, m + i, v + i, c);
+}
+
+}  // namespace
+
+void stepCuda(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v,
+              const Coefficients<float>& c, void* stream_ptr) {
+  const int64_t n = value.numel();
+  if (n == 0) return;
+  constexpr int kThreads = 256;
+  const int64_t blocks = (n + kThreads - 1) / kThreads;
+  stepKernel<<<static_cast<unsigned>(blocks), kThreads, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
+      value.data_ptr<float>(), grad.defined() ? grad.data_ptr<float>() : nullptr,
+      m.data_ptr<float>(), v.data_ptr<float>(), n, c);
+  const cudaError_t err = cudaGetLastError();
+  if (err != cudaSuccess) throw Error("<adam>", "CUDA launch", "success", cudaGetErrorString(err));
+}
+
+}  // namespace adam
+}  // namespace gaussians
+}  // namespace sadsplat

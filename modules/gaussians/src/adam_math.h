@@ -1,0 +1,35 @@
+#pragma once
+// One element of the fused Adam step, shared by the CPU loop (adam.cpp) and the CUDA kernel
+// (adam_cuda.cu). The order of operations is the textbook formula's, so both backends round
+// alike.
+
+#if defined(__CUDACC__)
+#define SADSPLAT_ADAM_HD __host__ __device__ __forceinline__
+#else
+#define SADSPLAT_ADAM_HD inline
+#endif
+
+#include <cmath>
+
+namespace sadsplat {
+namespace gaussians {
+namespace adam {
+
+/// Per-step constants: the betas, their complements, the bias corrections and lr.
+template <typename T>
+struct Coefficients {
+  T beta1, one_minus_beta1, beta2, one_minus_beta2, correction1, correction2, eps, lr;
+};
+
+template <typename T>
+SADSPLAT_ADAM_HD void update(T* value, T grad, T* m, T* v, const Coefficients<T>& c) {
+  const T m_new = *m * c.beta1 + grad * c.one_minus_beta1;
+  const T v_new = *v * c.beta2 + grad * grad * c.one_minus_beta2;
+  *m = m_new;
+  *v = v_new;
+  *value -= c.lr * ((m_new / c.correction1) / (std::sqrt(v_new / c.correction2) + c.eps));
+}
+
+}  // namespace adam
+}  // namespace gaussians
+}  // namespace sadsplat

@@ -1,0 +1,94 @@
+// The fused Adam step against the textbook formula written with tensor operations.
+#include <gtest/gtest.h>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/adam.h"
+
+namespace sadsplat {
+namespace {
+
+using gaussians::adamStep;
+
+// The reference: eight element-wise tensor operations, in double.
+void textbookStep(at::Tensor& x, const at::Tensor& g, at::Tensor& m, at::Tensor& v, double lr,
+                  std::int64_t step) {
+  const double b1 = 0.9, b2 = 0.999, eps = 1e-15;
+  m = m * b1 + g * (1 - b1);
+  v = v * b2 + g * g * (1 - b2);
+  const double c1 = 1 - std::pow(b1, double(step)), c2 = 1 - std::pow(b2, double(step));
+  x = x - lr * ((m / c1) / ((v / c2).sqrt() + eps));
+}
+
+TEST(Adam, FusedStepMatchesTheTextbookFormulaOverSeveralSteps) {
+  at::manual_seed(3);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  at::Tensor x = at::randn({257, 3}, opts), m = at::zeros_like(x), v = at::zeros_like(x);
+  at::Tensor rx = x.clone(), rm = m.clone(), rv = v.clone();
+  for (std::int64_t step = 1; step <= 5; ++step) {
+    const at::Tensor g = at::randn({257, 3}, opts);
+    adamStep(x, g, m, v, 0.01, step);
+    textbookStep(rx, g, rm, rv, 0.01, step);
+  }
+  EXPECT_TRUE(at::allclose(x, rx, 1e-12, 1e-14));
+  EXPECT_TRUE(at::allclose(m, rm, 1e-12, 1e-14));
+  EXPECT_TRUE(at::allclose(v, rv, 1e-12, 1e-14));
+}
+
+TEST(Adam, FirstStepMovesEachElementByTheLearningRateAgainstItsGradientSign) {
+  at::Tensor x = at::zeros({4}), m = at::zeros({4}), v = at::zeros({4});
+  const at::Tensor g = at::tensor({2.0f, -0.5f, 1e-3f, -7.0f});
+  adamStep(x, g, m, v, 0.1, 1);
+  // Step 1: m / (1 - b1) = g and sqrt(v / (1 - b2)) = |g|, so the update is lr * sign(g).
+  EXPECT_TRUE(at::allclose(x, at::tensor({-0.1f, 0.1f, -0.1f, 0.1f}), 1e-5, 1e-6)) << x;
+}
+
+TEST(Adam, UndefinedGradientIsAZeroGradient) {
+  at::manual_seed(5);
+  at::Tensor x = at::randn({10}), m = at::randn({10}), v = at::rand({10});
+  at::Tensor x2 = x.clone(), m2 = m.clone(), v2 = v.clone();
+  adamStep(x, at::Tensor(), m, v, 0.05, 7);
+  adamStep(x2, at::zeros({10}), m2, v2, 0.05, 7);
+  EXPECT_TRUE(at::equal(x, x2));
+  EXPECT_TRUE(at::equal(m, m2));
+  EXPECT_TRUE(at::equal(v, v2));
+  EXPECT_FALSE(at::equal(m, m2 / 0.9)) << "moments decay";
+}
+
+TEST(Adam, UpdatesALeafThatRequiresGradInPlace) {
+  at::Tensor x = at::ones({3}).requires_grad_(true), m = at::zeros({3}), v = at::zeros({3});
+  const void* storage = x.data_ptr();
+  adamStep(x, at::ones({3}), m, v, 0.5, 1);
+  EXPECT_EQ(x.data_ptr(), storage);
+  EXPECT_TRUE(x.requires_grad());
+  EXPECT_NEAR(x[0].item<float>(), 0.5f, 1e-6);
+}
+
+TEST(Adam, MismatchedMomentsAreAnError) {
+  at::Tensor x = at::zeros({4}), m = at::zeros({5}), v = at::zeros({4});
+  EXPECT_THROW(adamStep(x, at::zeros({4}), m, v, 0.1, 1), Error);
+  at::Tensor m2 = at::zeros({4}, at::kDouble);
+  EXPECT_THROW(adamStep(x, at::zeros({4}), m2, v, 0.1, 1), Error);
+  at::Tensor m3 = at::zeros({4});
+  EXPECT_THROW(adamStep(x, at::zeros({3}), m3, v, 0.1, 1), Error);
+  EXPECT_THROW(adamStep(x, at::zeros({4}), m3, v, 0.1, 0), Error);
+}
+
+TEST(Adam, CudaStepMatchesTheCpuStep) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  at::manual_seed(9);
+  at::Tensor x = at::randn({100003}), m = at::randn({100003}), v = at::rand({100003});
+  const at::Tensor g = at::randn({100003});
+  at::Tensor cx = x.cuda(), cm = m.cuda(), cv = v.cuda();
+  adamStep(x, g, m, v, 0.01, 11);
+  adamStep(cx, g.cuda(), cm, cv, 0.01, 11);
+  EXPECT_TRUE(at::allclose(cx.cpu(), x, 1e-5, 1e-6));
+  EXPECT_TRUE(at::allclose(cm.cpu(), m, 1e-5, 1e-7));
+  EXPECT_TRUE(at::allclose(cv.cpu(), v, 1e-5, 1e-7));
+  at::Tensor cx2 = x.cuda(), cm2 = m.cuda(), cv2 = v.cuda();
+  adamStep(x, at::Tensor(), m, v, 0.01, 12);
+  adamStep(cx2, at::Tensor(), cm2, cv2, 0.01, 12);
+  EXPECT_TRUE(at::allclose(cx2.cpu(), x, 1e-5, 1e-6));
+}
+
+}  // namespace
+}  // namespace sadsplat
