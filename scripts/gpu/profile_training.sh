@@ -4,6 +4,7 @@
 # the full method unprofiled (the clean wall time, then eval), the full method with --profile
 # and Net-1 (--drop none) with --profile, one training at a time.
 #   bash scripts/gpu/profile_training.sh [ITERATIONS=7000] [KIND_SEED ...]
+# RUNS (env) picks among full_plain full_profile none_plain none_profile.
 # $OUT gets profile_<scene>_<run>.md, train logs, metrics and summary.txt.
 set -euo pipefail
 iterations="${1:-7000}"; shift $(( $# < 1 ? $# : 1 ))
@@ -21,7 +22,7 @@ for scene in "${scenes[@]}"; do
   cache="$work/${scene}_800x450.cache"
   [ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 \
     --cache "$cache" > "$out/synth_$scene.log" 2>&1
-  for run in full_plain full_profile none_profile; do
+  for run in ${RUNS:-full_plain full_profile none_profile}; do
     drop=${run%_*}; flags=(); [ "${run#*_}" = profile ] && flags=(--profile)
     dir="$work/${scene}_$run"; rm -rf "$dir"
     start=$(date +%s%N)
@@ -31,7 +32,7 @@ for scene in "${scenes[@]}"; do
     gaussians=$(tr '\r' '\n' < "$out/train_${scene}_$run.log" | grep -o 'gaussians [0-9]*' | tail -1)
     echo "$scene $run: wall ${wall} ms (process), $(grep -o 'trained in [0-9.]* s' "$out/train_${scene}_$run.log"), $gaussians" | tee -a "$summary"
     [ -f "$dir/profile.md" ] && cp "$dir/profile.md" "$out/profile_${scene}_$run.md"
-    if [ "$run" = full_plain ]; then
+    if [ "${run#*_}" = plain ]; then
       "$bin" eval "$dir" > "$out/metrics_${scene}_$run.json" 2>"$out/eval_${scene}_$run.log" || true
     fi
   done

@@ -546,8 +546,11 @@ StepStats Trainer::step() {
       const RenderResult& r = renders[k];
       const RasterCamera& cam = s.cameras[views[k]];
       if (!r.means2d.grad().defined()) continue;
-      const at::Tensor scale = at::tensor({cam.width * 0.5, cam.height * 0.5}, r.means2d.options());
-      const at::Tensor norm = (r.means2d.grad() * scale).norm(2, 1);
+      // Scaled column by column: no small tensor built on the host and copied every step.
+      const at::Tensor grad = r.means2d.grad();
+      const at::Tensor gx = grad.select(1, 0) * (cam.width * 0.5);
+      const at::Tensor gy = grad.select(1, 1) * (cam.height * 0.5);
+      const at::Tensor norm = at::sqrt(gx * gx + gy * gy);
       const at::Tensor visible = r.radii > 0;
       s.grad_accum += at::where(visible, norm, at::zeros_like(norm));
       s.denom += visible.to(at::kFloat);

@@ -1,6 +1,7 @@
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/semantic_drop/semantic_confidence.h"
 
 namespace sadsplat {
@@ -22,12 +23,9 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
 
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
-    at::Generator gen =
-        gaussians::seededGenerator(seed_, 13, static_cast<std::uint64_t>(iteration));
-    const at::Tensor u =
-        at::empty({log_alpha.size(0)}, at::TensorOptions().dtype(log_alpha.scalar_type()))
-            .uniform_(0, 1, gen)
-            .to(log_alpha.device());
+    // Counter-based noise on the parameters' device: nothing drawn on the host and copied.
+    const at::Tensor u = gaussians::counterUniform(
+        log_alpha.size(0), seed_, 13, static_cast<std::uint64_t>(iteration), log_alpha.options());
     return sampleGate(log_alpha, u, hc_);
   }
 
