@@ -119,6 +119,17 @@ function(sadsplat_link_openmp target)
   endif()
 endfunction()
 
+# --- Distributed training (c10d Gloo) ---------------------------------------------------------
+# LibTorch's ProcessGroupGloo header includes gloo's own headers (Debian: libgloo-dev); the PyTorch
+# wheels ship none, so there the distributed module builds without a backend.
+find_path(SADSPLAT_GLOO_INCLUDE_DIR gloo/config.h)
+find_file(SADSPLAT_TORCH_GLOO_HEADER torch/csrc/distributed/c10d/ProcessGroupGloo.hpp
+          PATHS ${TORCH_INCLUDE_DIRS} NO_DEFAULT_PATH)
+set(SADSPLAT_HAVE_GLOO OFF)
+if(SADSPLAT_GLOO_INCLUDE_DIR AND SADSPLAT_TORCH_GLOO_HEADER)
+  set(SADSPLAT_HAVE_GLOO ON)
+endif()
+
 # --- GoogleTest -----------------------------------------------------------------------------
 if(SADSPLAT_BUILD_TESTS)
   find_package(GTest REQUIRED)

@@ -7,6 +7,8 @@ packages=(
   libpcl-dev libflann-dev libeigen3-dev libvtk9-dev mpi-default-dev
   libtorch-dev libopencv-dev libgtest-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   libopen3d-dev python3 python3-open3d
+  # gloo's headers: LibTorch's c10d Gloo process group (data-parallel training, --nproc).
+  libgloo-dev
   # VTK renders through X only on Debian: headless views, screenshots and report plots run
   # under Xvfb with Mesa's software OpenGL.
   xvfb xauth libgl1-mesa-dri

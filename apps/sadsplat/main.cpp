@@ -7,10 +7,12 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/distributed/rank_group.h"
 #include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -209,6 +211,8 @@ int main(int argc, char** argv) {
   double train_scale = 0.5;
   bool train_resume = false;
   bool train_profile = false;
+  int train_nproc = 1;
+  int train_views_per_step = 0;
   train->add_option("SCENE", train_scene, "scene directory or scene cache")->required();
   train->add_option("--out", train_out, "run directory")->required();
   train->add_option("--config", train_config_file, "JSON file with TrainConfig keys");
@@ -218,6 +222,16 @@ int main(int argc, char** argv) {
   train->add_option("--scale", train_scale, "image scale when importing a directory")
       ->capture_default_str();
   train->add_flag("--resume", train_resume, "continue from RUN/checkpoint.bin");
+  train
+      ->add_option(
+          "--nproc", train_nproc,
+          "data-parallel ranks on this machine (c10d Gloo; or start the ranks with "
+          "torchrun --no-python, which sets RANK / WORLD_SIZE / MASTER_ADDR / MASTER_PORT)")
+      ->check(CLI::Range(1, 256));
+  train
+      ->add_option("--views-per-step", train_views_per_step,
+                   "training views per step and rank (1); the loss is their mean")
+      ->check(CLI::Range(1, 1024));
   train->add_flag("--profile", train_profile,
                   "time each phase of the iterations (waits for the GPU at every phase "
                   "boundary) and write RUN/profile.md");
@@ -442,18 +456,33 @@ int main(int argc, char** argv) {
       if (!train_drop.empty()) config.drop = train_drop;
       if (train_p_base >= 0) config.p_base = train_p_base;
       if (train_lambda_l0 >= 0) config.lambda_l0 = train_lambda_l0;
+      if (train_views_per_step > 0) config.views_per_step = train_views_per_step;
+      // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
+      std::optional<sadsplat::distributed::LocalRanks> local_ranks;
+      if (train_nproc > 1 && std::getenv("RANK") == nullptr) {
+        local_ranks.emplace(train_nproc, std::vector<std::string>(argv + 1, argv + argc));
+        sadsplat::gaussians::setCpuThreads();
+      }
+      const auto rank_env = sadsplat::distributed::RankEnvironment::fromProcessEnvironment();
+      const bool quiet_rank = rank_env && rank_env->rank != 0;
       sadsplat::pipeline::TrainRunOptions options;
+      if (rank_env && rank_env->world_size > 1) {
+        options.collective = sadsplat::distributed::joinGroup(*rank_env);
+      }
       options.scene = train_scene;
       options.out = train_out;
       options.scale = train_scale;
       options.resume = train_resume;
       options.profile = train_profile;
-      options.progress = &std::cout;
+      options.progress = quiet_rank ? nullptr : &std::cout;
       options.stop = &g_stop;
       std::signal(SIGINT, requestStop);
       std::signal(SIGTERM, requestStop);
       const double seconds = sadsplat::pipeline::trainRun(options, config);
-      std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
+      if (local_ranks) local_ranks->waitAll();
+      if (!quiet_rank) {
+        std::cout << "trained in " << seconds << " s; model in " << train_out << "/model.ply\n";
+      }
     } else if (*pseudo) {
       pseudo_options.builtin.geometry = !pseudo_no_geometry;
       pseudo_options.builtin.scale_region_size = !pseudo_fixed_region_size;

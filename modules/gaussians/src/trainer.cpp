@@ -62,6 +62,7 @@ std::string TrainConfig::toJson() const {
                       {"lambda_rgb", lambda_rgb},
                       {"lambda_semantic", lambda_semantic},
                       {"semantic_interval", semantic_interval},
+                      {"views_per_step", views_per_step},
                       {"use_pseudo_labels", use_pseudo_labels},
                       {"lambda_pseudo", lambda_pseudo},
                       {"pseudo_labels_train_decoder", pseudo_labels_train_decoder},
@@ -125,6 +126,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.lambda_rgb = d["lambda_rgb"];
   c.lambda_semantic = d["lambda_semantic"];
   c.semantic_interval = d["semantic_interval"];
+  c.views_per_step = d["views_per_step"];
   c.use_pseudo_labels = d["use_pseudo_labels"];
   c.lambda_pseudo = d["lambda_pseudo"];
   c.pseudo_labels_train_decoder = d["pseudo_labels_train_decoder"];
@@ -179,6 +181,7 @@ struct Trainer::State {
   at::Tensor confidence;  // [N] last semantic confidence computed by the drop (0 before)
   std::shared_ptr<const DropStrategy> drop;
   StepProfile::Ptr profile;
+  Collective::Ptr collective;
   // Densification statistics.
   at::Tensor grad_accum, denom, max_radii;
   std::int64_t adam_step = 0;
@@ -251,6 +254,37 @@ struct Trainer::State {
     return gate.defined() ? opacity * gate : opacity;
   }
 
+  // Sums every parameter's gradient over the ranks in one flat all-reduce. A gradient no rank has
+  // stays undefined (so Adam skips that tensor as a single process would); one that only some
+  // ranks have counts as zero on the others.
+  void reduceGradients() {
+    State& s = *this;
+    std::vector<at::Tensor> parts;
+    std::vector<float> present;
+    for (const Param& q : s.params) {
+      const at::Tensor grad = q.value.grad();
+      present.push_back(grad.defined() ? 1.0f : 0.0f);
+      parts.push_back(grad.defined() ? grad.reshape({-1})
+                                     : at::zeros({q.value.numel()}, q.value.options()));
+    }
+    parts.push_back(at::tensor(present).to(s.device));
+    at::Tensor flat = at::cat(parts);
+    s.collective->sum(flat);
+    const at::Tensor flags =
+        flat.slice(0, flat.size(0) - static_cast<int64_t>(present.size())).cpu();
+    int64_t offset = 0;
+    for (std::size_t k = 0; k < s.params.size(); ++k) {
+      Param& q = s.params[k];
+      const int64_t n = q.value.numel();
+      if (flags[static_cast<int64_t>(k)].item<float>() > 0) {
+        q.value.mutable_grad() = flat.slice(0, offset, offset + n).view(q.value.sizes()).clone();
+      } else if (q.value.grad().defined()) {
+        q.value.mutable_grad().reset();
+      }
+      offset += n;
+    }
+  }
+
   void densifyAndPrune(bool prune_big) {
     const double threshold = config.densify_grad_threshold;
     const at::Tensor avg = grad_accum / denom.clamp_min(1);
@@ -315,9 +349,12 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   State& s = *state_;
   s.config = config;
   if (config.iterations < 1 || config.feature_dim < 0 || config.feature_dim > kFeatureDim ||
-      config.max_sh_degree < 0 || config.max_sh_degree > 3 || config.semantic_interval < 0) {
-    throw Error("<config>", "iterations / feature_dim / max_sh_degree / semantic_interval",
-                "iterations >= 1, feature_dim 0..32, max_sh_degree 0..3, semantic_interval >= 0");
+      config.max_sh_degree < 0 || config.max_sh_degree > 3 || config.semantic_interval < 0 ||
+      config.views_per_step < 1) {
+    throw Error("<config>",
+                "iterations / feature_dim / max_sh_degree / semantic_interval / views_per_step",
+                "iterations >= 1, feature_dim 0..32, max_sh_degree 0..3, semantic_interval >= 0, "
+                "views_per_step >= 1");
   }
   if (config.device == "cuda") {
     if (!at::hasCUDA()) {
@@ -445,6 +482,10 @@ void Trainer::setDropStrategy(std::shared_ptr<const DropStrategy> strategy) {
 
 void Trainer::setProfile(StepProfile::Ptr profile) { state_->profile = std::move(profile); }
 
+void Trainer::setCollective(Collective::Ptr collective) {
+  state_->collective = std::move(collective);
+}
+
 Trainer::~Trainer() = default;
 
 int Trainer::iteration() const { return state_->iteration; }
@@ -476,11 +517,23 @@ StepStats Trainer::step() {
     std::sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
     return views[order[pos]];
   };
-  std::vector<int> views = {pick(s.train_views, 1, it)};
-  if (!s.labelled_views.empty() && c.semantic_interval > 0 && c.lambda_semantic > 0 &&
-      it % c.semantic_interval == 0) {
-    const int lv = pick(s.labelled_views, 2, it / c.semantic_interval);
-    if (lv != views[0]) views.push_back(lv);
+  // Data-parallel ranks split one global batch of views_per_step x ranks draws: this rank's
+  // draws are numbered rank * views_per_step + b, so N ranks draw what one process with N times
+  // the views per step would.
+  const int ranks = s.collective ? s.collective->size() : 1;
+  const int rank = s.collective ? s.collective->rank() : 0;
+  const int batch = c.views_per_step * ranks;
+  const bool semantic_step = !s.labelled_views.empty() && c.semantic_interval > 0 &&
+                             c.lambda_semantic > 0 && it % c.semantic_interval == 0;
+  std::vector<int> views;
+  for (int b = 0; b < c.views_per_step; ++b) {
+    const int draw = rank * c.views_per_step + b;
+    const int tv = pick(s.train_views, 1, it * batch + draw);
+    views.push_back(tv);
+    if (semantic_step) {
+      const int lv = pick(s.labelled_views, 2, (it / c.semantic_interval) * batch + draw);
+      if (lv != tv) views.push_back(lv);
+    }
   }
 
   RenderSettings settings;
@@ -531,9 +584,12 @@ StepStats Trainer::step() {
     total = total.defined() ? total + loss : loss;
     renders.push_back(r);
   }
+  // The mean over the global batch (one draw: the sum of its training and labelled views' losses).
+  if (batch > 1) total = total / batch;
   if (s.drop) {
+    // Added once over all ranks.
     const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value);
-    if (reg.defined()) total = total + reg;
+    if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);
   }
   enterPhase(profile, "backward");
   total.backward();
@@ -542,20 +598,34 @@ StepStats Trainer::step() {
     c10::AutoGradMode no_grad(false);
     enterPhase(profile, "densification statistics");
     // Densification statistics: NDC-space screen gradient of visible Gaussians (3DGS).
+    // Per view, so a batch's mean loss is scaled back by the batch size (3DGS's per-view gradient).
+    at::Tensor grad_accum = s.collective ? at::zeros_like(s.grad_accum) : s.grad_accum;
+    at::Tensor denom = s.collective ? at::zeros_like(s.denom) : s.denom;
+    at::Tensor max_radii = s.max_radii;
     for (std::size_t k = 0; k < renders.size(); ++k) {
       const RenderResult& r = renders[k];
       const RasterCamera& cam = s.cameras[views[k]];
       if (!r.means2d.grad().defined()) continue;
       // Scaled column by column: no small tensor built on the host and copied every step.
       const at::Tensor grad = r.means2d.grad();
-      const at::Tensor gx = grad.select(1, 0) * (cam.width * 0.5);
-      const at::Tensor gy = grad.select(1, 1) * (cam.height * 0.5);
+      const at::Tensor gx = grad.select(1, 0) * (cam.width * 0.5 * batch);
+      const at::Tensor gy = grad.select(1, 1) * (cam.height * 0.5 * batch);
       const at::Tensor norm = at::sqrt(gx * gx + gy * gy);
       const at::Tensor visible = r.radii > 0;
-      s.grad_accum += at::where(visible, norm, at::zeros_like(norm));
-      s.denom += visible.to(at::kFloat);
-      s.max_radii = at::where(visible, at::max(s.max_radii, r.radii.to(at::kFloat)), s.max_radii);
+      grad_accum += at::where(visible, norm, at::zeros_like(norm));
+      denom += visible.to(at::kFloat);
+      max_radii = at::where(visible, at::max(max_radii, r.radii.to(at::kFloat)), max_radii);
     }
+    if (s.collective) {
+      enterPhase(profile, "all-reduce");
+      s.collective->sum(grad_accum);
+      s.collective->sum(denom);
+      s.collective->max(max_radii);
+      s.grad_accum += grad_accum;
+      s.denom += denom;
+      s.reduceGradients();
+    }
+    s.max_radii = max_radii;
     enterPhase(profile, "optimiser");
     // Adam (own, fused implementation so densification can reshape its state). The features
     // take a step with a zero gradient when no view of this iteration rendered them: their
@@ -610,9 +680,10 @@ StepStats Trainer::step() {
   }
   enterPhase(profile, "loss values to host");
   const at::Tensor zero = at::zeros({}, total.options());
-  const at::Tensor values = at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero})
-                                .to(at::kDouble)
-                                .cpu();
+  at::Tensor values = at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero,
+                                 at::full({}, static_cast<double>(views.size()), total.options())});
+  if (s.collective) s.collective->sum(values);
+  values = values.to(at::kDouble).cpu();
   const double* value = values.data_ptr<double>();
   if (profile) {
     profile->leave();
@@ -620,8 +691,8 @@ StepStats Trainer::step() {
   }
   StepStats stats;
   stats.iteration = s.iteration;
-  stats.rgb_loss = value[1] / views.size();
-  stats.semantic_loss = value[2];
+  stats.rgb_loss = value[1] / value[3];
+  stats.semantic_loss = value[2] / batch;
   stats.loss = value[0];
   stats.num_gaussians = s.n();
   stats.dropped = dropped;

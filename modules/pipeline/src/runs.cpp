@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
@@ -135,7 +136,10 @@ io::Scene loadScene(const std::string& path, double scale) {
 }
 
 double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_in) {
-  makeDirectory(o.out);
+  // Rank 0 of a data-parallel group (or a single process) writes the run; the ranks hold the
+  // same Gaussians at every step.
+  const bool writer = !o.collective || o.collective->rank() == 0;
+  if (writer) makeDirectory(o.out);
   const std::string checkpoint = o.out + "/checkpoint.bin";
   gaussians::TrainConfig config = config_in;
   double previous_seconds = 0;
@@ -172,8 +176,9 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   }
   gaussians::Trainer trainer(scene, config);
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
+  trainer.setCollective(o.collective);
   if (o.resume) trainer.loadCheckpoint(checkpoint);
-  writeText(o.out + "/config.json", trainer.config().toJson());
+  if (writer) writeText(o.out + "/config.json", trainer.config().toJson());
   gaussians::StepProfile::Ptr profile;
   if (o.profile) {
     profile = std::make_shared<gaussians::StepProfile>(
@@ -185,14 +190,20 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     return previous_seconds + std::chrono::duration<double>(Clock::now() - start).count();
   };
   const int first = trainer.iteration();
-  io::TrainLogWriter log(o.out + "/train_log.jsonl", o.resume ? first : -1);
+  std::optional<io::TrainLogWriter> log;
+  if (writer) log.emplace(o.out + "/train_log.jsonl", o.resume ? first : -1);
   // Fault injection for the crash tests (tests/apps/test_faults.cpp): the process kills itself
   // with SIGKILL right after this iteration's step, before its checkpoint.
   const char* kill_at_text = std::getenv("SADSPLAT_FAULT_KILL_AT_ITERATION");
-  const int kill_at = kill_at_text ? std::atoi(kill_at_text) : -1;
+  // SADSPLAT_FAULT_KILL_RANK limits it to one rank of a data-parallel group.
+  const char* kill_rank_text = std::getenv("SADSPLAT_FAULT_KILL_RANK");
+  const bool kill_this_rank = kill_rank_text == nullptr ||
+                              (o.collective && o.collective->rank() == std::atoi(kill_rank_text));
+  const int kill_at = kill_at_text && kill_this_rank ? std::atoi(kill_at_text) : -1;
   int last_checkpoint = first;
   // The checkpoint and run.json go together: run.json says which iteration the checkpoint holds.
   const auto checkpointNow = [&] {
+    if (!writer) return;
     trainer.saveCheckpoint(checkpoint);
     writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), seconds());
     last_checkpoint = trainer.iteration();
@@ -224,7 +235,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     }
     if (it == kill_at) std::raise(SIGKILL);
     gaussians::enterPhase(profile.get(), "log and progress");
-    logStep(log, stats, seconds(), it == config.iterations);
+    if (log) logStep(*log, stats, seconds(), it == config.iterations);
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
@@ -261,10 +272,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   if (profile) {
     const std::string table = "Training time per phase (" + config.device +
                               ", each phase boundary waits for the device):\n\n" + profile->table();
-    writeText(o.out + "/profile.md", table);
+    if (writer) writeText(o.out + "/profile.md", table);
     if (o.progress) *o.progress << table;
   }
   const double total = seconds();
+  if (!writer) return total;
   trainer.saveCheckpoint(checkpoint);
   writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);
   writeModel(o.out, trainer, scene.classes);

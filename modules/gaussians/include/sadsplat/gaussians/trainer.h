@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sadsplat/common/gaussian_point.h"
+#include "sadsplat/gaussians/collective.h"
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/step_profile.h"
 #include "sadsplat/io/scene.h"
@@ -33,6 +34,10 @@ struct TrainConfig {
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;
+  /// Training views rendered per step (and, on semantic steps, as many labelled views); the loss
+  /// is their mean. With N data-parallel ranks each rank renders this many, so N ranks with 1
+  /// view each train like one process with N views per step.
+  int views_per_step = 1;
   /// Supervise the unlabelled training views with the scene's kept pseudo-labels (written by
   /// `sadsplat pseudo-labels`; without them this does nothing). Ground truth always wins.
   bool use_pseudo_labels = true;
@@ -164,6 +169,10 @@ class Trainer {
 
   /// \brief Installs the semantic-aware drop (none by default).
   void setDropStrategy(std::shared_ptr<const DropStrategy> strategy);
+  /// \brief Trains as one rank of a data-parallel group: each rank renders its own views, the
+  /// gradients and densification statistics are summed over the ranks, so every rank keeps the
+  /// same Gaussians. Set before the first step (null: a single process).
+  void setCollective(Collective::Ptr collective);
   /// \brief Times the phases of every following step() in `profile` (null: stop timing).
   void setProfile(StepProfile::Ptr profile);
 

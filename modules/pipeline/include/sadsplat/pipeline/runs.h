@@ -37,6 +37,9 @@ struct TrainRunOptions {
   /// Time every phase of every iteration (synchronising the device at each boundary) and write
   /// the table to out/profile.md and to `progress`.
   bool profile = false;
+  /// Train as one rank of a data-parallel group (distributed::joinGroup); only rank 0 writes the
+  /// run directory, every rank resumes from its checkpoint.
+  gaussians::Collective::Ptr collective;
 };
 
 /// \brief Thrown by trainRun when `stop` was set: the checkpoint of `iteration` is written and
