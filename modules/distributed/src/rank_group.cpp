@@ -60,7 +60,10 @@ class GlooCollective : public gaussians::Collective {
     try {
       c10d::TCPStoreOptions store_options;
       store_options.port = static_cast<std::uint16_t>(env.master_port);
-      store_options.isServer = env.rank == 0;
+      // Under torchrun the agent already hosts the store at MASTER_PORT: every rank is a client.
+      const char* agent_store = std::getenv("TORCHELASTIC_USE_AGENT_STORE");
+      store_options.isServer =
+          env.rank == 0 && !(agent_store != nullptr && std::string(agent_store) == "True");
       store_options.numWorkers = static_cast<std::size_t>(env.world_size);
       store_options.waitWorkers = true;
       store_options.timeout = env.timeout;
