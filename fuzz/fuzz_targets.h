@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fuzz_support.h"
+#include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
@@ -117,6 +118,12 @@ inline void fuzz_json(const std::uint8_t* data, std::size_t size) {
   fuzz::expectOnlySadsplatErrors([&] { io::readClassesJson(path); });
   fuzz::expectOnlySadsplatErrors([&] { io::readSplitJson(path); });
   fuzz::expectOnlySadsplatErrors([&] { io::readTrainLog(path); });
+}
+
+// Fuzz target: the training configuration (train --config FILE.json, a run's config.json).
+inline void fuzz_train_config(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  fuzz::expectOnlySadsplatErrors([&] { gaussians::TrainConfig::fromJson(text, "config.json"); });
 }
 
 }  // namespace fuzz

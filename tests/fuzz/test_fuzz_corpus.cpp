@@ -23,7 +23,8 @@ const std::map<std::string, std::function<void(const std::uint8_t*, std::size_t)
     {"splat_formats", fuzz::fuzz_splat_formats},
     {"scene_cache", fuzz::fuzz_scene_cache},
     {"colmap", fuzz::fuzz_colmap},
-    {"json", fuzz::fuzz_json}};
+    {"json", fuzz::fuzz_json},
+    {"train_config", fuzz::fuzz_train_config}};
 
 TEST(FuzzCorpus, EveryCommittedInputGivesSuccessOrOneSadsplatError) {
   std::size_t inputs = 0;

@@ -270,6 +270,16 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
     EXPECT_EQ(e.field(), "lr_warp");
   }
   EXPECT_THROW(TrainConfig::fromJson("{\"iterations\": \"many\"}", "cfg.json"), Error);
+  // Numbers outside their field's type, a fraction for a count, a short colour: errors naming the
+  // key (they were converted with undefined behaviour, or were internal errors).
+  for (const char* bad :
+       {"{\"iterations\": 1e300}", "{\"iterations\": 2147483648}", "{\"seed\": -1}",
+        "{\"densify_from\": 2.5}", "{\"background\": [1, 2]}", "{\"background\": [1, 2, null]}"}) {
+    EXPECT_THROW(TrainConfig::fromJson(bad, "cfg.json"), Error) << bad;
+  }
+  EXPECT_EQ(TrainConfig::fromJson("{\"seed\": 18446744073709551615}", "c").seed,
+            18446744073709551615ull);
+  EXPECT_EQ(TrainConfig::fromJson("{\"iterations\": 3.0}", "c").iterations, 3);
   TrainConfig c;
   c.iterations = 123;
   c.background = {0.5f, 0.25f, 1.f};

@@ -2,7 +2,6 @@
 
 #include <ATen/CPUGeneratorImpl.h>
 #include <c10/core/GradMode.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -51,114 +50,6 @@ at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
   // where() (not a multiplication by the mask) so unsupervised pixels get exactly zero gradient.
   const at::Tensor per_pixel = at::where(supervised, 1 - cosine, at::zeros_like(cosine));
   return per_pixel.sum() / supervised.sum().clamp_min(1).to(per_pixel.scalar_type());
-}
-
-std::string TrainConfig::toJson() const {
-  nlohmann::json j = {{"iterations", iterations},
-                      {"feature_dim", feature_dim},
-                      {"max_sh_degree", max_sh_degree},
-                      {"sh_increase_interval", sh_increase_interval},
-                      {"lambda_ssim", lambda_ssim},
-                      {"lambda_rgb", lambda_rgb},
-                      {"lambda_semantic", lambda_semantic},
-                      {"semantic_interval", semantic_interval},
-                      {"views_per_step", views_per_step},
-                      {"use_pseudo_labels", use_pseudo_labels},
-                      {"lambda_pseudo", lambda_pseudo},
-                      {"pseudo_labels_train_decoder", pseudo_labels_train_decoder},
-                      {"lr_position_init", lr_position_init},
-                      {"lr_position_final", lr_position_final},
-                      {"lr_sh_dc", lr_sh_dc},
-                      {"lr_sh_rest", lr_sh_rest},
-                      {"lr_opacity", lr_opacity},
-                      {"lr_scaling", lr_scaling},
-                      {"lr_rotation", lr_rotation},
-                      {"lr_feature", lr_feature},
-                      {"lr_decoder", lr_decoder},
-                      {"densify_from", densify_from},
-                      {"densify_until", densify_until},
-                      {"densify_interval", densify_interval},
-                      {"densify_grad_threshold", densify_grad_threshold},
-                      {"percent_dense", percent_dense},
-                      {"min_opacity", min_opacity},
-                      {"opacity_reset_interval", opacity_reset_interval},
-                      {"max_screen_radius", max_screen_radius},
-                      {"checkpoint_interval", checkpoint_interval},
-                      {"seed", seed},
-                      {"background", {background[0], background[1], background[2]}},
-                      {"device", device},
-                      {"max_gaussians", max_gaussians},
-                      {"drop", drop},
-                      {"p_base", p_base},
-                      {"drop_interval", drop_interval},
-                      {"lambda_l0", lambda_l0},
-                      {"lr_log_alpha", lr_log_alpha},
-                      {"log_alpha_init", log_alpha_init}};
-  return j.dump(2) + "\n";
-}
-
-TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& origin) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for 1e99999
-    throw Error(origin, "JSON syntax", "valid JSON", e.what());
-  }
-  if (!j.is_object()) throw Error(origin, "top level", "a JSON object", j.type_name());
-  TrainConfig c;
-  nlohmann::json defaults = nlohmann::json::parse(c.toJson());
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!defaults.contains(it.key()))
-      throw Error(origin, it.key(), "a known configuration key", "unknown");
-    if (it.value().type() != defaults[it.key()].type() &&
-        !(it.value().is_number() && defaults[it.key()].is_number())) {
-      throw Error(origin, it.key(), std::string("a ") + defaults[it.key()].type_name(),
-                  it.value().type_name());
-    }
-    defaults[it.key()] = it.value();
-  }
-  const auto& d = defaults;
-  c.iterations = d["iterations"];
-  c.feature_dim = d["feature_dim"];
-  c.max_sh_degree = d["max_sh_degree"];
-  c.sh_increase_interval = d["sh_increase_interval"];
-  c.lambda_ssim = d["lambda_ssim"];
-  c.lambda_rgb = d["lambda_rgb"];
-  c.lambda_semantic = d["lambda_semantic"];
-  c.semantic_interval = d["semantic_interval"];
-  c.views_per_step = d["views_per_step"];
-  c.use_pseudo_labels = d["use_pseudo_labels"];
-  c.lambda_pseudo = d["lambda_pseudo"];
-  c.pseudo_labels_train_decoder = d["pseudo_labels_train_decoder"];
-  c.lr_position_init = d["lr_position_init"];
-  c.lr_position_final = d["lr_position_final"];
-  c.lr_sh_dc = d["lr_sh_dc"];
-  c.lr_sh_rest = d["lr_sh_rest"];
-  c.lr_opacity = d["lr_opacity"];
-  c.lr_scaling = d["lr_scaling"];
-  c.lr_rotation = d["lr_rotation"];
-  c.lr_feature = d["lr_feature"];
-  c.lr_decoder = d["lr_decoder"];
-  c.densify_from = d["densify_from"];
-  c.densify_until = d["densify_until"];
-  c.densify_interval = d["densify_interval"];
-  c.densify_grad_threshold = d["densify_grad_threshold"];
-  c.percent_dense = d["percent_dense"];
-  c.min_opacity = d["min_opacity"];
-  c.opacity_reset_interval = d["opacity_reset_interval"];
-  c.max_screen_radius = d["max_screen_radius"];
-  c.checkpoint_interval = d["checkpoint_interval"];
-  c.seed = d["seed"];
-  for (int k = 0; k < 3; ++k) c.background[k] = d["background"][k];
-  c.device = d["device"];
-  c.max_gaussians = d["max_gaussians"];
-  c.drop = d["drop"];
-  c.p_base = d["p_base"];
-  c.drop_interval = d["drop_interval"];
-  c.lambda_l0 = d["lambda_l0"];
-  c.lr_log_alpha = d["lr_log_alpha"];
-  c.log_alpha_init = d["log_alpha_init"];
-  return c;
 }
 
 struct Trainer::State {

@@ -17,75 +17,11 @@
 #include "sadsplat/gaussians/collective.h"
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/scene.h"
 
 namespace sadsplat {
 namespace gaussians {
-
-/// \brief Every training parameter, with the defaults of the paper / 3DGS.
-struct TrainConfig {
-  int iterations = 7000;  ///< paper: 7000
-  int feature_dim = 32;   ///< paper: semantic dimension 32
-  int max_sh_degree = 3;
-  int sh_increase_interval = 1000;
-  double lambda_ssim = 0.2;  ///< paper: lambda_SSIM = 0.2
-  double lambda_rgb = 1.0;
-  double lambda_semantic = 1.0;
-  /// Every this many iterations a labelled view is rendered as well, for the semantic loss
-  /// (only 3 of ~63 training views carry labels). 1 = every iteration.
-  int semantic_interval = 2;
-  /// Training views rendered per step (and, on semantic steps, as many labelled views); the loss
-  /// is their mean. With N data-parallel ranks each rank renders this many, so N ranks with 1
-  /// view each train like one process with N views per step.
-  int views_per_step = 1;
-  /// Supervise the unlabelled training views with the scene's kept pseudo-labels (written by
-  /// `sadsplat pseudo-labels`; without them this does nothing). Ground truth always wins.
-  bool use_pseudo_labels = true;
-  double lambda_pseudo = 1.0;  ///< weight of the semantic loss on pseudo-labelled views
-  /// Whether the semantic loss of pseudo-labelled views also trains the decoder (paper: yes).
-  /// false: pseudo-labels only move the Gaussians' features and the decoder (the class embedding
-  /// space) learns from ground truth alone, so the class mix of the kept pseudo-labels (mostly the
-  /// easy classes) cannot shift the decoder's class prior.
-  bool pseudo_labels_train_decoder = true;
-  double lr_position_init = 1.6e-4;   ///< times the scene extent
-  double lr_position_final = 1.6e-6;  ///< times the scene extent
-  double lr_sh_dc = 2.5e-3;
-  double lr_sh_rest = 2.5e-3 / 20;
-  double lr_opacity = 0.05;
-  double lr_scaling = 5e-3;
-  double lr_rotation = 1e-3;
-  double lr_feature = 2.5e-3;
-  double lr_decoder = 1e-3;
-  int densify_from = 500;
-  int densify_until = -1;  ///< -1: half of the iterations
-  int densify_interval = 100;
-  double densify_grad_threshold = 2e-4;  ///< on the NDC-space gradient, as in 3DGS
-  double percent_dense = 0.01;
-  double min_opacity = 0.005;
-  int opacity_reset_interval = 3000;
-  int max_screen_radius = 20;
-  int checkpoint_interval = 1000;  ///< 0 = none
-  std::uint64_t seed = 42;
-  std::array<float, 3> background{0, 0, 0};
-  std::string device = "cpu";   ///< "cpu" or "cuda"
-  int max_gaussians = 3000000;  ///< densification stops growing past this
-  // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
-  // strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
-  std::string drop = "none";  ///< none | semantic | structure | full
-  double p_base = 1.0;        ///< paper: P_base = 1.0
-  int drop_interval = 500;    ///< paper: every N = 500 iterations
-  /// Weight of L_L0. 0.2 was chosen on city seed 1 (0.1 / 0.2 / 0.4) for >= 5x fewer Gaussians
-  /// at equal mIoU; it costs ~3 dB PSNR against no drop (0.1: ~1.7 dB, ~4x fewer). See README.
-  double lambda_l0 = 0.2;
-  double lr_log_alpha = 0.01;
-  double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
-
-  /// \brief The configuration as JSON text.
-  std::string toJson() const;
-  /// \brief Reads a JSON object; keys not given keep their defaults; unknown keys are errors.
-  /// \throws sadsplat::Error naming `origin` and the key
-  static TrainConfig fromJson(const std::string& text, const std::string& origin);
-};
 
 /// \brief The semantic loss of the paper ("Training Loss"): 1 - cosine similarity between the
 /// decoded feature (linear layer W, b) and the one-hot embedding of the pixel's class, averaged
