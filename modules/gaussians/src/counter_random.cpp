@@ -2,15 +2,15 @@
 
 namespace sadsplat {
 namespace gaussians {
-namespace {
 
-// splitmix64's finaliser, on the host, for the per-draw key.
-std::uint64_t mix64(std::uint64_t x) {
+std::uint64_t mixBits(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ull;
   x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
   x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
   return x ^ (x >> 31);
 }
+
+namespace {
 
 // A 32-bit integer hash as int64 tensor operations that never overflow (shifts of
 // non-negative values are logical): values stay below
@@ -28,7 +28,7 @@ at::Tensor hash32(at::Tensor x) {
 
 at::Tensor counterUniform(std::int64_t n, std::uint64_t seed, std::uint64_t purpose,
                           std::uint64_t iteration, const at::TensorOptions& options) {
-  const std::uint64_t key = mix64(seed ^ mix64(purpose ^ mix64(iteration)));
+  const std::uint64_t key = mixBits(seed ^ mixBits(purpose ^ mixBits(iteration)));
   const std::int64_t low = static_cast<std::int64_t>(key & 0xFFFFFFFFull);
   const std::int64_t high = static_cast<std::int64_t>(key >> 32);
   const at::Tensor index = at::arange(n, options.dtype(at::kLong));

@@ -9,6 +9,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/adam.h"
+#include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -17,13 +18,6 @@
 namespace sadsplat {
 namespace gaussians {
 namespace {
-
-std::uint64_t mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
 
 // One optimised tensor with its Adam moments (per-row tensors are resized by densification).
 struct Param {
@@ -38,7 +32,7 @@ double logit(double p) { return std::log(p / (1 - p)); }
 }  // namespace
 
 at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
-  return at::detail::createCPUGenerator(mix(seed ^ mix(purpose ^ mix(iteration))));
+  return at::detail::createCPUGenerator(mixBits(seed ^ mixBits(purpose ^ mixBits(iteration))));
 }
 
 at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
@@ -404,7 +398,8 @@ StepStats Trainer::step() {
     std::vector<int> order(n);
     std::iota(order.begin(), order.end(), 0);
     std::vector<std::uint64_t> keys(n);
-    for (int i = 0; i < n; ++i) keys[i] = mix(c.seed ^ mix(purpose ^ mix(epoch * 1000003ull + i)));
+    for (int i = 0; i < n; ++i)
+      keys[i] = mixBits(c.seed ^ mixBits(purpose ^ mixBits(epoch * 1000003ull + i)));
     std::sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
     return views[order[pos]];
   };
