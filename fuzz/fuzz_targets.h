@@ -9,12 +9,14 @@
 #include <vector>
 
 #include "fuzz_support.h"
+#include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene.h"
 #include "sadsplat/io/scene_cache.h"
+#include "sadsplat/io/scene_import.h"
 #include "sadsplat/io/semantic_ply.h"
 #include "sadsplat/io/splat_formats.h"
 #include "sadsplat/io/train_log.h"
@@ -125,6 +127,29 @@ inline void fuzz_train_config(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   fuzz::expectOnlySadsplatErrors([&] { gaussians::TrainConfig::fromJson(text, "config.json"); });
 }
+
+// Fuzz target: the training checkpoint (checkpoint.bin, read by --resume and eval).
+inline void fuzz_checkpoint(const std::uint8_t* data, std::size_t size) {
+  const std::string path = fuzz::inputFile("checkpoint.bin");
+  fuzz::writeInput(path, data, size);
+  fuzz::expectOnlySadsplatErrors([&] { gaussians::readTensorArchive(path); });
+}
+
+#if SADSPLAT_HAVE_OPENCV
+// Fuzz target: a label map PNG, imported with a scene (`sadsplat import`, `train SCENE_DIR`): the
+// fixture scene is copied once, the input replaces its first label map.
+inline void fuzz_label_png(const std::uint8_t* data, std::size_t size) {
+  static const std::string scene = [] {
+    const std::string dir = fuzz::inputFile("scene");
+    std::filesystem::remove_all(dir);
+    std::filesystem::copy(std::string(SADSPLAT_SOURCE_DIR) + "/data/tiny_scene", dir,
+                          std::filesystem::copy_options::recursive);
+    return dir;
+  }();
+  fuzz::writeInput(scene + "/labels/view_000.png", data, size);
+  fuzz::expectOnlySadsplatErrors([&] { io::importScene(scene, io::ImportOptions()); });
+}
+#endif
 
 }  // namespace fuzz
 }  // namespace sadsplat

@@ -24,7 +24,12 @@ const std::map<std::string, std::function<void(const std::uint8_t*, std::size_t)
     {"scene_cache", fuzz::fuzz_scene_cache},
     {"colmap", fuzz::fuzz_colmap},
     {"json", fuzz::fuzz_json},
-    {"train_config", fuzz::fuzz_train_config}};
+    {"train_config", fuzz::fuzz_train_config},
+    {"checkpoint", fuzz::fuzz_checkpoint},
+#if SADSPLAT_HAVE_OPENCV
+    {"label_png", fuzz::fuzz_label_png},
+#endif
+};
 
 TEST(FuzzCorpus, EveryCommittedInputGivesSuccessOrOneSadsplatError) {
   std::size_t inputs = 0;

@@ -29,9 +29,10 @@ class Reader {
     if (n > bytes_.size() - pos_) {
       throw Error(path_, field, "more data (checkpoint truncated)", "end of file");
     }
-    std::memcpy(dst, bytes_.data() + pos_, n);
+    if (n > 0) std::memcpy(dst, bytes_.data() + pos_, n);
     pos_ += n;
   }
+  std::size_t remaining() const { return bytes_.size() - pos_; }
 
  private:
   const std::string& path_;
@@ -111,11 +112,29 @@ TensorArchive readTensorArchive(const std::string& path) {
       archive.numbers[name] = r.get<double>(name);
       continue;
     }
+    if (kind != 0) {
+      throw Error(path, name + " kind", "0 (tensor) or 1 (number)", std::to_string(kind));
+    }
     const auto dtype = r.get<std::uint8_t>(name + " dtype");
     const auto ndim = r.get<std::uint32_t>(name + " ndim");
     if (dtype > 2 || ndim > 8) throw Error(path, name, "dtype 0..2 and at most 8 dimensions");
     std::vector<int64_t> sizes(ndim);
-    for (auto& s : sizes) s = r.get<std::int64_t>(name + " size");
+    // The sizes must fit the bytes left before anything is allocated.
+    const std::size_t element = dtype == 2 ? 8 : 4;
+    std::size_t bytes_needed = element;
+    for (auto& s : sizes) {
+      s = r.get<std::int64_t>(name + " size");
+      if (s < 0 || s > (std::int64_t{1} << 40)) {
+        throw Error(path, name + " size", "0 .. 2^40", std::to_string(s));
+      }
+      const auto dim = static_cast<std::size_t>(s);
+      if (dim != 0 && bytes_needed > r.remaining() / dim) {
+        throw Error(path, name + " sizes",
+                    "a tensor that fits the " + std::to_string(r.remaining()) +
+                        " bytes left (checkpoint truncated or corrupt)");
+      }
+      bytes_needed *= dim;
+    }
     const at::ScalarType type = dtype == 0 ? at::kFloat : dtype == 1 ? at::kInt : at::kLong;
     at::Tensor t = at::empty(sizes, at::TensorOptions().dtype(type));
     r.read(t.data_ptr(), static_cast<std::size_t>(t.numel() * t.element_size()), name + " data");
