@@ -162,7 +162,7 @@ struct Trainer::State {
       Param& q = s.params[k];
       const int64_t n = q.value.numel();
       if (flags[static_cast<int64_t>(k)].item<float>() > 0) {
-        q.value.mutable_grad() = flat.slice(0, offset, offset + n).view(q.value.sizes()).clone();
+        q.value.mutable_grad() = flat.slice(0, offset, offset + n).view(q.value.sizes());
       } else if (q.value.grad().defined()) {
         q.value.mutable_grad().reset();
       }
