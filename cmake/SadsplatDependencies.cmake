@@ -126,8 +126,27 @@ find_path(SADSPLAT_GLOO_INCLUDE_DIR gloo/config.h)
 find_file(SADSPLAT_TORCH_GLOO_HEADER torch/csrc/distributed/c10d/ProcessGroupGloo.hpp
           PATHS ${TORCH_INCLUDE_DIRS} NO_DEFAULT_PATH)
 set(SADSPLAT_HAVE_GLOO OFF)
-if(SADSPLAT_GLOO_INCLUDE_DIR AND SADSPLAT_TORCH_GLOO_HEADER)
+# Not in a CUDA build: the PyTorch wheels' LibTorch was built without Debian's gloo.
+if(SADSPLAT_GLOO_INCLUDE_DIR AND SADSPLAT_TORCH_GLOO_HEADER AND NOT SADSPLAT_HAVE_CUDA)
   set(SADSPLAT_HAVE_GLOO ON)
+endif()
+
+# --- Distributed training on GPUs (c10d NCCL) --------------------------------------------------
+# A CUDA LibTorch built with USE_C10D_NCCL has ProcessGroupNCCL; its header includes nccl.h, which
+# the PyTorch wheels keep in the nvidia-nccl package beside torch (site-packages/nvidia/...).
+set(SADSPLAT_HAVE_NCCL OFF)
+if(SADSPLAT_HAVE_CUDA)
+  find_file(SADSPLAT_TORCH_NCCL_HEADER torch/csrc/distributed/c10d/ProcessGroupNCCL.hpp
+            PATHS ${TORCH_INCLUDE_DIRS} NO_DEFAULT_PATH)
+  file(GLOB _sadsplat_nccl_hints "${TORCH_INSTALL_PREFIX}/../nvidia/nccl"
+       "${TORCH_INSTALL_PREFIX}/../nvidia/cu*")
+  find_path(SADSPLAT_NCCL_INCLUDE_DIR nccl.h HINTS ${_sadsplat_nccl_hints}
+            ${CUDAToolkit_INCLUDE_DIRS} PATH_SUFFIXES include)
+  find_library(SADSPLAT_NCCL_LIBRARY NAMES nccl libnccl.so.2 HINTS ${_sadsplat_nccl_hints}
+               PATH_SUFFIXES lib lib64)
+  if(SADSPLAT_TORCH_NCCL_HEADER AND SADSPLAT_NCCL_INCLUDE_DIR)
+    set(SADSPLAT_HAVE_NCCL ON)
+  endif()
 endif()
 
 # --- GoogleTest -----------------------------------------------------------------------------

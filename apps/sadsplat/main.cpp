@@ -98,8 +98,13 @@ int runSynth(const SynthArgs& a) {
   } else if (a.preset.empty() || a.preset == "full") {
     o.kind = kind;
     o.seed = a.seed;
+  } else if (a.preset == "city-xl") {
+    if (kind != synth::SceneKind::kCity) {
+      throw Error("<command line>", "--preset city-xl", "--kind city", a.kind);
+    }
+    o = synth::SynthOptions::cityXl(a.seed);
   } else {
-    throw Error("<command line>", "--preset", "demo or full", a.preset);
+    throw Error("<command line>", "--preset", "demo, full or city-xl", a.preset);
   }
   if (a.views > 0) o.views = a.views;
   if (a.width > 0) o.width = a.width;
@@ -211,8 +216,9 @@ int main(int argc, char** argv) {
   double train_scale = 0.5;
   bool train_resume = false;
   bool train_profile = false;
-  int train_nproc = 1;
+  int train_nproc = 0;
   int train_views_per_step = 0;
+  bool train_batch_schedule = false;
   train->add_option("SCENE", train_scene, "scene directory or scene cache")->required();
   train->add_option("--out", train_out, "run directory")->required();
   train->add_option("--config", train_config_file, "JSON file with TrainConfig keys");
@@ -225,13 +231,18 @@ int main(int argc, char** argv) {
   train
       ->add_option(
           "--nproc", train_nproc,
-          "data-parallel ranks on this machine (c10d Gloo; or start the ranks with "
-          "torchrun --no-python, which sets RANK / WORLD_SIZE / MASTER_ADDR / MASTER_PORT)")
+          "data-parallel ranks on this machine (c10d Gloo on CPUs, NCCL with --device cuda: "
+          "one GPU each); or start the ranks with torchrun --no-python, which sets RANK / "
+          "WORLD_SIZE / LOCAL_RANK / MASTER_ADDR / MASTER_PORT. 1: a group of one rank")
       ->check(CLI::Range(1, 256));
   train
       ->add_option("--views-per-step", train_views_per_step,
                    "training views per step and rank (1); the loss is their mean")
       ->check(CLI::Range(1, 1024));
+  train->add_flag("--batch-schedule", train_batch_schedule,
+                  "with a global batch of B = ranks x views per step > 1, take the schedule in B "
+                  "times fewer steps (iterations, densification, resets, drop) and the learning "
+                  "rates x sqrt(B): as many views seen as one view per step");
   train->add_flag("--profile", train_profile,
                   "time each phase of the iterations (waits for the GPU at every phase "
                   "boundary) and write RUN/profile.md");
@@ -344,7 +355,8 @@ int main(int argc, char** argv) {
   SynthArgs synth_args;
   synth_cmd->add_option("--kind", synth_args.kind, "city, country or port")->capture_default_str();
   synth_cmd->add_option("--seed", synth_args.seed, "scene seed")->capture_default_str();
-  synth_cmd->add_option("--preset", synth_args.preset, "demo (320x180) or full (1600x900)");
+  synth_cmd->add_option("--preset", synth_args.preset, "demo (320x180), full (1600x900) or city-xl (a city of 4x the area, "
+                                  "280 views of 1600x900)");
   synth_cmd->add_option("--views", synth_args.views, "number of views (70)");
   synth_cmd->add_option("--width", synth_args.width, "image width (1600)");
   synth_cmd->add_option("--height", synth_args.height, "image height (900)");
@@ -459,15 +471,20 @@ int main(int argc, char** argv) {
       if (train_views_per_step > 0) config.views_per_step = train_views_per_step;
       // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
       std::optional<sadsplat::distributed::LocalRanks> local_ranks;
-      if (train_nproc > 1 && std::getenv("RANK") == nullptr) {
+      if (train_nproc > 0 && std::getenv("RANK") == nullptr) {
         local_ranks.emplace(train_nproc, std::vector<std::string>(argv + 1, argv + argc));
         sadsplat::gaussians::setCpuThreads();
       }
       const auto rank_env = sadsplat::distributed::RankEnvironment::fromProcessEnvironment();
       const bool quiet_rank = rank_env && rank_env->rank != 0;
       sadsplat::pipeline::TrainRunOptions options;
-      if (rank_env && rank_env->world_size > 1) {
-        options.collective = sadsplat::distributed::joinGroup(*rank_env);
+      if (train_batch_schedule) {
+        config = config.forGlobalBatch(config.views_per_step * (rank_env ? rank_env->world_size : 1));
+      }
+      if (rank_env) {
+        // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
+        if (config.device.rfind("cuda", 0) == 0) sadsplat::distributed::bindLocalGpu(*rank_env);
+        options.collective = sadsplat::distributed::joinGroup(*rank_env, config.device);
       }
       options.scene = train_scene;
       options.out = train_out;

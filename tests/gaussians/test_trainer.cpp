@@ -290,5 +290,29 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   EXPECT_THROW(Trainer(scene_, c), Error);
 }
 
+TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRates) {
+  TrainConfig c;  // defaults: 7000 iterations, densify 500 / 100, reset 3000, drop 500
+  c.densify_until = -1;
+  c.checkpoint_interval = 0;
+  const TrainConfig b = c.forGlobalBatch(4);
+  EXPECT_EQ(b.iterations, 1750);
+  EXPECT_EQ(b.densify_from, 125);
+  EXPECT_EQ(b.densify_interval, 25);
+  EXPECT_EQ(b.opacity_reset_interval, 750);
+  EXPECT_EQ(b.sh_increase_interval, 250);
+  EXPECT_EQ(b.drop_interval, 125);
+  EXPECT_EQ(b.densify_until, -1);       // still "half of the iterations"
+  EXPECT_EQ(b.checkpoint_interval, 0);  // still none
+  EXPECT_DOUBLE_EQ(b.lr_opacity, 2 * c.lr_opacity);
+  EXPECT_DOUBLE_EQ(b.lr_position_final, 2 * c.lr_position_final);
+  EXPECT_DOUBLE_EQ(b.lr_log_alpha, 2 * c.lr_log_alpha);
+  EXPECT_EQ(b.seed, c.seed);
+  // Intervals never reach 0; one view per step is the configuration itself.
+  c.densify_interval = 3;
+  EXPECT_EQ(c.forGlobalBatch(8).densify_interval, 1);
+  EXPECT_EQ(c.forGlobalBatch(1).toJson(), c.toJson());
+  EXPECT_THROW(c.forGlobalBatch(0), Error);
+}
+
 }  // namespace
 }  // namespace sadsplat

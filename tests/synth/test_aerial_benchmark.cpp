@@ -2,6 +2,7 @@
 // written files, and the scene import of what it writes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -10,6 +11,7 @@
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/synth/aerial_benchmark.h"
 #include "sadsplat/synth/scene_writer.h"
+#include "sadsplat/synth/world.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -179,6 +181,52 @@ TEST(AerialBenchmark, BadOptionsAreClearErrors) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_EQ(e.field(), "--labelled");
+  }
+}
+
+TEST(AerialBenchmark, CityXlIsFourTilesWithTheirOwnOrbitsAndSplits) {
+  const synth::World one(synth::SceneKind::kCity, 3), xl(synth::SceneKind::kCity, 3, 2);
+  EXPECT_EQ(xl.extent(), 2 * one.extent());
+  EXPECT_GT(xl.objects().size(), 3 * one.objects().size());
+  EXPECT_THROW(synth::World(synth::SceneKind::kPort, 3, 2), Error);
+  EXPECT_THROW(synth::World(synth::SceneKind::kCity, 3, 0), Error);
+
+  const synth::SynthOptions full = synth::SynthOptions::cityXl(5);
+  EXPECT_EQ(full.views, 280);
+  ASSERT_EQ(full.labelled.size(), 12u);
+  ASSERT_EQ(full.test.size(), 28u);
+  int labelled_per_tile[4] = {0, 0, 0, 0};
+  for (int v : full.labelled) {
+    ++labelled_per_tile[v % 4];
+    EXPECT_EQ(std::count(full.test.begin(), full.test.end(), v), 0) << v;
+  }
+  for (int n : labelled_per_tile) EXPECT_EQ(n, 3);
+
+  // View i looks at the centre of tile i % 4 (+-4 m of jitter): its optical axis meets the ground
+  // there.
+  synth::SynthOptions o = full;
+  o.views = 8;
+  o.width = 48;
+  o.height = 27;
+  o.max_points = 200;
+  o.labelled = {0, 1};
+  o.test = {6, 7};
+  const synth::SynthScene scene = synth::generate(o);
+  for (int i = 0; i < o.views; ++i) {
+    const auto& q = scene.views[i].camera.qvec;
+    const auto& t = scene.views[i].camera.tvec;
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    // Rows of the world-to-camera rotation; the third is the optical axis.
+    const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                            {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+    double c[3];
+    for (int k = 0; k < 3; ++k) c[k] = -(R[0][k] * t[0] + R[1][k] * t[1] + R[2][k] * t[2]);
+    const double along = -c[2] / R[2][2];
+    const double gx = c[0] + along * R[2][0], gy = c[1] + along * R[2][1];
+    const double tx = (i % 2 == 0 ? -100 : 100), ty = ((i % 4) / 2 == 0 ? -100 : 100);
+    EXPECT_NEAR(gx, tx, 5.0) << i;
+    EXPECT_NEAR(gy, ty, 5.0) << i;
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -54,6 +55,31 @@ double real(const nlohmann::json& d, const char* key, const std::string& origin)
 }
 
 }  // namespace
+
+TrainConfig TrainConfig::forGlobalBatch(int views) const {
+  if (views < 1) throw Error("<config>", "global batch", ">= 1 views per step", std::to_string(views));
+  TrainConfig c = *this;
+  if (views == 1) return c;
+  // Counts round to the nearest step, intervals stay >= 1 (0 and -1 keep their meaning).
+  const auto steps = [views](int count) {
+    return count <= 0 ? count : std::max(1, static_cast<int>(std::lround(double(count) / views)));
+  };
+  c.iterations = steps(iterations);
+  c.sh_increase_interval = steps(sh_increase_interval);
+  c.densify_from = steps(densify_from);
+  c.densify_until = steps(densify_until);
+  c.densify_interval = steps(densify_interval);
+  c.opacity_reset_interval = steps(opacity_reset_interval);
+  c.checkpoint_interval = steps(checkpoint_interval);
+  c.drop_interval = steps(drop_interval);
+  const double lr = std::sqrt(static_cast<double>(views));
+  for (double* rate : {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest,
+                       &c.lr_opacity, &c.lr_scaling, &c.lr_rotation, &c.lr_feature,
+                       &c.lr_decoder, &c.lr_log_alpha}) {
+    *rate *= lr;
+  }
+  return c;
+}
 
 std::string TrainConfig::toJson() const {
   nlohmann::json j = {{"iterations", iterations},

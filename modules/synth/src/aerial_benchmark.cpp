@@ -34,18 +34,25 @@ struct Pose {
   Vec3 rows[3];
 };
 
+// View i orbits tile i % tiles^2 (the whole world when tiles = 1) as the j-th of its views.
 Pose orbitPose(const World& world, const SynthOptions& o, int i) {
   const std::uint64_t s = o.seed;
-  const double theta = 2 * kPi * i / o.views + 0.03 * (hash01(s, 41, i) - 0.5);
-  const double phase = 2 * kPi * hash01(s, 42), phase2 = 2 * kPi * hash01(s, 43);
+  const int tiles = world.tiles(), per_tile_count = tiles * tiles;
+  const int tile = i % per_tile_count, j = i / per_tile_count;
+  const int orbit_views = (o.views + per_tile_count - 1) / per_tile_count;
+  const double tile_extent = world.extent() / tiles;
+  const double tile_x = (2 * (tile % tiles) - tiles + 1) * tile_extent;
+  const double tile_y = (2 * (tile / tiles) - tiles + 1) * tile_extent;
+  const double theta = 2 * kPi * j / orbit_views + 0.03 * (hash01(s, 41, i) - 0.5);
+  const double phase = 2 * kPi * hash01(s, 42, tile), phase2 = 2 * kPi * hash01(s, 43, tile);
   const double pitch = (42.0 + 14.0 * std::sin(2 * theta + phase)) * kPi / 180.0;
-  const double base = 0.85 * world.extent() / std::tan(o.horizontal_fov_deg * kPi / 360.0);
+  const double base = 0.85 * tile_extent / std::tan(o.horizontal_fov_deg * kPi / 360.0);
   const double dist = base * (1.0 + 0.08 * std::sin(3 * theta + phase2));
-  const Vec3 target = {static_cast<float>(8 * (hash01(s, 44, i) - 0.5)),
-                       static_cast<float>(8 * (hash01(s, 45, i) - 0.5)), 0.f};
+  const Vec3 target = {static_cast<float>(tile_x + 8 * (hash01(s, 44, i) - 0.5)),
+                       static_cast<float>(tile_y + 8 * (hash01(s, 45, i) - 0.5)), 0.f};
   Pose p;
-  p.centre = {static_cast<float>(dist * std::cos(pitch) * std::cos(theta)),
-              static_cast<float>(dist * std::cos(pitch) * std::sin(theta)),
+  p.centre = {static_cast<float>(tile_x + dist * std::cos(pitch) * std::cos(theta)),
+              static_cast<float>(tile_y + dist * std::cos(pitch) * std::sin(theta)),
               static_cast<float>(dist * std::sin(pitch))};
   const Vec3 forward = normalize(target - p.centre);
   const Vec3 right = normalize(cross(forward, {0, 0, 1}));
@@ -341,6 +348,24 @@ SynthOptions SynthOptions::demo(SceneKind kind, std::uint64_t seed) {
   return o;
 }
 
+SynthOptions SynthOptions::cityXl(std::uint64_t seed) {
+  SynthOptions o;
+  o.kind = SceneKind::kCity;
+  o.seed = seed;
+  o.tiles = 2;
+  o.views = 280;
+  o.max_points = 80000;
+  // The ordinary split on every tile: view i belongs to tile i % 4 as its (i / 4)-th view.
+  const std::vector<int> labelled = o.labelled, test = o.test;
+  o.labelled.clear();
+  o.test.clear();
+  for (int tile = 0; tile < 4; ++tile) {
+    for (int j : labelled) o.labelled.push_back(4 * j + tile);
+    for (int j : test) o.test.push_back(4 * j + tile);
+  }
+  return o;
+}
+
 SynthScene generate(const SynthOptions& o) {
   if (o.views < 2 || o.width < 16 || o.height < 16) {
     throw Error("<synth>", "views/width/height", "at least 2 views of at least 16x16 pixels",
@@ -354,7 +379,7 @@ SynthScene generate(const SynthOptions& o) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  const World world(o.kind, o.seed);
+  const World world(o.kind, o.seed, o.tiles);
   SynthScene scene;
   scene.classes = world.classes();
   const double sun_azimuth = 2 * kPi * hash01(o.seed, 51),

@@ -85,7 +85,11 @@ SceneKind parseSceneKind(const std::string& name) {
   throw Error("<synth>", "--kind", "city, country or port", name);
 }
 
-World::World(SceneKind kind, std::uint64_t seed) : kind_(kind), seed_(seed) {
+World::World(SceneKind kind, std::uint64_t seed, int tiles)
+    : kind_(kind), seed_(seed), tiles_(tiles) {
+  if (tiles < 1 || tiles > 8 || (tiles > 1 && kind != SceneKind::kCity)) {
+    throw Error("<synth>", "tiles", "1 (any kind) or 2..8 (city)", std::to_string(tiles));
+  }
   switch (kind) {
     case SceneKind::kCity:
       buildCity();
@@ -147,13 +151,15 @@ void World::buildCity() {
               {"grass", {152, 251, 152}, "grass or a lawn"},
               {"car", {0, 0, 142}, "a car"},
               {"paved", {190, 153, 153}, "paved ground, a sidewalk or a plaza"}};
-  extent_ = 100.f;
+  extent_ = 100.f * tiles_;
   block_ = 40.f;
   road_half_ = 4.f;
   Rng rng(seed_ * 7919 + 1);
   const float inner = block_ / 2 - road_half_ - 3.f;  // half-size of a block's lot area
-  for (int bx = -2; bx <= 2; ++bx) {
-    for (int by = -2; by <= 2; ++by) {
+  // Blocks that do not fit the area draw nothing from rng: tiles = 1 is the scene of old.
+  const int blocks = static_cast<int>(std::ceil(extent_ / block_));
+  for (int bx = -blocks; bx < blocks; ++bx) {
+    for (int by = -blocks; by < blocks; ++by) {
       const float cx = (bx + 0.5f) * block_, cy = (by + 0.5f) * block_;
       if (std::fabs(cx) + block_ / 2 > extent_ + 1 || std::fabs(cy) + block_ / 2 > extent_ + 1)
         continue;
@@ -206,7 +212,8 @@ void World::buildCity() {
     }
   }
   // Street trees on the sidewalks (their crowns overhang the roads) and cars on the roads.
-  for (int k = -2; k <= 2; ++k) {
+  const int lines = static_cast<int>(std::floor(extent_ / block_));
+  for (int k = -lines; k <= lines; ++k) {
     const float line = k * block_;
     for (float s = -extent_ + 3; s < extent_ - 3; s += rng.uniform(7.f, 12.f)) {
       if (distanceToGrid(s, block_) < road_half_ + 4) continue;

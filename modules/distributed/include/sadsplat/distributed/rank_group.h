@@ -1,9 +1,10 @@
 #pragma once
 /// \file rank_group.h
 /// \brief Data-parallel training over several processes on LibTorch's c10d: the ranks find
-/// each other through a c10d::TCPStore (torchrun's variables RANK, WORLD_SIZE, MASTER_ADDR,
-/// MASTER_PORT) and sum gradients with a c10d::ProcessGroupGloo (CPU tensors). Every collective
-/// has a timeout, so a rank that dies stops the others with an error instead of a hang.
+/// each other through a c10d::TCPStore (torchrun's variables RANK, WORLD_SIZE, LOCAL_RANK,
+/// MASTER_ADDR, MASTER_PORT) and sum gradients with a c10d::ProcessGroupGloo (CPU training) or a
+/// c10d::ProcessGroupNCCL (CUDA training, one GPU per rank). Every collective has a timeout, so a
+/// rank that dies stops the others with an error instead of a hang.
 
 #include <chrono>
 #include <memory>
@@ -20,6 +21,8 @@ namespace distributed {
 struct RankEnvironment {
   int rank = 0;
   int world_size = 1;
+  /// The rank on this host (LOCAL_RANK, default: rank): which GPU a CUDA rank uses.
+  int local_rank = 0;
   std::string master_addr = "127.0.0.1";
   int master_port = 29500;
   /// Longest wait for a collective or the rendezvous (SADSPLAT_DIST_TIMEOUT_S, default 120 s).
@@ -31,14 +34,21 @@ struct RankEnvironment {
   static std::optional<RankEnvironment> fromProcessEnvironment();
 };
 
-/// \brief Whether this build has a process-group backend (Gloo: LibTorch with c10d + gloo's
-/// headers at build time).
-bool haveDistributedBackend();
+/// \brief Whether this build can train on `device` ("cpu": c10d Gloo, LibTorch with gloo's headers
+/// at build time; "cuda": c10d NCCL, a CUDA LibTorch built with it).
+bool haveDistributedBackend(const std::string& device);
+
+/// \brief Gives this rank its own GPU: narrows CUDA_VISIBLE_DEVICES to the local rank's entry
+/// (or sets it to the local rank), so that the rank's "cuda" is that GPU. Call it before anything
+/// touches CUDA.
+/// \throws sadsplat::Error when CUDA_VISIBLE_DEVICES lists fewer GPUs than local ranks
+void bindLocalGpu(const RankEnvironment& env);
 
 /// \brief Joins the group described by `env` (rank 0 hosts the store) and returns its
-/// collectives. Blocks until every rank has joined or the timeout passes.
+/// collectives: NCCL when `device` is "cuda", Gloo for "cpu". Blocks until every rank has joined
+/// or the timeout passes.
 /// \throws sadsplat::Error when the backend is missing or the rendezvous fails
-gaussians::Collective::Ptr joinGroup(const RankEnvironment& env);
+gaussians::Collective::Ptr joinGroup(const RankEnvironment& env, const std::string& device);
 
 /// \brief Ranks 1 .. nproc-1 of a local group, started as copies of this program.
 class LocalRanks {

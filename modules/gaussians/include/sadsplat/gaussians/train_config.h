@@ -68,6 +68,14 @@ struct TrainConfig {
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
 
+  /// \brief The same training for a global batch of `views` training views per step (ranks x
+  /// views_per_step): every iteration count of the schedule (iterations, densification, opacity
+  /// reset, SH increase, drop, checkpoints) divided by `views`, so that the run sees as many
+  /// views as this one, and every learning rate times sqrt(views) (the square-root rule for
+  /// Adam that Grendel uses for batched 3DGS). views = 1 returns this configuration.
+  /// \throws sadsplat::Error when views < 1
+  TrainConfig forGlobalBatch(int views) const;
+
   /// \brief The configuration as JSON text.
   std::string toJson() const;
   /// \brief Reads a JSON object; keys not given keep their defaults; unknown keys are errors.

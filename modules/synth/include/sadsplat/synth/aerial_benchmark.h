@@ -27,9 +27,16 @@ struct SynthOptions {
   int max_points = 20000;    ///< sparse points kept (a few thousand to tens of thousands)
   int samples_per_axis = 2;  ///< colour anti-aliasing: s x s rays per pixel (labels, depth: 1)
   int threads = 0;           ///< 0 = all hardware threads
+  /// The world is tiles x tiles ordinary scenes in area (city only); view i orbits tile
+  /// i % tiles^2 at the ordinary scene's distance, so each tile gets views / tiles^2 views.
+  int tiles = 1;
 
   /// \brief The `--preset demo` size: 320x180, 40 views, 4000 points.
   static SynthOptions demo(SceneKind kind, std::uint64_t seed);
+  /// \brief The `--preset city-xl` benchmark: a city of 2 x 2 tiles (4x the area), 280 views of
+  /// 1600x900 (70 per tile), 80,000 sparse points; per tile the ordinary split (3 labelled
+  /// training views, 7 test views), so 12 labelled and 28 test views in all.
+  static SynthOptions cityXl(std::uint64_t seed);
 };
 
 /// \brief One generated view.

@@ -74,12 +74,15 @@ struct GroundSample {
 /// \brief A generated world. Deterministic in (kind, seed).
 class World {
  public:
-  /// \brief Builds the layout of `kind` from `seed`.
-  World(SceneKind kind, std::uint64_t seed);
+  /// \brief Builds the layout of `kind` from `seed`; a city can be `tiles` x `tiles` times the
+  /// area (its block grid continues; tiles = 1 is the ordinary scene, unchanged).
+  /// \throws sadsplat::Error for tiles > 1 on another kind or tiles outside [1, 8]
+  World(SceneKind kind, std::uint64_t seed, int tiles = 1);
 
   SceneKind kind() const { return kind_; }
   /// \brief The labelled area is [-extent, extent]^2; outside it the ground is label 255.
   float extent() const { return extent_; }
+  int tiles() const { return tiles_; }
   float maxHeight() const { return max_height_; }
   const std::vector<ClassInfo>& classes() const { return classes_; }
   const std::vector<Object>& objects() const { return objects_; }
@@ -106,6 +109,7 @@ class World {
 
   SceneKind kind_;
   std::uint64_t seed_;
+  int tiles_ = 1;
   float extent_ = 100.f;
   float max_height_ = 1.f;
   std::vector<ClassInfo> classes_;
