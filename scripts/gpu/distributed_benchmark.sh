@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Run ON THE GPU MACHINE from the repository root (builds build-gpu/ if missing): data-parallel
+# training over NCCL ranks against one GPU, on the large city-xl scene and on the ordinary city.
+#   bash scripts/gpu/distributed_benchmark.sh [ITERATIONS=7000] [GPUS=2]
+# RUNS (env, default: all) picks among
+#   xl_1gpu        city-xl, one GPU, one view per step, ITERATIONS steps (the reference)
+#   xl_1gpu_batch  city-xl, one GPU, GPUS views per step with --batch-schedule (the same
+#                  arithmetic as GPUS ranks: ITERATIONS / GPUS steps)
+#   xl_ranks       city-xl, GPUS NCCL ranks (--nproc GPUS --batch-schedule)
+#   city_1gpu, city_ranks   the same on the 70-view city (seed 0): the overhead at small scale
+# xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
+# Method: the full drop (--drop full), no pseudo-labels; 800x450 caches made here by synth.
+# $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
+# and the metrics.
+set -euo pipefail
+iterations="${1:-7000}"
+gpus="${2:-2}"
+out="${OUT:-/tmp/sadsplat-gpu-out}"
+mkdir -p "$out"
+# NVLink multicast stays off, also in the ranks the launcher starts (they inherit this).
+export NCCL_NVLS_ENABLE=0 TORCH_SYMM_MEM_DISABLE_MULTICAST=1 NVSHMEM_DISABLE_NVLS=1
+[ -x build-gpu/bin/sadsplat ] || bash scripts/gpu/build.sh > "$out/build.log" 2>&1 || { tail -30 "$out/build.log"; exit 1; }
+export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
+bin=$PWD/build-gpu/bin/sadsplat
+work=/tmp/sadsplat-distributed
+mkdir -p "$work"
+summary="$out/summary.txt"
+echo "== $(date -u +%F) iterations $iterations, $gpus GPUs: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" | tee -a "$summary"
+
+xl="$work/city_xl_800x450.cache"
+city="$work/city_0_800x450.cache"
+[ -f "$xl" ] || "$bin" synth --kind city --preset city-xl --width 800 --height 450 --cache "$xl" > "$out/synth_xl.log" 2>&1
+[ -f "$city" ] || "$bin" synth --kind city --seed 0 --width 800 --height 450 --cache "$city" > "$out/synth_city.log" 2>&1
+
+# Peak memory.used per GPU while a command runs (nvidia-smi, every 200 ms).
+peak_memory() {
+  awk -F', ' '{ if ($2 + 0 > peak[$1]) peak[$1] = $2 + 0 } END { for (g in peak) printf "gpu%s %d MiB ", g, peak[g] }' "$1"
+}
+
+# run NAME SCENE VISIBLE_GPUS [train flags...]: one training, timed, then eval.
+run() {
+  local name=$1 scene=$2 visible=$3; shift 3
+  local dir="$work/$name"; rm -rf "$dir"
+  nvidia-smi --query-gpu=index,memory.used --format=csv,noheader,nounits -lms 200 > "$out/mem_$name.csv" 2>/dev/null &
+  local poll=$!
+  local start; start=$(date +%s%N)
+  CUDA_VISIBLE_DEVICES=$visible "$bin" train "$scene" --device cuda --drop full --out "$dir" "$@" \
+    > "$out/train_$name.log" 2>&1 || echo "$name: training FAILED (rc $?)" | tee -a "$summary"
+  local wall=$(( ($(date +%s%N) - start) / 1000000 ))
+  kill "$poll" 2>/dev/null || true; wait "$poll" 2>/dev/null || true
+  local gaussians; gaussians=$(tr '\r' '\n' < "$out/train_$name.log" | grep -o 'gaussians [0-9]*' | tail -1)
+  CUDA_VISIBLE_DEVICES=${visible%%,*} "$bin" eval "$dir" > "$out/metrics_$name.json" 2> "$out/eval_$name.log" || true
+  local miou psnr
+  miou=$(grep -o '"miou": *[0-9.]*' "$out/metrics_$name.json" | head -1 | grep -o '[0-9.]*$' || echo "?")
+  psnr=$(grep -o '"psnr": *[0-9.]*' "$out/metrics_$name.json" | head -1 | grep -o '[0-9.]*$' || echo "?")
+  echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
+}
+
+half=$(( iterations / gpus ))
+wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
+all_gpus=$(seq -s, 0 $(( gpus - 1 )))
+if [ "${PAIR:-0}" = 1 ] && [[ $wanted == *" xl_1gpu "* && $wanted == *" xl_1gpu_batch "* ]]; then
+  run xl_1gpu "$xl" 0 --iterations "$iterations" &
+  run xl_1gpu_batch "$xl" 1 --iterations "$iterations" --views-per-step "$gpus" --batch-schedule &
+  wait
+else
+  [[ $wanted == *" xl_1gpu "* ]] && run xl_1gpu "$xl" 0 --iterations "$iterations"
+  [[ $wanted == *" xl_1gpu_batch "* ]] && run xl_1gpu_batch "$xl" 0 --iterations "$iterations" --views-per-step "$gpus" --batch-schedule
+fi
+[[ $wanted == *" xl_ranks "* ]] && run xl_ranks "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --batch-schedule
+[[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
+[[ $wanted == *" city_ranks "* ]] && run city_ranks "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --batch-schedule
+echo "(batch runs take $half steps of $gpus views)" >> "$summary"
