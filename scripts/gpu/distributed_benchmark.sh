@@ -10,6 +10,7 @@
 #   city_1gpu, city_ranks   the same on the 70-view city (seed 0): the overhead at small scale
 # xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
 # Method: the full drop (--drop full), no pseudo-labels; 800x450 caches made here by synth.
+# EXTRA_FLAGS (env) go to every training, e.g. --profile (then $OUT gets profile_<run>.md).
 # $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
 # and the metrics.
 set -euo pipefail
@@ -44,10 +45,11 @@ run() {
   nvidia-smi --query-gpu=index,memory.used --format=csv,noheader,nounits -lms 200 > "$out/mem_$name.csv" 2>/dev/null &
   local poll=$!
   local start; start=$(date +%s%N)
-  CUDA_VISIBLE_DEVICES=$visible "$bin" train "$scene" --device cuda --drop full --out "$dir" "$@" \
+  CUDA_VISIBLE_DEVICES=$visible "$bin" train "$scene" --device cuda --drop full --out "$dir" "$@" ${EXTRA_FLAGS:-} \
     > "$out/train_$name.log" 2>&1 || echo "$name: training FAILED (rc $?)" | tee -a "$summary"
   local wall=$(( ($(date +%s%N) - start) / 1000000 ))
   kill "$poll" 2>/dev/null || true; wait "$poll" 2>/dev/null || true
+  [ -f "$dir/profile.md" ] && cp "$dir/profile.md" "$out/profile_$name.md"
   local gaussians; gaussians=$(tr '\r' '\n' < "$out/train_$name.log" | grep -o 'gaussians [0-9]*' | tail -1)
   CUDA_VISIBLE_DEVICES=${visible%%,*} "$bin" eval "$dir" > "$out/metrics_$name.json" 2> "$out/eval_$name.log" || true
   local miou psnr

@@ -97,18 +97,27 @@ void expectTwoRanksTrainLikeOneProcess(const std::string& device) {
   EXPECT_TRUE(io::isRegularFile(dir.file("two_ranks/train_log.jsonl")));
 }
 
-// A group of one rank (its all-reduce is the identity) trains exactly like no group.
+// A group of one rank (its all-reduce is the identity) trains like no group: exactly on the CPU;
+// on a GPU to the last bits (the CUDA backward sums with atomics: two plain runs differ as much).
 void expectAGroupOfOneTrainsLikeNoGroup(const std::string& device) {
+  const bool exact = device == "cpu";
   test::TempDir dir;
   std::string out;
   const std::string common = " train " + kCache + " --iterations 30 --device " + device;
   ASSERT_EQ(test::runCommand(kCli + common + " --nproc 1 --out " + dir.file("group"), &out), 0)
       << out;
   ASSERT_EQ(test::runCommand(kCli + common + " --out " + dir.file("plain"), &out), 0) << out;
-  EXPECT_EQ(loggedLosses(test::readFile(dir.file("group/train_log.jsonl"))),
-            loggedLosses(test::readFile(dir.file("plain/train_log.jsonl"))));
+  const auto la = loggedLosses(test::readFile(dir.file("group/train_log.jsonl")));
+  const auto lb = loggedLosses(test::readFile(dir.file("plain/train_log.jsonl")));
+  ASSERT_EQ(la.size(), lb.size());
+  ASSERT_GE(la.size(), 2u);
+  for (std::size_t k = 0; k < la.size(); ++k) {
+    if (exact) EXPECT_EQ(la[k], lb[k]) << k;
+    EXPECT_NEAR(la[k], lb[k], 1e-5 * lb[k]) << k;
+  }
   const auto d = meanDifferences(dir.file("group/model.ply"), dir.file("plain/model.ply"));
-  EXPECT_EQ(d[0] + d[1] + d[2], 0.0);
+  // Measured 2026-11-23 on an H200: 9.8e-6 summed.
+  EXPECT_LE(d[0] + d[1] + d[2], exact ? 0.0 : 1e-4);
 }
 
 TEST(Distributed, TwoRanksTrainLikeOneProcessWithTwoViewsPerStep) {
