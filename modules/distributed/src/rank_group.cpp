@@ -91,23 +91,14 @@ Error rendezvousError(const RankEnvironment& env, const std::string& what) {
 // Sums and maxima through one c10d process group (Gloo: 1.13's ProcessGroup; NCCL: 2.x's
 // Backend; both have the same allreduce). `kHostOnly`: the backend reduces CPU tensors only, so
 // a CUDA tensor goes through the host.
-// Ends a group cleanly where the backend asks for it (2.x's NCCL warns at exit otherwise).
-template <class Group>
-auto shutdownGroup(Group& group, int) -> decltype(group.shutdown(), void()) {
-  try {
-    group.shutdown();
-  } catch (const std::exception&) {  // at exit after a failure: nothing left to report
-  }
-}
-template <class Group>
-void shutdownGroup(Group&, long) {}
-
 template <class Group, bool kHostOnly>
 class ProcessGroupCollective : public gaussians::Collective {
  public:
   ProcessGroupCollective(const RankEnvironment& env, c10::intrusive_ptr<Group> group)
       : env_(env), group_(std::move(group)) {}
-  ~ProcessGroupCollective() override { shutdownGroup(*group_, 0); }
+  // No explicit shutdown(): LibTorch 2.11's NCCL shutdown at the end of a run blocked rank 1 while
+  // rank 0 waited for it to exit (the group's destructor ends it; NCCL warns that
+  // destroy_process_group() was not called, which is harmless here).
   int rank() const override { return env_.rank; }
   int size() const override { return env_.world_size; }
   void sum(at::Tensor& tensor) override { reduce(tensor, c10d::ReduceOp::SUM); }

@@ -139,33 +139,57 @@ struct Trainer::State {
     return gate.defined() ? opacity * gate : opacity;
   }
 
-  // Sums every parameter's gradient over the ranks in one flat all-reduce. A gradient no rank has
-  // stays undefined (so Adam skips that tensor as a single process would); one that only some
-  // ranks have counts as zero on the others.
-  void reduceGradients() {
-    State& s = *this;
+  // What view v trains besides the picture: the features (it has a semantic loss) and the
+  // decoder (the loss also trains it).
+  struct ViewRole {
+    bool semantic = false;
+    bool decoder_learns = false;
+  };
+  ViewRole role(int v) const {
+    ViewRole r;
+    r.semantic = labels[v].defined() && semantic_weight[v] > 0 && config.feature_dim > 0;
+    // Ground truth always trains the decoder; pseudo-labels when the configuration says so.
+    const bool ground_truth =
+        std::find(labelled_views.begin(), labelled_views.end(), v) != labelled_views.end();
+    r.decoder_learns = r.semantic && (ground_truth || config.pseudo_labels_train_decoder);
+    return r;
+  }
+
+  // Sums every parameter's gradient and the step's densification sums (`sums`, per Gaussian)
+  // over the ranks in one flat all-reduce, without a host synchronisation. Which gradients exist
+  // somewhere in the group is known on every rank from the global batch's views
+  // (`features_anywhere`, `decoder_anywhere`; the other parameters have a gradient on every rank
+  // or on none): one that no rank has stays undefined and is not sent (Adam skips that tensor as
+  // a single process would); one that only some ranks have counts as zero on the others.
+  void reduceGradients(bool features_anywhere, bool decoder_anywhere,
+                       const std::vector<at::Tensor*>& sums) {
     std::vector<at::Tensor> parts;
-    std::vector<float> present;
-    for (const Param& q : s.params) {
+    std::vector<Param*> sent;
+    for (Param& q : params) {
       const at::Tensor grad = q.value.grad();
-      present.push_back(grad.defined() ? 1.0f : 0.0f);
+      bool anywhere = grad.defined();
+      if (q.name == "features") anywhere = features_anywhere;
+      if (q.name == "decoder_w" || q.name == "decoder_b") anywhere = decoder_anywhere;
+      if (grad.defined() && !anywhere) {
+        throw std::logic_error("trainer: gradient of " + q.name + " outside the global batch");
+      }
+      if (!anywhere) continue;
       parts.push_back(grad.defined() ? grad.reshape({-1})
                                      : at::zeros({q.value.numel()}, q.value.options()));
+      sent.push_back(&q);
     }
-    parts.push_back(at::tensor(present).to(s.device));
+    for (at::Tensor* sum : sums) parts.push_back(sum->reshape({-1}));
     at::Tensor flat = at::cat(parts);
-    s.collective->sum(flat);
-    const at::Tensor flags =
-        flat.slice(0, flat.size(0) - static_cast<int64_t>(present.size())).cpu();
+    collective->sum(flat);
     int64_t offset = 0;
-    for (std::size_t k = 0; k < s.params.size(); ++k) {
-      Param& q = s.params[k];
-      const int64_t n = q.value.numel();
-      if (flags[static_cast<int64_t>(k)].item<float>() > 0) {
-        q.value.mutable_grad() = flat.slice(0, offset, offset + n).view(q.value.sizes());
-      } else if (q.value.grad().defined()) {
-        q.value.mutable_grad().reset();
-      }
+    for (Param* q : sent) {
+      const int64_t n = q->value.numel();
+      q->value.mutable_grad() = flat.slice(0, offset, offset + n).view(q->value.sizes());
+      offset += n;
+    }
+    for (at::Tensor* sum : sums) {
+      const int64_t n = sum->numel();
+      *sum = flat.slice(0, offset, offset + n).view(sum->sizes());
       offset += n;
     }
   }
@@ -411,14 +435,25 @@ StepStats Trainer::step() {
   const int batch = c.views_per_step * ranks;
   const bool semantic_step = !s.labelled_views.empty() && c.semantic_interval > 0 &&
                              c.lambda_semantic > 0 && it % c.semantic_interval == 0;
-  std::vector<int> views;
-  for (int b = 0; b < c.views_per_step; ++b) {
-    const int draw = rank * c.views_per_step + b;
+  // The views of one draw: a training view, on semantic steps also a labelled one.
+  auto drawViews = [&](int draw, std::vector<int>* views) {
     const int tv = pick(s.train_views, 1, it * batch + draw);
-    views.push_back(tv);
+    views->push_back(tv);
     if (semantic_step) {
       const int lv = pick(s.labelled_views, 2, (it / c.semantic_interval) * batch + draw);
-      if (lv != tv) views.push_back(lv);
+      if (lv != tv) views->push_back(lv);
+    }
+  };
+  std::vector<int> views;
+  for (int b = 0; b < c.views_per_step; ++b) drawViews(rank * c.views_per_step + b, &views);
+  // Which of the features' and the decoder's gradients any rank of the group has this step.
+  bool features_anywhere = false, decoder_anywhere = false;
+  if (s.collective) {
+    std::vector<int> all;
+    for (int draw = 0; draw < batch; ++draw) drawViews(draw, &all);
+    for (int v : all) {
+      features_anywhere = features_anywhere || s.role(v).semantic;
+      decoder_anywhere = decoder_anywhere || s.role(v).decoder_learns;
     }
   }
 
@@ -439,7 +474,8 @@ StepStats Trainer::step() {
   for (int v : views) {
     enterPhase(profile, "render forward");
     const at::Tensor& labels = s.labels[v];
-    const bool semantic = labels.defined() && s.semantic_weight[v] > 0 && c.feature_dim > 0;
+    const State::ViewRole role = s.role(v);
+    const bool semantic = role.semantic;
     // Training uses no depth, and features only where a semantic loss reads them.
     settings.features = semantic;
     settings.depth = false;
@@ -456,9 +492,7 @@ StepStats Trainer::step() {
     if (semantic) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
       // class-score space of the built-in backend), averaged over supervised pixels only.
-      const bool ground_truth =
-          std::find(s.labelled_views.begin(), s.labelled_views.end(), v) != s.labelled_views.end();
-      const bool decoder_learns = ground_truth || c.pseudo_labels_train_decoder;
+      const bool decoder_learns = role.decoder_learns;
       const at::Tensor& w = s.p("decoder_w").value;
       const at::Tensor& b = s.p("decoder_b").value;
       const at::Tensor sem = decoder_learns
@@ -504,12 +538,11 @@ StepStats Trainer::step() {
     }
     if (s.collective) {
       enterPhase(profile, "all-reduce");
-      s.collective->sum(grad_accum);
-      s.collective->sum(denom);
+      // This step's sums travel with the gradients; the maxima need their own reduction.
+      s.reduceGradients(features_anywhere, decoder_anywhere, {&grad_accum, &denom});
       s.collective->max(max_radii);
       s.grad_accum += grad_accum;
       s.denom += denom;
-      s.reduceGradients();
     }
     s.max_radii = max_radii;
     enterPhase(profile, "optimiser");
