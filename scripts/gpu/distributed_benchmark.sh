@@ -10,6 +10,7 @@
 #   city_1gpu, city_ranks   the same on the 70-view city (seed 0): the overhead at small scale
 # xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
 # Method: the full drop (--drop full), no pseudo-labels; 800x450 caches made here by synth.
+# VIEWS (env, default 1): views per step and rank in the batched runs (global batch GPUS x VIEWS).
 # EXTRA_FLAGS (env) go to every training, e.g. --profile (then $OUT gets profile_<run>.md).
 # $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
 # and the metrics.
@@ -58,18 +59,20 @@ run() {
   echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
 }
 
-half=$(( iterations / gpus ))
+views=${VIEWS:-1}
+batch=$(( gpus * views ))
+half=$(( iterations / batch ))
 wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
 all_gpus=$(seq -s, 0 $(( gpus - 1 )))
 if [ "${PAIR:-0}" = 1 ] && [[ $wanted == *" xl_1gpu "* && $wanted == *" xl_1gpu_batch "* ]]; then
   run xl_1gpu "$xl" 0 --iterations "$iterations" &
-  run xl_1gpu_batch "$xl" 1 --iterations "$iterations" --views-per-step "$gpus" --batch-schedule &
+  run xl_1gpu_batch "$xl" 1 --iterations "$iterations" --views-per-step "$batch" --batch-schedule &
   wait
 else
   [[ $wanted == *" xl_1gpu "* ]] && run xl_1gpu "$xl" 0 --iterations "$iterations"
-  [[ $wanted == *" xl_1gpu_batch "* ]] && run xl_1gpu_batch "$xl" 0 --iterations "$iterations" --views-per-step "$gpus" --batch-schedule
+  [[ $wanted == *" xl_1gpu_batch "* ]] && run xl_1gpu_batch "$xl" 0 --iterations "$iterations" --views-per-step "$batch" --batch-schedule
 fi
-[[ $wanted == *" xl_ranks "* ]] && run xl_ranks "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --batch-schedule
+[[ $wanted == *" xl_ranks "* ]] && run xl_ranks "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 [[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
-[[ $wanted == *" city_ranks "* ]] && run city_ranks "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --batch-schedule
-echo "(batch runs take $half steps of $gpus views)" >> "$summary"
+[[ $wanted == *" city_ranks "* ]] && run city_ranks "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
+echo "(batch runs take $half steps of $batch views)" >> "$summary"
