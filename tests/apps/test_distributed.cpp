@@ -174,6 +174,39 @@ TEST(Distributed, ARankThatDiesEndsTheJobWithAnError) {
   EXPECT_FALSE(io::pathExists(dir.file("run/model.ply")));
 }
 
+int runJsonIterations(const std::string& run) {
+  const std::string text = test::readFile(run + "/run.json");
+  std::smatch m;
+  return std::regex_search(text, m, std::regex("\"iterations\": *([0-9]+)")) ? std::stoi(m[1]) : -1;
+}
+
+// SIGINT to rank 0 alone: the ranks agree to stop after the same iteration, rank 0 writes its
+// checkpoint, all exit with 130, and --resume with two ranks goes on from there.
+TEST(Distributed, SigintStopsEveryRankAtOneCheckpointAndTheGroupResumes) {
+  if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
+  test::TempDir dir;
+  const std::string run = dir.file("run");
+  std::string out;
+  const auto start = std::chrono::steady_clock::now();
+  const int rc = test::runCommand(
+      "(" + kCli + " train " + kCache + " --nproc 2 --iterations 1000000 --out " + run +
+          " & pid=$!; for i in $(seq 100); do sleep 0.1; grep -q '\"device\"' " + run +
+          "/config.json 2>/dev/null && break; done; sleep 1; kill -INT $pid; wait $pid)",
+      &out);
+  EXPECT_EQ(rc, 130) << out;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
+  const int reached = runJsonIterations(run);
+  ASSERT_GT(reached, 0) << out;
+  EXPECT_EQ(reached % 10, 0) << "the ranks stop at an agreement iteration";
+  ASSERT_EQ(test::runCommand(kCli + " train " + kCache + " --nproc 2 --iterations " +
+                                 std::to_string(reached + 20) + " --resume --out " + run,
+                             &out),
+            0)
+      << out;
+  EXPECT_EQ(runJsonIterations(run), reached + 20);
+  EXPECT_TRUE(io::isRegularFile(run + "/model.ply"));
+}
+
 TEST(Distributed, MalformedRankVariablesAreClearErrors) {
   if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
   std::string out;

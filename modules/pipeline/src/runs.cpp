@@ -208,8 +208,23 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), seconds());
     last_checkpoint = trainer.iteration();
   };
+  // A stop request (SIGINT / SIGTERM) reaches data-parallel ranks at different moments: they
+  // agree on it every few iterations (a one-number maximum over the group), so that all stop
+  // after the same iteration, the one rank 0's checkpoint holds.
+  const int stop_agreement_interval = 10;
+  const auto stopRequested = [&] {
+    const bool here = o.stop != nullptr && o.stop->load();
+    if (!o.collective) return here;
+    if (trainer.iteration() % stop_agreement_interval != 0) return false;
+    at::Tensor flag = at::full(
+        {1}, here ? 1.f : 0.f,
+        at::TensorOptions().device(config.device == "cuda" ? at::Device(at::kCUDA, 0)
+                                                           : at::Device(at::kCPU)));
+    o.collective->max(flag);
+    return flag.item<float>() > 0;
+  };
   while (trainer.iteration() < config.iterations) {
-    if (o.stop != nullptr && o.stop->load()) {
+    if (stopRequested()) {
       checkpointNow();
       throw TrainingInterrupted(o.out, trainer.iteration());
     }
