@@ -6,6 +6,9 @@
 #include <array>
 #include <chrono>
 #include <regex>
+#include <thread>
+
+#include <unistd.h>
 
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -205,6 +208,33 @@ TEST(Distributed, SigintStopsEveryRankAtOneCheckpointAndTheGroupResumes) {
       << out;
   EXPECT_EQ(runJsonIterations(run), reached + 20);
   EXPECT_TRUE(io::isRegularFile(run + "/model.ply"));
+}
+
+// An outside launcher (torchrun's variables, set by hand here: two processes started by the
+// shell) gives the model of --nproc 2.
+TEST(Distributed, RanksStartedByAnOutsideLauncherTrainLikeNproc) {
+  if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
+  test::TempDir dir;
+  std::string out;
+  const std::string train = kCli + " train " + kCache + " --iterations 30 --out ";
+  ASSERT_EQ(test::runCommand(train + dir.file("nproc") + " --nproc 2", &out), 0) << out;
+  const std::string port = std::to_string(20000 + ::getpid() % 20000);
+  // One CPU thread per rank, as --nproc 2 gives each on 2 cores (so the float sums run in the
+  // same order; with other thread counts the models agree to rounding only).
+  const int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / 2);
+  const std::string env = "OMP_NUM_THREADS=" + std::to_string(threads) +
+                          " WORLD_SIZE=2 MASTER_ADDR=127.0.0.1 MASTER_PORT=" + port +
+                          " SADSPLAT_DIST_TIMEOUT_S=30 ";
+  ASSERT_EQ(test::runCommand("(" + env + "RANK=1 LOCAL_RANK=1 " + train + dir.file("outside") +
+                                 " > /dev/null 2>&1 & " + env + "RANK=0 LOCAL_RANK=0 " + train +
+                                 dir.file("outside") + "; rc=$?; wait $! || rc=1; exit $rc)",
+                             &out),
+            0)
+      << out;
+  EXPECT_EQ(loggedLosses(test::readFile(dir.file("outside/train_log.jsonl"))),
+            loggedLosses(test::readFile(dir.file("nproc/train_log.jsonl"))));
+  EXPECT_TRUE(test::readFile(dir.file("outside/model.ply")) ==
+              test::readFile(dir.file("nproc/model.ply")));
 }
 
 TEST(Distributed, MalformedRankVariablesAreClearErrors) {
