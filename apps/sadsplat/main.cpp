@@ -355,8 +355,9 @@ int main(int argc, char** argv) {
   SynthArgs synth_args;
   synth_cmd->add_option("--kind", synth_args.kind, "city, country or port")->capture_default_str();
   synth_cmd->add_option("--seed", synth_args.seed, "scene seed")->capture_default_str();
-  synth_cmd->add_option("--preset", synth_args.preset, "demo (320x180), full (1600x900) or city-xl (a city of 4x the area, "
-                                  "280 views of 1600x900)");
+  synth_cmd->add_option("--preset", synth_args.preset,
+                        "demo (320x180), full (1600x900) or city-xl (a city of 4x the area, "
+                        "280 views of 1600x900)");
   synth_cmd->add_option("--views", synth_args.views, "number of views (70)");
   synth_cmd->add_option("--width", synth_args.width, "image width (1600)");
   synth_cmd->add_option("--height", synth_args.height, "image height (900)");
@@ -479,7 +480,8 @@ int main(int argc, char** argv) {
       const bool quiet_rank = rank_env && rank_env->rank != 0;
       sadsplat::pipeline::TrainRunOptions options;
       if (train_batch_schedule) {
-        config = config.forGlobalBatch(config.views_per_step * (rank_env ? rank_env->world_size : 1));
+        config =
+            config.forGlobalBatch(config.views_per_step * (rank_env ? rank_env->world_size : 1));
       }
       if (rank_env) {
         // Every rank of a group, also a group of one (its all-reduce then costs what it costs).

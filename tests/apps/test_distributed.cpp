@@ -147,11 +147,11 @@ TEST(Distributed, BatchScheduleTakesTheSameViewsInFewerSteps) {
   if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
   test::TempDir dir;
   std::string out;
-  ASSERT_EQ(test::runCommand(kCli + " train " + kCache +
-                                 " --iterations 40 --nproc 2 --batch-schedule --out " +
-                                 dir.file("run"),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::runCommand(kCli + " train " + kCache +
+                           " --iterations 40 --nproc 2 --batch-schedule --out " + dir.file("run"),
+                       &out),
+      0)
       << out;
   const std::string config = test::readFile(dir.file("run/config.json"));
   EXPECT_TRUE(std::regex_search(config, std::regex("\"iterations\": *20,"))) << config;

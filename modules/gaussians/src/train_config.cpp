@@ -57,7 +57,8 @@ double real(const nlohmann::json& d, const char* key, const std::string& origin)
 }  // namespace
 
 TrainConfig TrainConfig::forGlobalBatch(int views) const {
-  if (views < 1) throw Error("<config>", "global batch", ">= 1 views per step", std::to_string(views));
+  if (views < 1)
+    throw Error("<config>", "global batch", ">= 1 views per step", std::to_string(views));
   TrainConfig c = *this;
   if (views == 1) return c;
   // Counts round to the nearest step, intervals stay >= 1 (0 and -1 keep their meaning).
@@ -73,9 +74,9 @@ TrainConfig TrainConfig::forGlobalBatch(int views) const {
   c.checkpoint_interval = steps(checkpoint_interval);
   c.drop_interval = steps(drop_interval);
   const double lr = std::sqrt(static_cast<double>(views));
-  for (double* rate : {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest,
-                       &c.lr_opacity, &c.lr_scaling, &c.lr_rotation, &c.lr_feature,
-                       &c.lr_decoder, &c.lr_log_alpha}) {
+  for (double* rate :
+       {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest, &c.lr_opacity,
+        &c.lr_scaling, &c.lr_rotation, &c.lr_feature, &c.lr_decoder, &c.lr_log_alpha}) {
     *rate *= lr;
   }
   return c;

@@ -216,10 +216,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     const bool here = o.stop != nullptr && o.stop->load();
     if (!o.collective) return here;
     if (trainer.iteration() % stop_agreement_interval != 0) return false;
-    at::Tensor flag = at::full(
-        {1}, here ? 1.f : 0.f,
-        at::TensorOptions().device(config.device == "cuda" ? at::Device(at::kCUDA, 0)
-                                                           : at::Device(at::kCPU)));
+    at::Tensor flag =
+        at::full({1}, here ? 1.f : 0.f,
+                 at::TensorOptions().device(config.device == "cuda" ? at::Device(at::kCUDA, 0)
+                                                                    : at::Device(at::kCPU)));
     o.collective->max(flag);
     return flag.item<float>() > 0;
   };
