@@ -219,6 +219,7 @@ int main(int argc, char** argv) {
   int train_nproc = 0;
   int train_views_per_step = 0;
   bool train_batch_schedule = false;
+  bool train_prune_floaters = false;
   train->add_option("SCENE", train_scene, "scene directory or scene cache")->required();
   train->add_option("--out", train_out, "run directory")->required();
   train->add_option("--config", train_config_file, "JSON file with TrainConfig keys");
@@ -243,6 +244,10 @@ int main(int argc, char** argv) {
                   "with a global batch of B = ranks x views per step > 1, take the schedule in B "
                   "times fewer steps (iterations, densification, resets, drop) and the learning "
                   "rates x sqrt(B): as many views seen as one view per step");
+  train->add_flag("--prune-floaters", train_prune_floaters,
+                  "after the last iteration remove Gaussians seen by fewer than 2 training views "
+                  "or larger than 0.1 x the scene extent (config: floater_min_views, "
+                  "floater_max_scale)");
   train->add_flag("--profile", train_profile,
                   "time each phase of the iterations (waits for the GPU at every phase "
                   "boundary) and write RUN/profile.md");
@@ -470,6 +475,7 @@ int main(int argc, char** argv) {
       if (train_p_base >= 0) config.p_base = train_p_base;
       if (train_lambda_l0 >= 0) config.lambda_l0 = train_lambda_l0;
       if (train_views_per_step > 0) config.views_per_step = train_views_per_step;
+      if (train_prune_floaters) config.prune_floaters = true;
       // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
       std::optional<sadsplat::distributed::LocalRanks> local_ranks;
       if (train_nproc > 0 && std::getenv("RANK") == nullptr) {

@@ -4,6 +4,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/image_metrics.h"
+#include "sadsplat/gaussians/view_coverage.h"
 #include "sadsplat/io/atomic_file.h"
 
 #if SADSPLAT_HAVE_OPENCV
@@ -60,9 +61,29 @@ void writePanel(const std::string& path, const io::View& view, const at::Tensor&
 
 }  // namespace
 
+FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& scene) {
+  std::vector<gaussians::RasterCamera> all, training;
+  for (const io::View& v : scene.views) {
+    all.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+    if (v.train) training.push_back(all.back());
+  }
+  const gaussians::GaussianParams g = trainer.parameters();
+  FloaterCensus census;
+  census.extent = gaussians::sceneExtent(all);
+  const auto count = [](const at::Tensor& mask) { return mask.sum().item<std::int64_t>(); };
+  census.larger_than_2pct =
+      count(gaussians::floaterMask(g.means, g.log_scales, training, 0, 0.02 * census.extent));
+  census.larger_than_10pct =
+      count(gaussians::floaterMask(g.means, g.log_scales, training, 0, 0.1 * census.extent));
+  census.seen_by_under_2_views =
+      count(gaussians::floaterMask(g.means, g.log_scales, training, 2, 0));
+  return census;
+}
+
 EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                     const std::string& panel_dir) {
   EvalResult result;
+  result.floaters = countFloaters(trainer, scene);
   result.confusion = ConfusionMatrix(static_cast<int>(scene.classes.size()));
   bool any_test = false;
   for (const auto& v : scene.views) any_test = any_test || v.test;
@@ -126,6 +147,12 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
                             {"psnr", r.psnr},
                             {"ssim", r.ssim},
                             {"num_gaussians", facts.num_gaussians},
+                            {"floaters",
+                             {{"scene_extent", r.floaters.extent},
+                              {"larger_than_2pct_extent", r.floaters.larger_than_2pct},
+                              {"larger_than_10pct_extent", r.floaters.larger_than_10pct},
+                              {"seen_by_under_2_training_views",
+                               r.floaters.seen_by_under_2_views}}},
                             {"iterations", facts.iterations},
                             {"train_seconds", facts.train_seconds},
                             {"device", facts.device},

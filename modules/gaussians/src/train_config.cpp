@@ -92,6 +92,9 @@ std::string TrainConfig::toJson() const {
                       {"lambda_semantic", lambda_semantic},
                       {"semantic_interval", semantic_interval},
                       {"views_per_step", views_per_step},
+                      {"prune_floaters", prune_floaters},
+                      {"floater_min_views", floater_min_views},
+                      {"floater_max_scale", floater_max_scale},
                       {"use_pseudo_labels", use_pseudo_labels},
                       {"lambda_pseudo", lambda_pseudo},
                       {"pseudo_labels_train_decoder", pseudo_labels_train_decoder},
@@ -156,6 +159,9 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.lambda_semantic = real(d, "lambda_semantic", origin);
   c.semantic_interval = integer<int>(d, "semantic_interval", origin);
   c.views_per_step = integer<int>(d, "views_per_step", origin);
+  c.prune_floaters = d["prune_floaters"].get<bool>();
+  c.floater_min_views = integer<int>(d, "floater_min_views", origin);
+  c.floater_max_scale = real(d, "floater_max_scale", origin);
   c.use_pseudo_labels = d["use_pseudo_labels"];
   c.lambda_pseudo = real(d, "lambda_pseudo", origin);
   c.pseudo_labels_train_decoder = d["pseudo_labels_train_decoder"];

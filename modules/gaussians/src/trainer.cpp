@@ -1,4 +1,5 @@
 #include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/gaussians/view_coverage.h"
 
 #include <ATen/CPUGeneratorImpl.h>
 #include <c10/core/GradMode.h>
@@ -278,11 +279,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   if (s.num_classes < 1) throw Error(scene.source, "classes", "at least one class");
 
   // Views: images, masks, labels on the device; cameras; scene extent from the camera centres.
-  std::vector<std::array<double, 3>> centres;
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
     const io::View& v = scene.views[i];
     s.cameras.push_back(RasterCamera::fromPinhole(v.camera));
-    centres.push_back(s.cameras.back().centre());
     if (!v.train) {
       s.images.emplace_back();
       s.masks.emplace_back();
@@ -335,16 +334,7 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
     s.train_views.push_back(static_cast<int>(i));
   }
   if (s.train_views.empty()) throw Error(scene.source, "split", "at least one training view");
-  std::array<double, 3> mean{0, 0, 0};
-  for (const auto& c : centres) {
-    for (int k = 0; k < 3; ++k) mean[k] += c[k] / centres.size();
-  }
-  double radius = 0;
-  for (const auto& c : centres) {
-    radius = std::max(radius, std::sqrt(std::pow(c[0] - mean[0], 2) + std::pow(c[1] - mean[1], 2) +
-                                        std::pow(c[2] - mean[2], 2)));
-  }
-  s.extent = std::max(1e-3, 1.1 * radius);
+  s.extent = sceneExtent(s.cameras);
 
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
   InitOptions init;
@@ -469,7 +459,7 @@ StepStats Trainer::step() {
     sum = sum.defined() ? sum + value.detach() : value.detach();
   };
   std::vector<RenderResult> renders;
-  std::int64_t dropped = 0, closed_at_end = 0;
+  std::int64_t dropped = 0, closed_at_end = 0, floaters_at_end = 0;
   DropDecision decision;
   for (int v : views) {
     enterPhase(profile, "render forward");
@@ -583,6 +573,17 @@ StepStats Trainer::step() {
         closed_at_end = s.n() - open.sum().item<std::int64_t>();
         if (closed_at_end > 0) s.resize(open, {});
       }
+      if (c.prune_floaters) {
+        // Floaters: seen by too few training views, or far larger than the scene's detail.
+        std::vector<RasterCamera> training;
+        for (int v : s.train_views) training.push_back(s.cameras[v]);
+        const at::Tensor keep = floaterMask(s.p("means").value, s.p("scales").value, training,
+                                            c.floater_min_views,
+                                            c.floater_max_scale * s.extent)
+                                    .logical_not();
+        floaters_at_end = s.n() - keep.sum().item<std::int64_t>();
+        if (floaters_at_end > 0) s.resize(keep, {});
+      }
     }
     enterPhase(profile, "densify, prune, reset");
     if (done <= c.densify_until) {
@@ -616,6 +617,7 @@ StepStats Trainer::step() {
   stats.num_gaussians = s.n();
   stats.dropped = dropped;
   stats.removed_closed_gates = closed_at_end;
+  stats.removed_floaters = floaters_at_end;
   stats.drop = decision;
   stats.pseudo_labelled_views = s.pseudo_labelled_views;
   return stats;

@@ -264,6 +264,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   << " Gaussians with a closed gate (they render nothing), " << stats.num_gaussians
                   << " left\n";
     }
+    if (stats.removed_floaters > 0 && o.progress) {
+      *o.progress << "\n[floaters] end of training: removed " << stats.removed_floaters
+                  << " Gaussians seen by fewer than " << config.floater_min_views
+                  << " training views or larger than " << config.floater_max_scale
+                  << " x the scene extent, " << stats.num_gaussians << " left\n";
+    }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = (it - first) / std::max(1e-9, elapsed);

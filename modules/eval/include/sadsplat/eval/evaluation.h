@@ -13,12 +13,25 @@
 namespace sadsplat {
 namespace eval {
 
+/// \brief The model's floaters, counted against the scene's cameras (gaussians/view_coverage.h):
+/// what a user sees from new angles and the test views barely score.
+struct FloaterCensus {
+  double extent = 0;                      ///< scene extent (3DGS: from the camera centres)
+  std::int64_t larger_than_2pct = 0;      ///< largest scale (std. dev.) > 0.02 x extent
+  std::int64_t larger_than_10pct = 0;     ///< > 0.1 x extent (what 3DGS prunes after resets)
+  std::int64_t seen_by_under_2_views = 0; ///< centre inside fewer than 2 training views
+};
+
+/// \brief Counts the floaters of the trainer's model against the scene's cameras.
+FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& scene);
+
 /// \brief Everything measured on the test views.
 struct EvalResult {
   ConfusionMatrix confusion{1};
   double psnr = 0;  ///< mean over test views
   double ssim = 0;  ///< mean over test views
   std::vector<std::string> views;
+  FloaterCensus floaters;
 };
 
 /// \brief Renders every test view (views with a label map; all views with labels if the scene
@@ -37,7 +50,7 @@ struct RunFacts {
 };
 
 /// \brief metrics.json text: miou, macc, oacc, per_class_iou, psnr, ssim, num_gaussians,
-/// iterations, train_seconds, device, classes, confusion_matrix, views.
+/// floaters, iterations, train_seconds, device, classes, confusion_matrix, views.
 std::string metricsJson(const EvalResult& result, const std::vector<ClassInfo>& classes,
                         const RunFacts& facts);
 

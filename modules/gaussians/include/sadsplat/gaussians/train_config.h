@@ -57,6 +57,12 @@ struct TrainConfig {
   std::array<float, 3> background{0, 0, 0};
   std::string device = "cpu";   ///< "cpu" or "cuda"
   int max_gaussians = 3000000;  ///< densification stops growing past this
+  /// After the last iteration remove the floaters: Gaussians whose centre fewer than
+  /// floater_min_views training views see, or whose largest scale exceeds floater_max_scale x
+  /// the scene extent (gaussians/view_coverage.h).
+  bool prune_floaters = false;
+  int floater_min_views = 2;
+  double floater_max_scale = 0.1;
   // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
   // strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
   std::string drop = "none";  ///< none | semantic | structure | full

@@ -86,6 +86,8 @@ struct StepStats {
   /// After the last iteration: Gaussians removed because their evaluation gate is closed (z = 0,
   /// they render nothing).
   std::int64_t removed_closed_gates = 0;
+  /// After the last iteration, with TrainConfig::prune_floaters: the floaters removed.
+  std::int64_t removed_floaters = 0;
   int pseudo_labelled_views = 0;  ///< training views supervised by pseudo-labels
 };
 

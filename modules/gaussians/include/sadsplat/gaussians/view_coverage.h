@@ -1,0 +1,34 @@
+#pragma once
+/// \file view_coverage.h
+/// \brief Where a capture constrains a model: how many cameras see each Gaussian's centre, and
+/// the scene extent (3DGS's: from the camera centres). A Gaussian that fewer than two training
+/// views see has an unconstrained depth; one far larger than the scene's detail blurs every
+/// view it covers. Both are the floaters a user sees from new angles.
+
+#include <ATen/ATen.h>
+
+#include <vector>
+
+#include "sadsplat/gaussians/rasterizer.h"
+
+namespace sadsplat {
+namespace gaussians {
+
+/// \brief 1.1 times the largest distance of a camera centre from the cameras' mean centre (the
+/// 3DGS "cameras extent"; learning rates and size thresholds scale with it). At least 1e-3.
+double sceneExtent(const std::vector<RasterCamera>& cameras);
+
+/// \brief Per Gaussian (`means`, [N, 3], any device), how many of `cameras` see its centre: in
+/// front of the camera (beyond its near plane) and projecting inside its image. int32 [N], on
+/// the device of `means`.
+at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras);
+
+/// \brief The floaters of a model: Gaussians seen by fewer than `min_views` cameras, or whose
+/// largest scale (standard deviation, world units) exceeds `max_scale`. bool [N] (true = floater).
+/// `log_scales` [N, 3] as the trainer stores them. min_views <= 0 or max_scale <= 0 turns that
+/// test off.
+at::Tensor floaterMask(const at::Tensor& means, const at::Tensor& log_scales,
+                       const std::vector<RasterCamera>& cameras, int min_views, double max_scale);
+
+}  // namespace gaussians
+}  // namespace sadsplat

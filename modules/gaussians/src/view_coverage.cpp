@@ -1,0 +1,64 @@
+#include "sadsplat/gaussians/view_coverage.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/raster_math.h"
+
+namespace sadsplat {
+namespace gaussians {
+
+double sceneExtent(const std::vector<RasterCamera>& cameras) {
+  if (cameras.empty()) return 1e-3;
+  std::array<double, 3> mean{0, 0, 0};
+  std::vector<std::array<double, 3>> centres;
+  for (const RasterCamera& c : cameras) centres.push_back(c.centre());
+  for (const auto& c : centres) {
+    for (int k = 0; k < 3; ++k) mean[k] += c[k] / centres.size();
+  }
+  double radius = 0;
+  for (const auto& c : centres) {
+    radius = std::max(radius, std::sqrt(std::pow(c[0] - mean[0], 2) + std::pow(c[1] - mean[1], 2) +
+                                        std::pow(c[2] - mean[2], 2)));
+  }
+  return std::max(1e-3, 1.1 * radius);
+}
+
+at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras) {
+  if (means.dim() != 2 || means.size(1) != 3) {
+    throw Error("<view coverage>", "means", "an [N, 3] tensor");
+  }
+  const at::Tensor m = means.detach().to(at::kDouble);
+  at::Tensor counts = at::zeros({means.size(0)}, means.options().dtype(at::kInt));
+  for (const RasterCamera& c : cameras) {
+    const double q[4] = {c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]};
+    double R[9];
+    raster::quatToRotation(q, R);
+    // Camera coordinates x_c = R x + t, one row of R per axis.
+    const at::Tensor rows = at::tensor(std::vector<double>(R, R + 9), m.options()).view({3, 3});
+    const at::Tensor t = at::tensor(std::vector<double>(c.tvec.begin(), c.tvec.end()), m.options());
+    const at::Tensor cam = at::matmul(m, rows.t()) + t;
+    const at::Tensor x = cam.select(1, 0), y = cam.select(1, 1), z = cam.select(1, 2);
+    const at::Tensor in_front = z > c.near_plane;
+    const at::Tensor zs = at::where(in_front, z, at::ones_like(z));
+    const at::Tensor u = c.fx * x / zs + c.cx, v = c.fy * y / zs + c.cy;
+    const at::Tensor seen = in_front & (u >= 0) & (u < c.width) & (v >= 0) & (v < c.height);
+    counts += seen.to(at::kInt);
+  }
+  return counts;
+}
+
+at::Tensor floaterMask(const at::Tensor& means, const at::Tensor& log_scales,
+                       const std::vector<RasterCamera>& cameras, int min_views, double max_scale) {
+  at::Tensor floater = at::zeros({means.size(0)}, means.options().dtype(at::kBool));
+  if (min_views > 0) floater = floater | (viewCounts(means, cameras) < min_views);
+  if (max_scale > 0) {
+    const at::Tensor largest = std::get<0>(log_scales.detach().max(1)).exp();
+    floater = floater | (largest > max_scale);
+  }
+  return floater;
+}
+
+}  // namespace gaussians
+}  // namespace sadsplat
