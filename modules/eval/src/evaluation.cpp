@@ -140,25 +140,25 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
   }
   nlohmann::json names = nlohmann::json::array();
   for (const auto& c : classes) names.push_back(c.name);
-  const nlohmann::json j = {{"miou", r.confusion.meanIou()},
-                            {"macc", r.confusion.meanAccuracy()},
-                            {"oacc", r.confusion.overallAccuracy()},
-                            {"per_class_iou", per_class},
-                            {"psnr", r.psnr},
-                            {"ssim", r.ssim},
-                            {"num_gaussians", facts.num_gaussians},
-                            {"floaters",
-                             {{"scene_extent", r.floaters.extent},
-                              {"larger_than_2pct_extent", r.floaters.larger_than_2pct},
-                              {"larger_than_10pct_extent", r.floaters.larger_than_10pct},
-                              {"seen_by_under_2_training_views",
-                               r.floaters.seen_by_under_2_views}}},
-                            {"iterations", facts.iterations},
-                            {"train_seconds", facts.train_seconds},
-                            {"device", facts.device},
-                            {"classes", names},
-                            {"confusion_matrix", matrix},
-                            {"views", r.views}};
+  const nlohmann::json j = {
+      {"miou", r.confusion.meanIou()},
+      {"macc", r.confusion.meanAccuracy()},
+      {"oacc", r.confusion.overallAccuracy()},
+      {"per_class_iou", per_class},
+      {"psnr", r.psnr},
+      {"ssim", r.ssim},
+      {"num_gaussians", facts.num_gaussians},
+      {"floaters",
+       {{"scene_extent", r.floaters.extent},
+        {"larger_than_2pct_extent", r.floaters.larger_than_2pct},
+        {"larger_than_10pct_extent", r.floaters.larger_than_10pct},
+        {"seen_by_under_2_training_views", r.floaters.seen_by_under_2_views}}},
+      {"iterations", facts.iterations},
+      {"train_seconds", facts.train_seconds},
+      {"device", facts.device},
+      {"classes", names},
+      {"confusion_matrix", matrix},
+      {"views", r.views}};
   return j.dump(2) + "\n";
 }
 

@@ -578,8 +578,7 @@ StepStats Trainer::step() {
         std::vector<RasterCamera> training;
         for (int v : s.train_views) training.push_back(s.cameras[v]);
         const at::Tensor keep = floaterMask(s.p("means").value, s.p("scales").value, training,
-                                            c.floater_min_views,
-                                            c.floater_max_scale * s.extent)
+                                            c.floater_min_views, c.floater_max_scale * s.extent)
                                     .logical_not();
         floaters_at_end = s.n() - keep.sum().item<std::int64_t>();
         if (floaters_at_end > 0) s.resize(keep, {});

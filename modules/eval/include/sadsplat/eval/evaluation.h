@@ -16,10 +16,10 @@ namespace eval {
 /// \brief The model's floaters, counted against the scene's cameras (gaussians/view_coverage.h):
 /// what a user sees from new angles and the test views barely score.
 struct FloaterCensus {
-  double extent = 0;                      ///< scene extent (3DGS: from the camera centres)
-  std::int64_t larger_than_2pct = 0;      ///< largest scale (std. dev.) > 0.02 x extent
-  std::int64_t larger_than_10pct = 0;     ///< > 0.1 x extent (what 3DGS prunes after resets)
-  std::int64_t seen_by_under_2_views = 0; ///< centre inside fewer than 2 training views
+  double extent = 0;                       ///< scene extent (3DGS: from the camera centres)
+  std::int64_t larger_than_2pct = 0;       ///< largest scale (std. dev.) > 0.02 x extent
+  std::int64_t larger_than_10pct = 0;      ///< > 0.1 x extent (what 3DGS prunes after resets)
+  std::int64_t seen_by_under_2_views = 0;  ///< centre inside fewer than 2 training views
 };
 
 /// \brief Counts the floaters of the trainer's model against the scene's cameras.
