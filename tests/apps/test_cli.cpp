@@ -178,6 +178,24 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   EXPECT_NE(out.find("device"), std::string::npos) << out;
 }
 
+// A run trained on a relative scene path is evaluated from another working directory (run.json
+// keeps the scene's absolute path), and eval's metrics count the floaters.
+TEST(Cli, EvalFindsTheSceneOfARunFromAnyDirectory) {
+  test::TempDir dir;
+  std::string out;
+  const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  ASSERT_EQ(test::runCommand("cd " + dir.path() + " && cp " + cache + " scene.cache && " + kCli +
+                                 " train scene.cache --iterations 5 --out run",
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::runCommand("cd / && " + kCli + " eval " + dir.file("run"), &out), 0) << out;
+  for (const char* key : {"\"floaters\"", "\"scene_extent\"", "\"larger_than_10pct_extent\"",
+                          "\"seen_by_under_2_training_views\""}) {
+    EXPECT_NE(out.find(key), std::string::npos) << key << out;
+  }
+}
+
 // The demo end to end, shortened: pseudo-labels are written and used, the drop acts, the run is
 // evaluated; --baseline skips both.
 TEST(Cli, DemoRunsTheMethodAndTheBaseline) {

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iomanip>
 #include <optional>
 #include <sstream>
@@ -54,7 +55,10 @@ std::string formatSeconds(double s) {
 
 void writeRunJson(const std::string& dir, const std::string& scene, double scale,
                   const std::string& device, int iterations, double seconds) {
-  const nlohmann::json j = {{"scene", scene},
+  // Absolute, so that `eval` finds the scene from any working directory.
+  std::error_code error;
+  const std::filesystem::path absolute = std::filesystem::absolute(scene, error);
+  const nlohmann::json j = {{"scene", error ? scene : absolute.lexically_normal().string()},
                             {"scale", scale},
                             {"device", device},
                             {"iterations", iterations},
@@ -265,10 +269,17 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   << " left\n";
     }
     if (stats.removed_floaters > 0 && o.progress) {
+      std::string rule;
+      if (config.floater_min_views > 0) {
+        rule = "seen by fewer than " + std::to_string(config.floater_min_views) + " training views";
+      }
+      if (config.floater_max_scale > 0) {
+        std::ostringstream size;
+        size << "larger than " << config.floater_max_scale << " x the scene extent";
+        rule += (rule.empty() ? "" : " or ") + size.str();
+      }
       *o.progress << "\n[floaters] end of training: removed " << stats.removed_floaters
-                  << " Gaussians seen by fewer than " << config.floater_min_views
-                  << " training views or larger than " << config.floater_max_scale
-                  << " x the scene extent, " << stats.num_gaussians << " left\n";
+                  << " Gaussians " << rule << ", " << stats.num_gaussians << " left\n";
     }
     if (o.progress && (it % 10 == 0 || it == config.iterations)) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
