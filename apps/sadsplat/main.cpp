@@ -13,6 +13,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/distributed/rank_group.h"
+#include "sadsplat/eval/experiment_table.h"
 #include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -346,6 +347,15 @@ int main(int argc, char** argv) {
   evaluate->add_option("RUN", eval_run, "run directory")->required();
   evaluate->add_option("--scene", eval_scene, "scene to evaluate on (default: the run's)");
 
+  auto* table = app.add_subcommand(
+      "table",
+      "Tables of an experiment folder: RESULTS/<kind>_<seed>/<config>_t<seed>/metrics.json");
+  std::string table_results, table_baseline = "none", table_out;
+  table->add_option("RESULTS", table_results, "experiment results folder")->required();
+  table->add_option("--baseline", table_baseline, "configuration to compare the counts with")
+      ->capture_default_str();
+  table->add_option("--out", table_out, "also write the Markdown to this file");
+
   auto* demo = app.add_subcommand("demo",
                                   "Generate the demo city, pseudo-label it, train on CPU with the "
                                   "semantic-aware drop, evaluate");
@@ -522,6 +532,13 @@ int main(int argc, char** argv) {
                                         : sadsplat::pseudo_labels::ScoreScale::kScore;
       pseudo_options.progress = &std::cout;
       std::cout << sadsplat::pipeline::pseudoLabelRun(pseudo_options);
+    } else if (*table) {
+      const std::string text = sadsplat::eval::experimentTables(
+          sadsplat::eval::readExperimentRuns(table_results), table_baseline);
+      if (!table_out.empty()) {
+        sadsplat::io::writeFileAtomically(table_out, [&](std::ostream& o) { o << text; });
+      }
+      std::cout << text;
     } else if (*evaluate) {
       std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
 #if SADSPLAT_HAVE_VIZ
