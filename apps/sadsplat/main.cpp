@@ -260,6 +260,18 @@ int main(int argc, char** argv) {
   train->add_option(
       "--lambda-l0", train_lambda_l0,
       "weight of the L0 sparsity loss (0.2; 0.1 renders 1.0-1.4 dB better and keeps ~1.7x more)");
+  int train_recovery = -1;
+  train
+      ->add_option("--recovery", train_recovery,
+                   "with a drop: the last N iterations train without gates, L0 and drops, the "
+                   "gates folded into the opacities (not the paper; 0 = the paper's schedule)")
+      ->check(CLI::NonNegativeNumber);
+  double train_recovery_prune = -1;
+  train
+      ->add_option("--recovery-prune", train_recovery_prune,
+                   "at the start of the recovery also remove this share of the Gaussians that "
+                   "contribute least to the training views (0 = none)")
+      ->check(CLI::Range(0.0, 0.999));
 
   auto* pseudo = app.add_subcommand("pseudo-labels",
                                     "Write confidence maps and filtered pseudo-labels of the "
@@ -484,6 +496,8 @@ int main(int argc, char** argv) {
       if (!train_drop.empty()) config.drop = train_drop;
       if (train_p_base >= 0) config.p_base = train_p_base;
       if (train_lambda_l0 >= 0) config.lambda_l0 = train_lambda_l0;
+      if (train_recovery >= 0) config.recovery_iterations = train_recovery;
+      if (train_recovery_prune >= 0) config.recovery_prune = train_recovery_prune;
       if (train_views_per_step > 0) config.views_per_step = train_views_per_step;
       if (train_prune_floaters) config.prune_floaters = true;
       // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).

@@ -9,7 +9,9 @@
 # Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
 #        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
 #        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt
-#        pseudo_labels_train_decoder = false (e.g. none_decgt_pl).
+#        pseudo_labels_train_decoder = false (e.g. none_decgt_pl), _recN recovery_iterations = N
+#        and _cutX recovery_prune = X (e.g. full_p1_lambda0.2_rec1000_cut0.3_pl), _refssim
+#        fused_ssim = false.
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
 # summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
 # name suffix for the work dir and the outputs, so that two label variants can run side by side).
@@ -45,6 +47,9 @@ train_one() {
   case "$name" in *_lambda*) local l0=${name#*_lambda}; keys+=("\"lambda_l0\": ${l0%%_*}") ;; esac
   case "$name" in *_lp*) local lp=${name#*_lp}; keys+=("\"lambda_pseudo\": ${lp%%_*}") ;; esac
   case "$name" in *_decgt*) keys+=("\"pseudo_labels_train_decoder\": false") ;; esac
+  case "$name" in *_refssim*) keys+=("\"fused_ssim\": false") ;; esac
+  case "$name" in *_rec*) local rec=${name#*_rec}; keys+=("\"recovery_iterations\": ${rec%%_*}") ;; esac
+  case "$name" in *_cut*) local cut=${name#*_cut}; keys+=("\"recovery_prune\": ${cut%%_*}") ;; esac
   if [ ${#keys[@]} -gt 0 ]; then
     (IFS=,; echo "{${keys[*]}}") > "$work/config_$name.json"; args=(--config "$work/config_$name.json")
   fi
@@ -84,8 +89,9 @@ for f in sorted(glob.glob(os.path.join(res, "metrics_*.json"))):
     except Exception as e:
         print(name, "unreadable", e); continue
     rows.append((name, m))
-    print("%-16s mIoU %6.2f  mAcc %6.2f  OA %6.2f  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.0f s" % (
-        name, 100*m['miou'], 100*m['macc'], 100*m['oacc'], m['psnr'], m['ssim'], m['num_gaussians'], m['train_seconds']))
+    print("%-16s mIoU %6.2f  mAcc %6.2f  OA %6.2f  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.0f s  render %.2f ms" % (
+        name, 100*m['miou'], 100*m['macc'], 100*m['oacc'], m['psnr'], m['ssim'], m['num_gaussians'], m['train_seconds'],
+        m.get('render_ms', float('nan'))))
 rep = os.path.join(res, "pseudo_report", "report.txt")
 if os.path.exists(rep):
     print(open(rep).read())

@@ -266,6 +266,109 @@ TEST_P(TrainerOnDevice, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
   EXPECT_EQ(gated.toCloud().size(), static_cast<std::size_t>(n1 / 2));
 }
 
+// Gates for the recovery phase's test: every third Gaussian's evaluation gate closed, every
+// third half open, the rest open; a training gate of 0.9 and an L0 term of 10 (so a step's loss
+// tells whether the gates were on); dropNow records when it was asked.
+class ThirdsGates : public gaussians::DropStrategy {
+ public:
+  at::Tensor trainingGate(const at::Tensor& log_alpha, int) const override {
+    return at::full_like(log_alpha, 0.9) + 0 * log_alpha;
+  }
+  at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
+    const at::Tensor third =
+        at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 3;
+    return (third.to(log_alpha.dtype()) * 0.5).to(log_alpha.device());
+  }
+  at::Tensor regularisation(const at::Tensor& log_alpha) const override {
+    return 10 + 0 * log_alpha.sum();
+  }
+  bool dropNow(int done) const override {
+    asked->push_back(done);
+    return false;
+  }
+  gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
+  std::shared_ptr<std::vector<int>> asked = std::make_shared<std::vector<int>>();
+};
+
+TEST_P(TrainerOnDevice, RecoveryFoldsTheGatesIntoTheOpacitiesAndTrainsWithoutThem) {
+  TrainConfig c = small(20);
+  c.recovery_iterations = 5;
+  c.lr_opacity = 0;  // the opacities change only by the folding
+  Trainer trainer(scene_, c);
+  auto gates = std::make_shared<ThirdsGates>();
+  trainer.setDropStrategy(gates);
+  const std::int64_t n = trainer.numGaussians();
+  at::Tensor opacity_before;
+  for (int i = 1; i <= 20; ++i) {
+    if (i == 15) opacity_before = at::sigmoid(trainer.parameters().opacity_logits.detach()).cpu();
+    const gaussians::StepStats s = trainer.step();
+    trainer.checkConsistency();
+    EXPECT_EQ(s.recovery_started, i == 15);
+    if (i <= 15) {
+      EXPECT_GT(s.loss, 10) << "iteration " << i << " trains with the L0 term";
+    } else {
+      EXPECT_LT(s.loss, 10) << "iteration " << i << " trains without it";
+    }
+    if (i == 15) {
+      EXPECT_EQ(s.recovery_closed_gates, (n + 2) / 3);
+      EXPECT_EQ(s.recovery_pruned, 0);
+      EXPECT_EQ(s.num_gaussians, n - (n + 2) / 3);
+    }
+  }
+  // Drops are asked for before the recovery only; none of the closed gates is left at the end.
+  EXPECT_EQ(gates->asked->back(), 15);
+  EXPECT_EQ(trainer.numGaussians(), n - (n + 2) / 3);
+  // Folded: opacity x gate (0.5 or 1) of the Gaussians that stayed, in their order.
+  const at::Tensor kept = (at::arange(n) % 3) != 0;
+  const at::Tensor gate = ((at::arange(n) % 3).to(at::kFloat) * 0.5).index({kept});
+  const at::Tensor expected = opacity_before.index({kept}) * gate;
+  const at::Tensor after = at::sigmoid(trainer.parameters().opacity_logits.detach()).cpu();
+  EXPECT_TRUE(at::allclose(after, expected, 1e-4, 1e-6));
+}
+
+TEST_P(TrainerOnDevice, RecoveryPruneRemovesTheShareThatContributesLeast) {
+  TrainConfig c = small(12);
+  c.recovery_iterations = 2;
+  c.recovery_prune = 0.4;
+  Trainer trainer(scene_, c);
+  trainer.setDropStrategy(std::make_shared<ThirdsGates>());
+  const std::int64_t n = trainer.numGaussians();
+  gaussians::StepStats s;
+  for (int i = 0; i < 10; ++i) s = trainer.step();
+  ASSERT_TRUE(s.recovery_started);
+  const std::int64_t open = n - (n + 2) / 3;
+  EXPECT_EQ(s.recovery_pruned, static_cast<std::int64_t>(std::floor(0.4 * open)));
+  EXPECT_EQ(s.num_gaussians, open - s.recovery_pruned);
+  trainer.checkConsistency();
+  for (int i = 0; i < 2; ++i) trainer.step();
+  EXPECT_EQ(trainer.numGaussians(), open - s.recovery_pruned);
+}
+
+TEST_F(TrainerTest, ResumeAcrossTheRecoveryIsExact) {
+  TrainConfig c = small(16);
+  c.recovery_iterations = 8;
+  c.recovery_prune = 0.2;
+  Trainer straight(scene_, c);
+  straight.setDropStrategy(std::make_shared<ThirdsGates>());
+  for (int i = 0; i < 16; ++i) straight.step();
+  test::TempDir dir;
+  {
+    Trainer first(scene_, c);
+    first.setDropStrategy(std::make_shared<ThirdsGates>());
+    for (int i = 0; i < 11; ++i) first.step();
+    first.saveCheckpoint(dir.file("ckpt.bin"));
+  }
+  Trainer resumed(scene_, c);
+  resumed.setDropStrategy(std::make_shared<ThirdsGates>());
+  resumed.loadCheckpoint(dir.file("ckpt.bin"));
+  for (int i = 0; i < 5; ++i) resumed.step();
+  const auto a = straight.parameters(), b = resumed.parameters();
+  ASSERT_EQ(a.means.size(0), b.means.size(0));
+  EXPECT_TRUE(at::equal(a.means, b.means));
+  EXPECT_TRUE(at::equal(a.opacity_logits, b.opacity_logits));
+  EXPECT_TRUE(at::equal(a.features, b.features));
+}
+
 TEST_F(TrainerTest, ResumeFromACheckpointIsExact) {
   TrainConfig c = small(40);
   c.densify_from = 5;

@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/view_coverage.h"
@@ -87,10 +89,18 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   result.confusion = ConfusionMatrix(static_cast<int>(scene.classes.size()));
   bool any_test = false;
   for (const auto& v : scene.views) any_test = any_test || v.test;
-  double psnr_sum = 0, ssim_sum = 0;
+  double psnr_sum = 0, ssim_sum = 0, render_seconds = 0;
   for (const io::View& view : scene.views) {
     if ((any_test && !view.test) || view.labels.empty()) continue;
     const gaussians::RenderResult r = trainer.renderView(view);
+    {
+      // Render time: r was the warm-up; reading a value back waits for the device.
+      constexpr int kRepeats = 3;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int k = 0; k < kRepeats; ++k) trainer.renderView(view).alpha.sum().item<float>();
+      render_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / kRepeats;
+    }
     const at::Tensor pred = trainer.predictClasses(r).to(at::kCPU).contiguous();
     std::vector<std::uint8_t> labels = view.labels.pixels;
     for (std::size_t i = 0; i < labels.size(); ++i) {
@@ -122,6 +132,7 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   }
   result.psnr = psnr_sum / result.views.size();
   result.ssim = ssim_sum / result.views.size();
+  result.render_ms = 1000.0 * render_seconds / result.views.size();
   return result;
 }
 
@@ -148,6 +159,7 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
       {"psnr", r.psnr},
       {"ssim", r.ssim},
       {"num_gaussians", facts.num_gaussians},
+      {"render_ms", r.render_ms},
       {"floaters",
        {{"scene_extent", r.floaters.extent},
         {"larger_than_2pct_extent", r.floaters.larger_than_2pct},

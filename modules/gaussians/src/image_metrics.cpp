@@ -1,11 +1,70 @@
 #include "sadsplat/gaussians/image_metrics.h"
 
+#include <torch/csrc/autograd/custom_function.h>
+
 #include <cmath>
+
+#if SADSPLAT_HAVE_CUDA
+#include <c10/cuda/CUDAGuard.h>
+#include <c10/cuda/CUDAStream.h>
+#endif
+
+#include "sadsplat/common/error.h"
+#include "ssim_backend.h"
 
 namespace sadsplat {
 namespace gaussians {
 
-at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
+namespace ssim_fused {
+
+std::array<float, 11> window() {
+  // As the reference computes it: exp(-(i - 5)^2 / (2 * 1.5^2)) in float, normalised.
+  std::array<float, 11> w{};
+  float sum = 0;
+  for (int i = 0; i < 11; ++i) {
+    w[i] = std::exp(static_cast<float>((i - 5) * (i - 5)) / (-2 * 1.5f * 1.5f));
+    sum += w[i];
+  }
+  for (float& v : w) v /= sum;
+  return w;
+}
+
+}  // namespace ssim_fused
+
+namespace {
+
+#if SADSPLAT_HAVE_CUDA
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+
+void* currentStream(const at::Tensor& t) {
+  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
+}
+
+// mean(SSIM map) of a (differentiable) against b (a constant target).
+class FusedSsim : public torch::autograd::Function<FusedSsim> {
+ public:
+  static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a, const at::Tensor& b) {
+    const c10::cuda::CUDAGuard guard(a.device());
+    const at::Tensor ac = a.contiguous(), bc = b.contiguous();
+    auto [map, partials] = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
+    ctx->save_for_backward({ac, bc, partials});
+    return map.mean();
+  }
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const at::Tensor& a = saved[0];
+    const c10::cuda::CUDAGuard guard(a.device());
+    const at::Tensor upstream = grads[0].to(at::kFloat).contiguous();
+    at::Tensor grad = ssim_fused::backwardCuda(a, saved[1], saved[2], upstream, currentStream(a));
+    return {grad, at::Tensor()};
+  }
+};
+#endif
+
+}  // namespace
+
+at::Tensor ssimReference(const at::Tensor& a, const at::Tensor& b) {
   const auto opts = a.options();
   at::Tensor g = at::arange(11, opts).sub(5).pow(2).div(-2 * 1.5 * 1.5).exp();
   g = g / g.sum();
@@ -24,6 +83,25 @@ at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
   const at::Tensor map =
       ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2));
   return map.mean();
+}
+
+bool ssimIsFused(const at::Tensor& a, const at::Tensor& b) {
+#if SADSPLAT_HAVE_CUDA
+  return a.is_cuda() && b.is_cuda() && a.scalar_type() == at::kFloat &&
+         b.scalar_type() == at::kFloat && a.dim() == 3 && a.size(2) == 3 &&
+         a.sizes().equals(b.sizes()) && a.device() == b.device() && !b.requires_grad();
+#else
+  (void)a;
+  (void)b;
+  return false;
+#endif
+}
+
+at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
+#if SADSPLAT_HAVE_CUDA
+  if (ssimIsFused(a, b)) return FusedSsim::apply(a, b);
+#endif
+  return ssimReference(a, b);
 }
 
 double psnr(const at::Tensor& a, const at::Tensor& b) {

@@ -73,6 +73,7 @@ TrainConfig TrainConfig::forGlobalBatch(int views) const {
   c.opacity_reset_interval = steps(opacity_reset_interval);
   c.checkpoint_interval = steps(checkpoint_interval);
   c.drop_interval = steps(drop_interval);
+  c.recovery_iterations = steps(recovery_iterations);
   const double lr = std::sqrt(static_cast<double>(views));
   for (double* rate :
        {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest, &c.lr_opacity,
@@ -88,6 +89,7 @@ std::string TrainConfig::toJson() const {
                       {"max_sh_degree", max_sh_degree},
                       {"sh_increase_interval", sh_increase_interval},
                       {"lambda_ssim", lambda_ssim},
+                      {"fused_ssim", fused_ssim},
                       {"lambda_rgb", lambda_rgb},
                       {"lambda_semantic", lambda_semantic},
                       {"semantic_interval", semantic_interval},
@@ -125,7 +127,9 @@ std::string TrainConfig::toJson() const {
                       {"drop_interval", drop_interval},
                       {"lambda_l0", lambda_l0},
                       {"lr_log_alpha", lr_log_alpha},
-                      {"log_alpha_init", log_alpha_init}};
+                      {"log_alpha_init", log_alpha_init},
+                      {"recovery_iterations", recovery_iterations},
+                      {"recovery_prune", recovery_prune}};
   return j.dump(2) + "\n";
 }
 
@@ -155,6 +159,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.max_sh_degree = integer<int>(d, "max_sh_degree", origin);
   c.sh_increase_interval = integer<int>(d, "sh_increase_interval", origin);
   c.lambda_ssim = real(d, "lambda_ssim", origin);
+  c.fused_ssim = d["fused_ssim"].get<bool>();
   c.lambda_rgb = real(d, "lambda_rgb", origin);
   c.lambda_semantic = real(d, "lambda_semantic", origin);
   c.semantic_interval = integer<int>(d, "semantic_interval", origin);
@@ -203,6 +208,8 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.lambda_l0 = real(d, "lambda_l0", origin);
   c.lr_log_alpha = real(d, "lr_log_alpha", origin);
   c.log_alpha_init = real(d, "log_alpha_init", origin);
+  c.recovery_iterations = integer<int>(d, "recovery_iterations", origin);
+  c.recovery_prune = real(d, "recovery_prune", origin);
   return c;
 }
 

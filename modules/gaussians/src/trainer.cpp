@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tuple>
+#include <utility>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/adam.h"
+#include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
@@ -29,6 +32,10 @@ struct Param {
 };
 
 double logit(double p) { return std::log(p / (1 - p)); }
+
+// log_alpha of a gate folded into its opacity: sigmoid(20) * 1.2 - 0.1 > 1, so the deterministic
+// gate is exactly 1, and so is every training sample (the noise's logit is clamped to +-13.8).
+constexpr double kSettledLogAlpha = 20.0;
 
 }  // namespace
 
@@ -128,9 +135,56 @@ struct Trainer::State {
     max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
   }
 
-  // The drop's deterministic (evaluation) gate per Gaussian; undefined without one.
+  // The first iteration of the recovery phase (TrainConfig::recovery_iterations): from there on
+  // no gates, no L0 term and no drops. Past the end without a drop or a recovery.
+  int recoveryStart() const {
+    return drop && config.recovery_iterations > 0 ? config.iterations - config.recovery_iterations
+                                                  : config.iterations + 1;
+  }
+  // Whether iteration `it` (0-based) trains with the drop's gates.
+  bool gated(int it) const { return drop && it < recoveryStart(); }
+
+  // The drop's deterministic (evaluation) gate per Gaussian; undefined without one, and once the
+  // gates are folded into the opacities.
   at::Tensor evaluationGate() const {
-    return drop ? drop->evaluationGate(p("log_alpha").value.detach()) : at::Tensor();
+    return gated(iteration) ? drop->evaluationGate(p("log_alpha").value.detach()) : at::Tensor();
+  }
+
+  // Start of the recovery phase: the Gaussians with a closed gate go, the other gates are folded
+  // into the opacities (and their log_alpha fixed open), then, with recovery_prune, the share of
+  // Gaussians that contribute least to the training views goes too. Returns {closed, pruned}.
+  std::pair<std::int64_t, std::int64_t> settleGates() {
+    std::int64_t closed = 0, pruned = 0;
+    const at::Tensor gate = drop->evaluationGate(p("log_alpha").value.detach());
+    if (gate.defined()) {
+      const at::Tensor open = gate > 0;
+      closed = n() - open.sum().item<std::int64_t>();
+      resize(open, {});
+      const at::Tensor kept_gate = gate.index_select(0, open.nonzero().squeeze(1));
+      Param& o = p("opacity");
+      const at::Tensor folded = (at::sigmoid(o.value.detach()) * kept_gate).clamp(1e-6, 1 - 1e-6);
+      o.value = at::log(folded / (1 - folded)).contiguous().requires_grad_(true);
+      Param& la = p("log_alpha");
+      la.value = at::full_like(la.value.detach(), kSettledLogAlpha).requires_grad_(true);
+      la.m.zero_();
+      la.v.zero_();
+    }
+    if (config.recovery_prune > 0 && n() > 0) {
+      std::vector<RasterCamera> training;
+      for (int v : train_views) training.push_back(cameras[v]);
+      const at::Tensor score = blendingWeightSums(gaussians(), training);
+      const std::int64_t count =
+          static_cast<std::int64_t>(std::floor(config.recovery_prune * static_cast<double>(n())));
+      if (count > 0) {
+        // The `count` lowest scores go (ties by index: a stable sort keeps this deterministic).
+        const at::Tensor order = std::get<1>(score.sort(/*stable=*/true, 0, false));
+        at::Tensor keep = at::ones({n()}, score.options().dtype(at::kBool));
+        keep.index_fill_(0, order.narrow(0, 0, count), false);
+        pruned = count;
+        resize(keep, {});
+      }
+    }
+    return {closed, pruned};
   }
 
   // Activated opacity times the evaluation gate (when there is one).
@@ -265,6 +319,14 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
                 "iterations / feature_dim / max_sh_degree / semantic_interval / views_per_step",
                 "iterations >= 1, feature_dim 0..32, max_sh_degree 0..3, semantic_interval >= 0, "
                 "views_per_step >= 1");
+  }
+  if (config.recovery_iterations < 0 || config.recovery_iterations >= config.iterations) {
+    throw Error("<config>", "recovery_iterations", "0 .. iterations - 1",
+                std::to_string(config.recovery_iterations));
+  }
+  if (!(config.recovery_prune >= 0 && config.recovery_prune < 1)) {
+    throw Error("<config>", "recovery_prune", "a share in [0, 1)",
+                std::to_string(config.recovery_prune));
   }
   if (config.device == "cuda") {
     if (!at::hasCUDA()) {
@@ -451,7 +513,8 @@ StepStats Trainer::step() {
   settings.sh_degree = s.shDegree();
   settings.background = c.background;
   GaussianParams g = s.gaussians();
-  if (s.drop) g.opacity_gate = s.drop->trainingGate(s.p("log_alpha").value, it);
+  const bool gated = s.gated(it);
+  if (gated) g.opacity_gate = s.drop->trainingGate(s.p("log_alpha").value, it);
   at::Tensor total;
   // Loss values stay on the device until the end of the step: one host synchronisation per step.
   at::Tensor rgb_sum, sem_sum;
@@ -460,6 +523,7 @@ StepStats Trainer::step() {
   };
   std::vector<RenderResult> renders;
   std::int64_t dropped = 0, closed_at_end = 0, floaters_at_end = 0;
+  std::int64_t settled_closed = 0, settled_pruned = 0;
   DropDecision decision;
   for (int v : views) {
     enterPhase(profile, "render forward");
@@ -476,7 +540,9 @@ StepStats Trainer::step() {
     const at::Tensor mask = s.masks[v].unsqueeze(2);
     const at::Tensor l1 = ((r.rgb - gt).abs() * mask).mean();
     const at::Tensor rgb_loss =
-        (1 - c.lambda_ssim) * l1 + c.lambda_ssim * (1 - ssim(r.rgb * mask, gt * mask));
+        (1 - c.lambda_ssim) * l1 +
+        c.lambda_ssim * (1 - (c.fused_ssim ? ssim(r.rgb * mask, gt * mask)
+                                           : ssimReference(r.rgb * mask, gt * mask)));
     at::Tensor loss = c.lambda_rgb * rgb_loss;
     accumulate(rgb_sum, rgb_loss);
     if (semantic) {
@@ -496,7 +562,7 @@ StepStats Trainer::step() {
   }
   // The mean over the global batch (one draw: the sum of its training and labelled views' losses).
   if (batch > 1) total = total / batch;
-  if (s.drop) {
+  if (gated) {
     // Added once over all ranks.
     const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value);
     if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);
@@ -549,7 +615,7 @@ StepStats Trainer::step() {
     s.iteration = it + 1;
     const int done = s.iteration;
     enterPhase(profile, "drop");
-    if (s.drop && s.drop->dropNow(done)) {
+    if (gated && s.drop->dropNow(done)) {
       DropInputs in;
       in.means = s.p("means").value.detach();
       in.opacities = at::sigmoid(s.p("opacity").value.detach());
@@ -563,6 +629,9 @@ StepStats Trainer::step() {
       s.confidence = decision.confidence.to(s.device).to(at::kFloat);
       dropped = s.n() - decision.keep.sum().item<std::int64_t>();
       s.resize(decision.keep.to(s.device), {});
+    }
+    if (done == s.recoveryStart()) {
+      std::tie(settled_closed, settled_pruned) = s.settleGates();
     }
     if (done == c.iterations) {
       // Gaussians whose evaluation gate is closed (z = 0) render nothing: removing them at the
@@ -617,6 +686,9 @@ StepStats Trainer::step() {
   stats.dropped = dropped;
   stats.removed_closed_gates = closed_at_end;
   stats.removed_floaters = floaters_at_end;
+  stats.recovery_started = s.iteration == s.recoveryStart();
+  stats.recovery_closed_gates = settled_closed;
+  stats.recovery_pruned = settled_pruned;
   stats.drop = decision;
   stats.pseudo_labelled_views = s.pseudo_labelled_views;
   return stats;

@@ -53,6 +53,7 @@ void TrainLogWriter::append(const TrainLogRecord& r) {
   } else {
     j["removed"] = r.removed;
   }
+  if (r.type == "recovery") j["closed_gate"] = r.closed_gate;
   if (r.type == "drop") {
     j["low_confidence"] = r.low_confidence;
     j["unseen"] = r.unseen;

@@ -110,6 +110,15 @@ void logStep(io::TrainLogWriter& log, const gaussians::StepStats& s, double seco
     r.gaussians = s.num_gaussians;
     log.append(r);
   }
+  if (s.recovery_started) {
+    io::TrainLogRecord r;
+    r.type = "recovery";
+    r.iteration = s.iteration;
+    r.removed = s.recovery_closed_gates + s.recovery_pruned;
+    r.closed_gate = s.recovery_closed_gates;
+    r.gaussians = s.num_gaussians;
+    log.append(r);
+  }
   if (s.iteration % 10 == 0 || last) {
     io::TrainLogRecord r;
     r.iteration = s.iteration;
@@ -267,6 +276,13 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
       *o.progress << "\n[drop] end of training: removed " << stats.removed_closed_gates
                   << " Gaussians with a closed gate (they render nothing), " << stats.num_gaussians
                   << " left\n";
+    }
+    if (stats.recovery_started && o.progress) {
+      *o.progress << "\n[recovery] iteration " << it << ": gates folded into the opacities; removed "
+                  << stats.recovery_closed_gates << " Gaussians with a closed gate and "
+                  << stats.recovery_pruned << " least contributing ones, " << stats.num_gaussians
+                  << " left; " << config.recovery_iterations
+                  << " iterations without gates, L0 and drops follow\n";
     }
     if (stats.removed_floaters > 0 && o.progress) {
       std::string rule;

@@ -98,11 +98,11 @@ std::string writeTrainingReport(const ReportOptions& options) {
       rest.x.push_back(r.iteration);
       rest.y.push_back(r.loss - r.rgb_loss - r.semantic_loss);
     }
-    if (r.type == "step" || r.type == "drop" || r.type == "closed_gates") {
+    if (r.type == "step" || r.type == "drop" || r.type == "closed_gates" || r.type == "recovery") {
       count.x.push_back(r.iteration);
       count.y.push_back(static_cast<double>(r.gaussians));
     }
-    if (r.type == "drop" || r.type == "closed_gates") {
+    if (r.type == "drop" || r.type == "closed_gates" || r.type == "recovery") {
       drops.x.push_back(r.iteration);
       drops.y.push_back(static_cast<double>(r.gaussians));
     }
@@ -197,6 +197,13 @@ std::string writeTrainingReport(const ReportOptions& options) {
                            : "")
          << "| " << r.iteration << " (end) | " << r.removed << " | " << r.gaussians << " | - | - | "
          << r.removed << " |\n";
+    } else if (r.type == "recovery") {
+      md << (events++ == 0 ? "| iteration | removed | left | low confidence | unseen | closed gate "
+                             "|\n|---|---|---|---|---|---|\n"
+                           : "")
+         << "| " << r.iteration << " (recovery: gates folded, " << r.removed - r.closed_gate
+         << " least contributing pruned) | " << r.removed << " | " << r.gaussians << " | - | - | "
+         << r.closed_gate << " |\n";
     }
   }
   if (events == 0) md << "No drop events (a run without the semantic-aware drop).\n";

@@ -30,6 +30,9 @@ struct EvalResult {
   ConfusionMatrix confusion{1};
   double psnr = 0;  ///< mean over test views
   double ssim = 0;  ///< mean over test views
+  /// Mean time to render one test view as evaluation renders it (RGB, features, depth), in ms:
+  /// 3 renders per view after a warm-up, each waited for (on CUDA, includes one small copy).
+  double render_ms = 0;
   std::vector<std::string> views;
   FloaterCensus floaters;
 };

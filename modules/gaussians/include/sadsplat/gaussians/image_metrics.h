@@ -8,8 +8,15 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief Mean SSIM of two [H, W, 3] images.
+/// \brief Mean SSIM of two [H, W, 3] images. On CUDA float32 images whose second image needs no
+/// gradient (a loss against a target) it runs fused (four memory-bound passes, the gradient for
+/// the first image only); otherwise as ssimReference.
 at::Tensor ssim(const at::Tensor& a, const at::Tensor& b);
+/// \brief The same SSIM composed of ATen operations (separable convolutions), on any device and
+/// differentiable in both images: the reference the fused path is tested against.
+at::Tensor ssimReference(const at::Tensor& a, const at::Tensor& b);
+/// \brief Whether ssim(a, b) takes the fused path.
+bool ssimIsFused(const at::Tensor& a, const at::Tensor& b);
 /// \brief PSNR in dB of two images with values in [0, 1].
 double psnr(const at::Tensor& a, const at::Tensor& b);
 

@@ -17,6 +17,9 @@ struct TrainConfig {
   int max_sh_degree = 3;
   int sh_increase_interval = 1000;
   double lambda_ssim = 0.2;  ///< paper: lambda_SSIM = 0.2
+  /// On CUDA, the SSIM loss in fused kernels (gaussians::ssim); false: the reference composition
+  /// of convolutions (gaussians::ssimReference), the same value ~10x slower (for comparisons).
+  bool fused_ssim = true;
   double lambda_rgb = 1.0;
   double lambda_semantic = 1.0;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
@@ -73,6 +76,16 @@ struct TrainConfig {
   double lambda_l0 = 0.2;
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
+  /// Not the paper: with a drop, the last `recovery_iterations` iterations train without gates,
+  /// L0 term and drops. At their start the Gaussians whose deterministic gate is closed go and
+  /// every other gate is folded into its opacity; the rest then adapts to the model that remains
+  /// (the gates' training noise had it render with opacities it never has at evaluation).
+  /// 0 = the paper's schedule (gates until the end).
+  int recovery_iterations = 0;
+  /// Not the paper: at the start of the recovery, also remove this share of the Gaussians with
+  /// the smallest contribution to the training views (sum of their blending weights,
+  /// gaussians/contribution.h). 0 = none; in [0, 1).
+  double recovery_prune = 0.0;
 
   /// \brief The same training for a global batch of `views` training views per step (ranks x
   /// views_per_step): every iteration count of the schedule (iterations, densification, opacity

@@ -88,6 +88,11 @@ struct StepStats {
   std::int64_t removed_closed_gates = 0;
   /// After the last iteration, with TrainConfig::prune_floaters: the floaters removed.
   std::int64_t removed_floaters = 0;
+  /// Whether the recovery phase (TrainConfig::recovery_iterations) starts after this step; if so
+  /// the Gaussians removed then for a closed gate, and for their small contribution.
+  bool recovery_started = false;
+  std::int64_t recovery_closed_gates = 0;
+  std::int64_t recovery_pruned = 0;
   int pseudo_labelled_views = 0;  ///< training views supervised by pseudo-labels
 };
 
@@ -116,7 +121,8 @@ class Trainer {
 
   /// \brief One optimisation step (render, loss, backward, Adam, densification schedule). With a
   /// drop strategy, densification prunes by the opacity a Gaussian renders with at evaluation
-  /// (opacity x deterministic gate), and the last step removes the Gaussians whose gate is closed.
+  /// (opacity x deterministic gate), and the last step removes the Gaussians whose gate is closed;
+  /// with TrainConfig::recovery_iterations the gates end earlier (see there).
   StepStats step();
   /// \brief Iterations done so far.
   int iteration() const;

@@ -9,7 +9,10 @@
 /// - `{"type":"drop","iteration","removed","gaussians","low_confidence","unseen","closed_gate"}`:
 ///   one semantic-aware drop, with the counts of why Gaussians went;
 /// - `{"type":"closed_gates","iteration","removed","gaussians"}`: the removal of closed gates
-///   after the last iteration.
+///   after the last iteration;
+/// - `{"type":"recovery","iteration","removed","gaussians","closed_gate"}`: the start of the
+///   recovery phase (gates folded into the opacities): `closed_gate` Gaussians with a closed gate
+///   and `removed - closed_gate` least contributing ones removed.
 /// A resumed run first drops the records after the checkpoint's iteration (those steps are
 /// trained again), then appends: the log reads as one uninterrupted run.
 
@@ -22,13 +25,13 @@ namespace io {
 
 /// \brief One record of a train log.
 struct TrainLogRecord {
-  std::string type = "step";  ///< step, drop or closed_gates
+  std::string type = "step";  ///< step, drop, closed_gates or recovery
   int iteration = 0;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;  ///< step records
   double seconds = 0;                                ///< training time so far (step records)
   long long gaussians = 0;                           ///< Gaussians after the event
   long long removed = 0;                             ///< drop / closed_gates records
-  long long low_confidence = 0, unseen = 0, closed_gate = 0;  ///< drop: why they went
+  long long low_confidence = 0, unseen = 0, closed_gate = 0;  ///< drop (recovery): why they went
 };
 
 /// \brief Appends records to a JSON-lines train log, one flushed line each.

@@ -1,0 +1,79 @@
+// Blending-weight sums (the recovery phase's pruning score) against the rendered alpha: per
+// pixel the blending weights of all Gaussians add up to the accumulated alpha, so their sums over
+// the pixels add up to the alpha image's sum.
+#include <gtest/gtest.h>
+
+#include "sadsplat/gaussians/contribution.h"
+
+namespace sadsplat {
+namespace {
+
+using gaussians::GaussianParams;
+using gaussians::RasterCamera;
+
+// 64x48 pixels, focal length 60, at the origin looking along +z.
+RasterCamera camera(double centre_x = 0) {
+  RasterCamera c;
+  c.width = 64;
+  c.height = 48;
+  c.fx = c.fy = 60;
+  c.cx = 32;
+  c.cy = 24;
+  c.tvec = {-centre_x, 0, 0};
+  return c;
+}
+
+// Isotropic Gaussians at `centres` (x, y, z triples) with scale 0.3 and opacity 0.8.
+GaussianParams gaussiansAt(const std::vector<float>& centres) {
+  const std::int64_t n = static_cast<std::int64_t>(centres.size() / 3);
+  GaussianParams g;
+  g.means = at::tensor(centres, at::kFloat).view({n, 3});
+  g.quats = at::zeros({n, 4}, at::kFloat);
+  g.quats.select(1, 0).fill_(1);
+  g.log_scales = at::full({n, 3}, std::log(0.3f), at::kFloat);
+  g.opacity_logits = at::full({n}, std::log(0.8f / 0.2f), at::kFloat);
+  g.sh = at::full({n, 1, 3}, 0.5f, at::kFloat);
+  return g;
+}
+
+double alphaSum(const GaussianParams& g, const RasterCamera& c) {
+  gaussians::RenderSettings s;
+  s.sh_degree = 0;
+  s.features = false;
+  s.depth = false;
+  return gaussians::render(g, c, s).alpha.sum().item<double>();
+}
+
+TEST(Contribution, ScoresSumToTheRenderedAlphaAndHiddenOrUnseenGaussiansScoreZero) {
+  // In front; right behind it (partly hidden); behind the camera; far outside the image.
+  const GaussianParams g = gaussiansAt({0, 0, 5, 0, 0, 8, 0, 0, -5, 40, 0, 5});
+  const at::Tensor score = gaussians::blendingWeightSums(g, {camera()});
+  ASSERT_EQ(score.size(0), 4);
+  EXPECT_GT(score[0].item<double>(), 10.0);  // covers many pixels at up to 0.8
+  EXPECT_GT(score[1].item<double>(), 0.0);
+  EXPECT_LT(score[1].item<double>(), score[0].item<double>());  // behind the first
+  EXPECT_EQ(score[2].item<double>(), 0.0);
+  EXPECT_EQ(score[3].item<double>(), 0.0);
+  EXPECT_NEAR(score.sum().item<double>(), alphaSum(g, camera()), 1e-3 * alphaSum(g, camera()));
+
+  // Alone, a Gaussian's score is its alpha image's sum.
+  const GaussianParams one = gaussiansAt({0, 0, 8});
+  EXPECT_NEAR(gaussians::blendingWeightSums(one, {camera()})[0].item<double>(),
+              alphaSum(one, camera()), 1e-3 * alphaSum(one, camera()));
+}
+
+TEST(Contribution, SumsOverTheViewsAndAppliesTheGate) {
+  GaussianParams g = gaussiansAt({0, 0, 5, 1, 0, 6});
+  const at::Tensor a = gaussians::blendingWeightSums(g, {camera(0)});
+  const at::Tensor b = gaussians::blendingWeightSums(g, {camera(1)});
+  const at::Tensor both = gaussians::blendingWeightSums(g, {camera(0), camera(1)});
+  EXPECT_TRUE(at::allclose(both, a + b, 1e-5, 1e-4));
+  // A closed gate: the Gaussian renders nothing and scores 0; the other one is no longer hidden.
+  g.opacity_gate = at::tensor({0.0f, 1.0f});
+  const at::Tensor gated = gaussians::blendingWeightSums(g, {camera(0)});
+  EXPECT_EQ(gated[0].item<double>(), 0.0);
+  EXPECT_GT(gated[1].item<double>(), a[1].item<double>());
+}
+
+}  // namespace
+}  // namespace sadsplat
