@@ -263,8 +263,8 @@ int main(int argc, char** argv) {
   int train_recovery = -1;
   train
       ->add_option("--recovery", train_recovery,
-                   "with a drop: the last N iterations train without gates, L0 and drops, the "
-                   "gates folded into the opacities (not the paper; 0 = the paper's schedule)")
+                   "the last N iterations train without gates, L0 and drops, the gates folded "
+                   "into the opacities (not the paper; 0 = the paper's schedule)")
       ->check(CLI::NonNegativeNumber);
   double train_recovery_prune = -1;
   train

@@ -344,6 +344,22 @@ TEST_P(TrainerOnDevice, RecoveryPruneRemovesTheShareThatContributesLeast) {
   EXPECT_EQ(trainer.numGaussians(), open - s.recovery_pruned);
 }
 
+TEST_F(TrainerTest, RecoveryPruneWorksWithoutADrop) {
+  TrainConfig c = small(6);
+  c.recovery_iterations = 2;
+  c.recovery_prune = 0.5;
+  Trainer trainer(scene_, c);
+  const std::int64_t n = trainer.numGaussians();
+  gaussians::StepStats s;
+  for (int i = 0; i < 4; ++i) s = trainer.step();
+  EXPECT_TRUE(s.recovery_started);
+  EXPECT_EQ(s.recovery_closed_gates, 0);
+  EXPECT_EQ(s.recovery_pruned, n / 2);
+  EXPECT_EQ(trainer.numGaussians(), n - n / 2);
+  for (int i = 0; i < 2; ++i) trainer.step();
+  trainer.checkConsistency();
+}
+
 TEST_F(TrainerTest, ResumeAcrossTheRecoveryIsExact) {
   TrainConfig c = small(16);
   c.recovery_iterations = 8;

@@ -138,8 +138,8 @@ struct Trainer::State {
   // The first iteration of the recovery phase (TrainConfig::recovery_iterations): from there on
   // no gates, no L0 term and no drops. Past the end without a drop or a recovery.
   int recoveryStart() const {
-    return drop && config.recovery_iterations > 0 ? config.iterations - config.recovery_iterations
-                                                  : config.iterations + 1;
+    return config.recovery_iterations > 0 ? config.iterations - config.recovery_iterations
+                                          : config.iterations + 1;
   }
   // Whether iteration `it` (0-based) trains with the drop's gates.
   bool gated(int it) const { return drop && it < recoveryStart(); }
@@ -150,12 +150,14 @@ struct Trainer::State {
     return gated(iteration) ? drop->evaluationGate(p("log_alpha").value.detach()) : at::Tensor();
   }
 
-  // Start of the recovery phase: the Gaussians with a closed gate go, the other gates are folded
-  // into the opacities (and their log_alpha fixed open), then, with recovery_prune, the share of
-  // Gaussians that contribute least to the training views goes too. Returns {closed, pruned}.
+  // Start of the recovery phase: with a drop, the Gaussians with a closed gate go and the other
+  // gates are folded into the opacities (their log_alpha fixed open); then, with recovery_prune,
+  // the share of Gaussians that contribute least to the training views goes. Returns
+  // {closed, pruned}.
   std::pair<std::int64_t, std::int64_t> settleGates() {
     std::int64_t closed = 0, pruned = 0;
-    const at::Tensor gate = drop->evaluationGate(p("log_alpha").value.detach());
+    const at::Tensor gate =
+        drop ? drop->evaluationGate(p("log_alpha").value.detach()) : at::Tensor();
     if (gate.defined()) {
       const at::Tensor open = gate > 0;
       closed = n() - open.sum().item<std::int64_t>();

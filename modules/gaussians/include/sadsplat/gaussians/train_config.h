@@ -76,11 +76,11 @@ struct TrainConfig {
   double lambda_l0 = 0.2;
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
-  /// Not the paper: with a drop, the last `recovery_iterations` iterations train without gates,
-  /// L0 term and drops. At their start the Gaussians whose deterministic gate is closed go and
-  /// every other gate is folded into its opacity; the rest then adapts to the model that remains
-  /// (the gates' training noise had it render with opacities it never has at evaluation).
-  /// 0 = the paper's schedule (gates until the end).
+  /// Not the paper: the last `recovery_iterations` iterations train without gates, L0 term and
+  /// drops. At their start, with a drop, the Gaussians whose deterministic gate is closed go and
+  /// every other gate is folded into its opacity (and recovery_prune applies, with or without a
+  /// drop); the rest then adapts to the model that remains. 0 = the paper's schedule (gates until
+  /// the end).
   int recovery_iterations = 0;
   /// Not the paper: at the start of the recovery, also remove this share of the Gaussians with
   /// the smallest contribution to the training views (sum of their blending weights,
