@@ -7,6 +7,8 @@
 # belongs in fuzz/regressions/<target>/ once fixed (tests/fuzz replays it in every build).
 # The fuzzers run from a copy of their binaries (build-fuzz/run/), so that the build directory
 # can be rebuilt while a long run goes on; FUZZ_NICE=19 lets them yield the CPU to other work.
+# FUZZ_TIMEOUT (seconds, default 10) is libFuzzer's per-input limit: raise it when the fuzzers
+# share the CPU with other work, or a starved process reports a "timeout" that is none.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:?usage: fuzz.sh SECONDS_PER_TARGET [TARGET ...]}
@@ -29,7 +31,7 @@ for t in "${targets[@]}"; do
   cp "build-fuzz/bin/fuzz_$t" "$runner"
   # ASan's leak check stays on: a leak is a failure like a crash.
   /usr/bin/time -f "%U %S" -o "$log.cpu" nice -n "${FUZZ_NICE:-0}" "$runner" "build-fuzz/corpus/$t" "fuzz/corpus/$t" -max_total_time="$seconds" \
-    -timeout=10 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 \
+    -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 \
     -artifact_prefix="build-fuzz/crashes/$t/" >"$log" 2>&1 || true
   rm -f "$runner"
   cpu=$(awk '{printf "%d", $1 + $2}' "$log.cpu" 2>/dev/null || echo "?")
