@@ -11,7 +11,7 @@
 #        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt
 #        pseudo_labels_train_decoder = false (e.g. none_decgt_pl), _recN recovery_iterations = N
 #        and _cutX recovery_prune = X (e.g. full_p1_lambda0.2_rec1000_cut0.3_pl), _refssim
-#        fused_ssim = false.
+#        fused_ssim = false, _gthX densify_grad_threshold = X (fewer Gaussians without a drop).
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
 # summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
 # name suffix for the work dir and the outputs, so that two label variants can run side by side).
@@ -47,6 +47,7 @@ train_one() {
   case "$name" in *_lambda*) local l0=${name#*_lambda}; keys+=("\"lambda_l0\": ${l0%%_*}") ;; esac
   case "$name" in *_lp*) local lp=${name#*_lp}; keys+=("\"lambda_pseudo\": ${lp%%_*}") ;; esac
   case "$name" in *_decgt*) keys+=("\"pseudo_labels_train_decoder\": false") ;; esac
+  case "$name" in *_gth*) local gth=${name#*_gth}; keys+=("\"densify_grad_threshold\": ${gth%%_*}") ;; esac
   case "$name" in *_refssim*) keys+=("\"fused_ssim\": false") ;; esac
   case "$name" in *_rec*) local rec=${name#*_rec}; keys+=("\"recovery_iterations\": ${rec%%_*}") ;; esac
   case "$name" in *_cut*) local cut=${name#*_cut}; keys+=("\"recovery_prune\": ${cut%%_*}") ;; esac

@@ -4,7 +4,8 @@
 # the full method unprofiled (the clean wall time, then eval), the full method with --profile
 # and Net-1 (--drop none) with --profile, one training at a time.
 #   bash scripts/gpu/profile_training.sh [ITERATIONS=7000] [KIND_SEED ...]
-# RUNS (env) picks among full_plain full_profile none_plain none_profile.
+# RUNS (env) picks among full_plain full_profile none_plain none_profile. PL=1 (env): the full
+# runs train on the scene with the built-in pseudo-labels (the default method, Net-4); Net-1 never.
 # $OUT gets profile_<scene>_<run>.md, train logs, metrics and summary.txt.
 set -euo pipefail
 iterations="${1:-7000}"; shift $(( $# < 1 ? $# : 1 ))
@@ -22,11 +23,16 @@ for scene in "${scenes[@]}"; do
   cache="$work/${scene}_800x450.cache"
   [ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 \
     --cache "$cache" > "$out/synth_$scene.log" 2>&1
+  pl_cache="$work/${scene}_800x450_pl.cache"
+  if [ "${PL:-0}" = 1 ] && [ ! -f "$pl_cache" ]; then
+    "$bin" pseudo-labels "$cache" --out "$pl_cache" > "$out/pseudo_labels_$scene.log" 2>&1
+  fi
   for run in ${RUNS:-full_plain full_profile none_profile}; do
     drop=${run%_*}; flags=(); [ "${run#*_}" = profile ] && flags=(--profile)
+    scene_file="$cache"; [ "${PL:-0}" = 1 ] && [ "$drop" = full ] && scene_file="$pl_cache"
     dir="$work/${scene}_$run"; rm -rf "$dir"
     start=$(date +%s%N)
-    "$bin" train "$cache" --device cuda --iterations "$iterations" --drop "$drop" --out "$dir" \
+    "$bin" train "$scene_file" --device cuda --iterations "$iterations" --drop "$drop" --out "$dir" \
       "${flags[@]}" > "$out/train_${scene}_$run.log" 2>&1
     wall=$(( ($(date +%s%N) - start) / 1000000 ))
     gaussians=$(tr '\r' '\n' < "$out/train_${scene}_$run.log" | grep -o 'gaussians [0-9]*' | tail -1)
