@@ -9,7 +9,6 @@
 #include <c10/cuda/CUDAStream.h>
 #endif
 
-#include "sadsplat/common/error.h"
 #include "ssim_backend.h"
 
 namespace sadsplat {

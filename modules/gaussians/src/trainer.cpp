@@ -165,7 +165,7 @@ struct Trainer::State {
       const at::Tensor kept_gate = gate.index_select(0, open.nonzero().squeeze(1));
       Param& o = p("opacity");
       const at::Tensor folded = (at::sigmoid(o.value.detach()) * kept_gate).clamp(1e-6, 1 - 1e-6);
-      o.value = at::log(folded / (1 - folded)).contiguous().requires_grad_(true);
+      o.value = at::logit(folded).contiguous().requires_grad_(true);
       Param& la = p("log_alpha");
       la.value = at::full_like(la.value.detach(), kSettledLogAlpha).requires_grad_(true);
       la.m.zero_();
