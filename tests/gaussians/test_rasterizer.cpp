@@ -10,6 +10,7 @@
 #include <random>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/rasterizer.h"
 
 namespace sadsplat {
@@ -286,6 +287,64 @@ TEST(Rasterizer, TiledRenderEqualsABruteForceComposite) {
   }
   EXPECT_LT(worst, 1e-12);
   EXPECT_GT(out[1].max().item<double>(), 0.5);  // the scene does cover the image
+}
+
+TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
+  // The binning radius: every pixel centre of the 3-sigma box where pixelAlpha is non-zero lies
+  // inside the box of half-width alphaExtent; faint Gaussians get less than their 3-sigma radius, Gaussians that
+  // cannot reach 1/255 get none, opaque ones keep the 3-sigma radius.
+  using gaussians::raster::alphaExtent;
+  gaussians::raster::Camera<double> cam{};
+  cam.R[0] = cam.R[4] = cam.R[8] = 1;
+  cam.fx = cam.fy = 60;
+  cam.cx = 40;
+  cam.cy = 30;
+  cam.width = 80;
+  cam.height = 60;
+  cam.near_plane = 0.01;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int shrunk = 0, checked = 0;
+  for (int k = 0; k < 60; ++k) {
+    const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
+    const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
+    const double log_scale[3] = {std::log(0.02 + 0.06 * (1 + u(rng))),
+                                 std::log(0.02 + 0.06 * (1 + u(rng))),
+                                 std::log(0.02 + 0.06 * (1 + u(rng)))};
+    gaussians::raster::Projected<double> p;
+    ASSERT_TRUE(gaussians::raster::projectGaussian(mean, quat, log_scale, cam, &p));
+    for (double opacity : {1.0 / 300, 1.0 / 255, 0.0045, 0.01, 0.1, 0.5, 0.99, 1.0}) {
+      const int extent = alphaExtent(p.radius, opacity);
+      EXPECT_LE(extent, p.radius);
+      if (opacity >= 0.99) {
+        EXPECT_EQ(extent, p.radius);
+      }
+      if (opacity < 1.0 / 255) {
+        EXPECT_EQ(extent, 0);
+      }
+      shrunk += extent < p.radius;
+      for (int py = -p.radius - 2; py <= p.radius + 2; ++py) {
+        for (int px = -p.radius - 2; px <= p.radius + 2; ++px) {
+          const double x = std::floor(p.mean2d[0]) + px + 0.5, y = std::floor(p.mean2d[1]) + py + 0.5;
+          double G = 0;
+          bool clamped = false;
+          if (gaussians::raster::pixelAlpha(p.mean2d, p.conic, opacity, x, y, &G, &clamped) == 0) {
+            continue;
+          }
+          // Past the 3-sigma box an opaque Gaussian can still reach 1/255 (out to ~3.3 sigma);
+          // the rasterizer cuts it there by design (as the reference 3DGS rasterizer does).
+          if (std::abs(x - p.mean2d[0]) > p.radius || std::abs(y - p.mean2d[1]) > p.radius) continue;
+          ++checked;
+          EXPECT_LE(std::abs(x - p.mean2d[0]), extent) << "Gaussian " << k << " opacity " << opacity;
+          EXPECT_LE(std::abs(y - p.mean2d[1]), extent) << "Gaussian " << k << " opacity " << opacity;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 10000);
+  EXPECT_GT(shrunk, 200);  // 0.0045 ... 0.5 shrink the box for every Gaussian
+  EXPECT_EQ(alphaExtent(10, std::nan("")), 0);
+  EXPECT_EQ(alphaExtent(0, 1.0), 0);
 }
 
 // Without features and depth (what training renders for a view with no semantic loss) the colour,

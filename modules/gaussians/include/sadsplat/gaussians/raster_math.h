@@ -55,6 +55,15 @@ SADSPLAT_HD T msqrt(T x) {
 }
 
 template <typename T>
+SADSPLAT_HD T mlog(T x) {
+#if defined(__CUDA_ARCH__)
+  return log(x);
+#else
+  return std::log(x);
+#endif
+}
+
+template <typename T>
 SADSPLAT_HD T mceil(T x) {
 #if defined(__CUDA_ARCH__)
   return ceil(x);
@@ -342,7 +351,7 @@ SADSPLAT_HD T gaussianPower(const T conic[3], T dx, T dy) {
   return T(-0.5) * (conic[0] * dx * dx + conic[2] * dy * dy) - conic[1] * dx * dy;
 }
 
-/// Tiles touched by a Gaussian's 3-sigma box: [x0, x1) x [y0, y1), clamped to the grid.
+/// Tiles touched by a Gaussian's box of half-width `radius` (its alphaExtent): [x0, x1) x [y0, y1), clamped to the grid.
 template <typename T>
 SADSPLAT_HD void tileRect(const T mean2d[2], int radius, int tiles_x, int tiles_y, int* x0, int* y0,
                           int* x1, int* y1) {
@@ -351,6 +360,22 @@ SADSPLAT_HD void tileRect(const T mean2d[2], int radius, int tiles_x, int tiles_
   *y0 = mmax(0, static_cast<int>(floorOf((mean2d[1] - radius) / size)));
   *x1 = mmin(tiles_x, static_cast<int>(floorOf((mean2d[0] + radius) / size)) + 1);
   *y1 = mmin(tiles_y, static_cast<int>(floorOf((mean2d[1] + radius) / size)) + 1);
+}
+
+/// The screen radius that holds every pixel where a Gaussian of this opacity reaches kMinAlpha,
+/// for binning: opacity * exp(-d^2 / (2 lambda)) >= 1/255 needs d <= sqrt(2 ln(255 opacity))
+/// sqrt(lambda), and `radius` (the 3-sigma radius) >= 3 sqrt(lambda); so the 3-sigma radius
+/// scaled by min(1, sqrt(2 ln(255 opacity)) / 3), rounded up, and 0 when no pixel can reach
+/// kMinAlpha. A pixel outside it would be skipped by pixelAlpha anyway: renders are unchanged,
+/// faint Gaussians just touch fewer tiles (gsplat bounds its tiles by opacity as well).
+template <typename T>
+SADSPLAT_HD int alphaExtent(int radius, T opacity) {
+  // 1 % margin on the opacity, against rounding at the threshold.
+  const T q = opacity * T(1.01 / kMinAlpha);
+  if (!(q > T(1)) || radius <= 0) return 0;
+  const T k = msqrt(T(2) * mlog(q)) / T(3);
+  if (!(k < T(1))) return radius;
+  return static_cast<int>(mceil(k * T(radius)));
 }
 
 /// Alpha of a Gaussian at a pixel centre (px, py), or 0 when it is skipped (power > 0 or alpha
