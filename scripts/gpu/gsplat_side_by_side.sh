@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run ON THE GPU MACHINE from the repository root: sadsplat against gsplat in one call.
+# Run ON THE GPU MACHINE from the repository root: sadsplat against gsplat in one run of this script.
 # Needs .deps/debs (scripts/gpu/fetch_deps.sh) and .deps/gsplat (gsplat's source with Debian's
 # glm headers: scripts/gsplat_reference/README.md) carried along.
 #   [LIMIT=590] [GSPLAT_RUNS="ref"] bash scripts/gpu/gsplat_side_by_side.sh [bench] [SCENE ...]
@@ -39,7 +39,7 @@ export PYTHONPATH=/tmp/gsplat-src
   touch /tmp/pyshim/rich/__init__.py
   export PYTHONPATH=/tmp/gsplat-src:/tmp/pyshim
 }
-# A gsplat extension built by an earlier call (.deps/gsplat-prebuilt/*.so, same flags) saves the
+# A gsplat extension built by an earlier run (.deps/gsplat-prebuilt/*.so, same flags) saves the
 # ~3 minutes of the JIT build: gsplat imports `gsplat.csrc` first, so a small module of that name
 # loads it.
 prebuilt=$(ls .deps/gsplat-prebuilt/*.so 2>/dev/null | head -1)
@@ -139,4 +139,4 @@ for r in rows:
     print("| %s | %s | %.1f | %d | %.2f | %.2f |" % r)
 PY
 tar czf "$out/side_by_side.tgz" -C "$work" logs $(cd "$work" && ls *.json 2>/dev/null)
-echo "call total $(( $(date +%s) - start )) s" | tee -a "$summary"
+echo "total $(( $(date +%s) - start )) s" | tee -a "$summary"

@@ -10,7 +10,7 @@
 #              both) x training seeds 0-2
 #   pbase      the 3 seed-0 scenes x full drop with pseudo-labels, P_base 0 / 0.5 / 1 / 1.5 / 2
 #              (configurations full_p0 ... full_p2) x training seeds 0-2
-# Env: SCENES, CONFIGS, SEEDS restrict the lists; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
+# Env: SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
 # WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup (e.g. a quick CPU check).
 # No run starts after DEADLINE_S and every run stops at it. $OUT gets table_TABLE.tgz (the new
 # metrics.json files in the layout above, plus train logs) and table_TABLE.txt (what ran, how long):
@@ -105,7 +105,9 @@ for scene in "${scenes[@]}"; do
   [ "$(left)" -le 30 ] && break
   prepare "$scene" "$needs_pl" || { echo "$scene: preparation stopped" | tee -a "$log"; break; }
   for item in "${todo[@]}"; do
-    [ "$(left)" -le 30 ] && break
+    # A run started too late is killed at the deadline and wasted: MIN_RUN_S is what one run
+    # needs at the chosen parallelism (~270-330 s with 6 at once on an H100).
+    [ "$(left)" -le "${MIN_RUN_S:-30}" ] && break
     while [ "$(jobs -rp | wc -l)" -ge "$parallel" ]; do wait -n; done
     run_one "$scene" "${item%%:*}" "${item##*:}" &
     pending=$((pending + 1))
