@@ -322,8 +322,16 @@ __global__ void __launch_bounds__(kBlock)
   for (int c = 0; c < D; ++c) my_gpix[c] = inside ? g_image[pix * D + c] : 0.f;
   float trans = final_trans;
   float last_alpha = 0.f;
+  // List entries behind every pixel's last contributor add nothing: start at the block's
+  // largest `last` instead of the list's end (at 1M Gaussians most of a tile's list lies there).
+  __shared__ int s_end;
+  if (threadIdx.x == 0) s_end = 0;
+  __syncthreads();
+  if (last > 0) atomicMax(&s_end, last);
+  __syncthreads();
+  const int end = min(stop, start + s_end);
 
-  for (int batch_end = stop; batch_end > start; batch_end -= kBlock) {
+  for (int batch_end = end; batch_end > start; batch_end -= kBlock) {
     __syncthreads();
     const int k = batch_end - 1 - threadIdx.x;
     if (k >= start) {
