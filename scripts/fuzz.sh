@@ -9,8 +9,14 @@
 # can be rebuilt while a long run goes on; FUZZ_NICE=19 lets them yield the CPU to other work.
 # FUZZ_TIMEOUT (seconds, default 10) is libFuzzer's per-input limit: raise it when the fuzzers
 # share the CPU with other work, or a starved process reports a "timeout" that is none.
+# With the kernel's autogroup scheduling (Debian's default) `nice` only ranks processes inside one
+# session: FUZZ_NICE also lowers this session's group, so start the script in its own session
+# (`setsid bash scripts/fuzz.sh ...`) or it lowers the shell it was started from as well.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ -n "${FUZZ_NICE:-}" ] && [ -w /proc/self/autogroup ]; then
+  echo "$FUZZ_NICE" > /proc/self/autogroup 2>/dev/null || true
+fi
 seconds=${1:?usage: fuzz.sh SECONDS_PER_TARGET [TARGET ...]}
 shift
 targets=("$@")
