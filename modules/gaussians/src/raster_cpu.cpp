@@ -200,7 +200,8 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const T* co = conics.data_ptr<T>();
     const T* op = opacities.data_ptr<T>();
     const T* val = values.data_ptr<T>();
-    out.binning = binGaussians(m2, radii.data_ptr<int>(), op, depths.data_ptr<T>(), n, width, height);
+    out.binning =
+        binGaussians(m2, radii.data_ptr<int>(), op, depths.data_ptr<T>(), n, width, height);
     const int* ranges = out.binning.tile_ranges.data_ptr<int>();
     const int* ids = out.binning.gaussian_ids.data_ptr<int>();
     T* img = out.image.data_ptr<T>();

@@ -91,9 +91,8 @@ __global__ void shBackwardKernel(int64_t n, int64_t K, int degree, float3 campos
 // ---- binning ---------------------------------------------------------------------------------
 
 __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
-                                 const int* __restrict__ radii,
-                                 const float* __restrict__ opacities, int tiles_x, int tiles_y,
-                                 int64_t* counts) {
+                                 const int* __restrict__ radii, const float* __restrict__ opacities,
+                                 int tiles_x, int tiles_y, int64_t* counts) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   int64_t count = 0;
@@ -108,8 +107,7 @@ __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
 
 // Key = tile id (high 32 bits) | depth's float bits (positive floats sort like their bits).
 __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
-                                const int* __restrict__ radii,
-                                const float* __restrict__ opacities,
+                                const int* __restrict__ radii, const float* __restrict__ opacities,
                                 const float* __restrict__ depths,
                                 const int64_t* __restrict__ offsets, int tiles_x, int tiles_y,
                                 int64_t* keys, int* values) {
@@ -153,10 +151,9 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
     return b;
   }
   at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
-  countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(n, means2d.data_ptr<float>(),
-                                                            radii.data_ptr<int>(),
-                                                            opacities.data_ptr<float>(), tiles_x,
-                                                            tiles_y, counts.data_ptr<int64_t>());
+  countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
+      n, means2d.data_ptr<float>(), radii.data_ptr<int>(), opacities.data_ptr<float>(), tiles_x,
+      tiles_y, counts.data_ptr<int64_t>());
   checkLaunch("countTilesKernel");
   const at::Tensor offsets = counts.cumsum(0);
   const int64_t m = offsets[n - 1].item<int64_t>();
@@ -165,9 +162,8 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
   if (m > 0) {
     writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
         n, means2d.data_ptr<float>(), radii.data_ptr<int>(), opacities.data_ptr<float>(),
-        depths.data_ptr<float>(),
-        offsets.data_ptr<int64_t>(), tiles_x, tiles_y, keys.data_ptr<int64_t>(),
-        values.data_ptr<int>());
+        depths.data_ptr<float>(), offsets.data_ptr<int64_t>(), tiles_x, tiles_y,
+        keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     // Stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
     auto sorted = at::sort(keys, /*stable=*/true, /*dim=*/0, /*descending=*/false);

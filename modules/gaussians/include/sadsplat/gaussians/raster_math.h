@@ -351,7 +351,8 @@ SADSPLAT_HD T gaussianPower(const T conic[3], T dx, T dy) {
   return T(-0.5) * (conic[0] * dx * dx + conic[2] * dy * dy) - conic[1] * dx * dy;
 }
 
-/// Tiles touched by a Gaussian's box of half-width `radius` (its alphaExtent): [x0, x1) x [y0, y1), clamped to the grid.
+/// Tiles touched by a Gaussian's box of half-width `radius` (its alphaExtent): [x0, x1) x [y0, y1),
+/// clamped to the grid.
 template <typename T>
 SADSPLAT_HD void tileRect(const T mean2d[2], int radius, int tiles_x, int tiles_y, int* x0, int* y0,
                           int* x1, int* y1) {
