@@ -2,6 +2,10 @@
 // for random in-frustum Gaussians, on CPU or CUDA. Prints one table row per configuration.
 //   sadsplat_bench_rasterizer [--device cpu|cuda] [--gaussians 100000,500000,1000000]
 //                             [--features 0,32] [--width 800] [--height 450] [--repeats 20]
+//                             [--profile]
+// --profile adds, per configuration, the time of each step of the rasterizer (projection, SH,
+// binning, sort, rasterization and their backward passes) from `repeats` more iterations in which
+// every step waits for the device (see step_profile.h), and the peak device memory.
 #include <CLI/CLI.hpp>
 
 #include <ATen/Context.h>
@@ -11,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -20,6 +25,7 @@
 
 #include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/gaussians/step_profile.h"
 
 namespace {
 
@@ -69,6 +75,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats)->capture_default_str();
   app.add_option("--warmup", warmup)->capture_default_str();
   app.add_option("--threads", threads, "CPU threads")->capture_default_str();
+  bool profile_steps = false;
+  app.add_flag("--profile", profile_steps, "also time each step of the rasterizer");
   CLI11_PARSE(app, argc, argv);
   sadsplat::gaussians::setCpuThreads(std::max(1, threads));
   const at::Device device = device_name == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU);
@@ -88,6 +96,7 @@ int main(int argc, char** argv) {
   std::printf(
       "| gaussians | features | tile hits / gaussian | forward ms | forward+backward ms |\n");
   std::printf("|---|---|---|---|---|\n");
+  std::string profiles;  // --profile: printed after the timing table
   for (int64_t n : counts) {
     for (int64_t c : feature_dims) {
       const GaussianParams g = randomInFrustum(n, c, cam, device);
@@ -122,7 +131,22 @@ int main(int argc, char** argv) {
                   static_cast<long long>(c), tiles_per_gaussian, fwd_ms / repeats,
                   both_ms / repeats);
       std::fflush(stdout);
+      if (profile_steps) {
+        sadsplat::gaussians::StepProfile profile(device);
+        const sadsplat::gaussians::ActiveProfileScope active(&profile);
+        for (int it = 0; it < repeats; ++it) {
+          profile.enter("forward+backward: forward");
+          const auto r2 = sadsplat::gaussians::render(g, cam);
+          profile.enter("forward+backward: backward");
+          (r2.rgb.sum() + r2.features.sum()).backward();
+          profile.leave();
+          profile.countIteration();
+        }
+        profiles += "\nSteps of forward+backward, " + std::to_string(n) + " Gaussians, " +
+                    std::to_string(c) + " features:\n\n" + profile.table();
+      }
     }
   }
+  std::printf("%s", profiles.c_str());
   return 0;
 }

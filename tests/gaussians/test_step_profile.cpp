@@ -36,6 +36,60 @@ TEST(StepProfile, EachPhaseGetsTheTimeUntilTheNextOne) {
   EXPECT_NE(table.find("(1 iterations)"), std::string::npos);
 }
 
+TEST(StepProfile, NestedPhasesKeepTheirOwnTimeAndAddUpToTheTotal) {
+  StepProfile profile(at::Device(at::kCPU));
+  {
+    // No active profile: a ScopedPhase records nothing.
+    const gaussians::ScopedPhase ignored("nowhere");
+  }
+  const gaussians::ActiveProfileScope active(&profile);
+  {
+    const gaussians::ScopedPhase outside("outside");  // no open phase: nothing either
+  }
+  profile.enter("outer");
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  {
+    const gaussians::ScopedPhase inner("inner");
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    {
+      const gaussians::ScopedPhase deepest("deepest");
+      std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    }
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  profile.leave();
+  EXPECT_EQ(gaussians::activeProfile(), &profile);
+  // Exclusive times: counting a nested phase in its parent as well would add >= 60 ms.
+  EXPECT_GE(profile.seconds("outer"), 0.040);
+  EXPECT_LT(profile.seconds("outer"), 0.040 + 0.040);
+  EXPECT_GE(profile.seconds("outer / inner"), 0.020);
+  EXPECT_LT(profile.seconds("outer / inner"), 0.020 + 0.040);
+  EXPECT_GE(profile.seconds("outer / inner / deepest"), 0.060);
+  EXPECT_EQ(profile.seconds("nowhere"), 0.0);
+  EXPECT_EQ(profile.seconds("outside"), 0.0);
+  EXPECT_DOUBLE_EQ(profile.totalSeconds(), profile.seconds("outer") +
+                                               profile.seconds("outer / inner") +
+                                               profile.seconds("outer / inner / deepest"));
+  EXPECT_EQ(profile.peakAllocatedBytes("outer"), 0);  // CPU: no device memory
+  const std::string table = profile.table();
+  EXPECT_NE(table.find("| outer / inner / deepest |"), std::string::npos);
+  EXPECT_EQ(table.find("peak allocated"), std::string::npos);
+}
+
+TEST(StepProfile, TheActiveProfileScopeRestoresThePreviousOne) {
+  StepProfile a(at::Device(at::kCPU)), b(at::Device(at::kCPU));
+  EXPECT_EQ(gaussians::activeProfile(), nullptr);
+  {
+    const gaussians::ActiveProfileScope first(&a);
+    {
+      const gaussians::ActiveProfileScope second(&b);
+      EXPECT_EQ(gaussians::activeProfile(), &b);
+    }
+    EXPECT_EQ(gaussians::activeProfile(), &a);
+  }
+  EXPECT_EQ(gaussians::activeProfile(), nullptr);
+}
+
 TEST(StepProfile, AProfiledTrainingTimesEveryPhaseAndGivesTheSameModel) {
   const io::Scene scene =
       io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
@@ -58,6 +112,13 @@ TEST(StepProfile, AProfiledTrainingTimesEveryPhaseAndGivesTheSameModel) {
                             "densify, prune, reset", "loss values to host"}) {
     EXPECT_GT(profile->seconds(phase), 0.0) << phase;
   }
+  // The rasterizer's steps, nested in the trainer's phases (the CPU backward runs in this thread).
+  for (const char* phase : {"render forward / project", "render forward / SH",
+                            "render forward / rasterize", "render forward / rasterize / binning",
+                            "backward / rasterize backward", "backward / project backward"}) {
+    EXPECT_GT(profile->seconds(phase), 0.0) << phase;
+  }
+  EXPECT_EQ(gaussians::activeProfile(), nullptr);  // step() restored it
   EXPECT_TRUE(at::equal(plain.parameters().means, profiled.parameters().means));
 }
 

@@ -9,6 +9,7 @@
 #include <c10/cuda/CUDAStream.h>
 #endif
 
+#include "sadsplat/gaussians/step_profile.h"
 #include "ssim_backend.h"
 
 namespace sadsplat {
@@ -44,6 +45,7 @@ void* currentStream(const at::Tensor& t) {
 class FusedSsim : public torch::autograd::Function<FusedSsim> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a, const at::Tensor& b) {
+    const ScopedPhase phase("SSIM");
     const c10::cuda::CUDAGuard guard(a.device());
     const at::Tensor ac = a.contiguous(), bc = b.contiguous();
     auto [map, partials] = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
@@ -53,6 +55,7 @@ class FusedSsim : public torch::autograd::Function<FusedSsim> {
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const at::Tensor& a = saved[0];
+    const ScopedPhase phase("SSIM backward");
     const c10::cuda::CUDAGuard guard(a.device());
     const at::Tensor upstream = grads[0].to(at::kFloat).contiguous();
     at::Tensor grad = ssim_fused::backwardCuda(a, saved[1], saved[2], upstream, currentStream(a));

@@ -11,6 +11,7 @@
 
 #include "raster_backend.h"
 #include "sadsplat/gaussians/raster_math.h"
+#include "sadsplat/gaussians/step_profile.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -131,6 +132,7 @@ namespace {
 template <typename T>
 Binning binGaussians(const T* means2d, const int* radii, const T* opacities, const T* depths,
                      int64_t n, int width, int height) {
+  const ScopedPhase phase("binning");
   const auto [tiles_x, tiles_y] = tileGrid(width, height);
   const int num_tiles = tiles_x * tiles_y;
   std::vector<std::vector<int>> lists(num_tiles);

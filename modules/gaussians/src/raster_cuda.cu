@@ -8,6 +8,7 @@
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
+#include "sadsplat/gaussians/step_profile.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -142,6 +143,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
                      const at::Tensor& opacities, const at::Tensor& depths, int width, int height,
                      cudaStream_t stream) {
   const int64_t n = means2d.size(0);
+  const ScopedPhase phase("binning");
   const auto [tiles_x, tiles_y] = tileGrid(width, height);
   const auto opts = means2d.options();
   Binning b;
@@ -166,6 +168,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
         keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     // Stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
+    const ScopedPhase sort_phase("sort");
     auto sorted = at::sort(keys, /*stable=*/true, /*dim=*/0, /*descending=*/false);
     keys = std::get<0>(sorted);
     values = values.index_select(0, std::get<1>(sorted)).contiguous();

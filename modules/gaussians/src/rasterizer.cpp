@@ -15,6 +15,7 @@
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
+#include "sadsplat/gaussians/step_profile.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -83,6 +84,7 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
                                const at::Tensor& quats, const at::Tensor& log_scales,
                                const std::vector<double>& camera) {
     const CameraParams cam = unpackCamera(camera);
+    const ScopedPhase phase("project");
     const at::Tensor m = means.contiguous(), q = quats.contiguous(), s = log_scales.contiguous();
     raster::ProjectionResult r;
     if (m.is_cuda()) {
@@ -104,6 +106,7 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const at::Tensor &m = saved[0], &q = saved[1], &s = saved[2], &radii = saved[3];
+    const ScopedPhase phase("project backward");
     const CameraParams cam = unpackCamera(ctx->saved_data["camera"].toDoubleVector());
     const at::Tensor g_m2 = orZeros(grads[0], at::empty({m.size(0), 2}, m.options()));
     const at::Tensor g_co = orZeros(grads[1], at::empty({m.size(0), 3}, m.options()));
@@ -128,6 +131,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                const at::Tensor& conics, const at::Tensor& opacities,
                                const at::Tensor& values, const at::Tensor& radii,
                                const at::Tensor& depths, int64_t width, int64_t height) {
+    const ScopedPhase phase("rasterize");
     const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
                      op = opacities.contiguous(), val = values.contiguous();
     raster::RasterResult r;
@@ -158,6 +162,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     raster::RasterResult fwd;
+    const ScopedPhase phase("rasterize backward");
     fwd.alpha = ctx->saved_data["alpha"].toTensor();
     fwd.last = ctx->saved_data["last"].toTensor();
     fwd.binning.tile_ranges = ctx->saved_data["tile_ranges"].toTensor();
@@ -188,6 +193,7 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
   static variable_list forward(AutogradContext* ctx, const at::Tensor& sh, const at::Tensor& means,
                                const std::vector<double>& camera) {
     const at::Tensor s = sh.contiguous(), m = means.contiguous();
+    const ScopedPhase phase("SH");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
     at::Tensor colors;
@@ -209,6 +215,7 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const auto camera = ctx->saved_data["camera"].toDoubleVector();
+    const ScopedPhase phase("SH backward");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
     const at::Tensor g = orZeros(grads[0], at::empty({saved[1].size(0), 3}, saved[1].options()));

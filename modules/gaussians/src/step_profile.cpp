@@ -1,15 +1,52 @@
 #include "sadsplat/gaussians/step_profile.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <numeric>
 
 #if SADSPLAT_HAVE_CUDA
+#include <c10/cuda/CUDACachingAllocator.h>
 #include <c10/cuda/CUDAFunctions.h>
 #endif
 
 namespace sadsplat {
 namespace gaussians {
+namespace {
+
+std::atomic<StepProfile*> g_active{nullptr};
+
+struct DevicePeaks {
+  std::int64_t allocated = 0;
+  std::int64_t reserved = 0;
+};
+
+// The caching allocator's peaks since the last resetDevicePeaks() (index 0 of its stat arrays is
+// the aggregate over pool kinds).
+DevicePeaks devicePeaks(const at::Device& device) {
+#if SADSPLAT_HAVE_CUDA
+  if (device.is_cuda()) {
+    const auto stats =
+        c10::cuda::CUDACachingAllocator::getDeviceStats(device.has_index() ? device.index() : 0);
+    return {stats.allocated_bytes[0].peak, stats.reserved_bytes[0].peak};
+  }
+#else
+  (void)device;
+#endif
+  return {};
+}
+
+void resetDevicePeaks(const at::Device& device) {
+#if SADSPLAT_HAVE_CUDA
+  if (device.is_cuda()) {
+    c10::cuda::CUDACachingAllocator::resetPeakStats(device.has_index() ? device.index() : 0);
+  }
+#else
+  (void)device;
+#endif
+}
+
+}  // namespace
 
 void synchronizeDevice(const at::Device& device) {
 #if SADSPLAT_HAVE_CUDA
@@ -19,51 +56,110 @@ void synchronizeDevice(const at::Device& device) {
 #endif
 }
 
+StepProfile* activeProfile() { return g_active.load(); }
+void setActiveProfile(StepProfile* profile) { g_active.store(profile); }
+
 StepProfile::StepProfile(const at::Device& device) : device_(device) {}
+
+int StepProfile::indexOf(const std::string& name) {
+  const auto it =
+      std::find_if(phases_.begin(), phases_.end(), [&](const Phase& p) { return p.name == name; });
+  if (it != phases_.end()) return static_cast<int>(it - phases_.begin());
+  phases_.push_back(Phase{name});
+  return static_cast<int>(phases_.size()) - 1;
+}
+
+void StepProfile::closeSlice() {
+  synchronizeDevice(device_);
+  const auto now = std::chrono::steady_clock::now();
+  if (stack_.empty()) return;
+  Phase& p = phases_[static_cast<std::size_t>(stack_.back())];
+  p.seconds += std::chrono::duration<double>(now - start_).count();
+  const DevicePeaks peaks = devicePeaks(device_);
+  p.peak_allocated = std::max(p.peak_allocated, peaks.allocated);
+  peak_reserved_ = std::max(peak_reserved_, peaks.reserved);
+}
+
+void StepProfile::openSlice() {
+  resetDevicePeaks(device_);
+  start_ = std::chrono::steady_clock::now();  // closeSlice() has synchronised the device
+}
 
 void StepProfile::enter(const std::string& name) {
   leave();
-  const auto it = std::find(names_.begin(), names_.end(), name);
-  current_ = static_cast<int>(it - names_.begin());
-  if (it == names_.end()) {
-    names_.push_back(name);
-    seconds_.push_back(0.0);
-  }
-  start_ = std::chrono::steady_clock::now();  // leave() has synchronised the device
+  push(name);
 }
 
 void StepProfile::leave() {
-  synchronizeDevice(device_);
-  const auto now = std::chrono::steady_clock::now();
-  if (current_ >= 0) {
-    seconds_[static_cast<std::size_t>(current_)] +=
-        std::chrono::duration<double>(now - start_).count();
-  }
-  current_ = -1;
+  closeSlice();
+  stack_.clear();
+}
+
+void StepProfile::push(const std::string& name) {
+  closeSlice();
+  const std::string full =
+      stack_.empty() ? name : phases_[static_cast<std::size_t>(stack_.back())].name + " / " + name;
+  stack_.push_back(indexOf(full));
+  openSlice();
+}
+
+void StepProfile::pop() {
+  closeSlice();
+  if (!stack_.empty()) stack_.pop_back();
+  if (!stack_.empty()) openSlice();
 }
 
 double StepProfile::seconds(const std::string& name) const {
-  const auto it = std::find(names_.begin(), names_.end(), name);
-  return it == names_.end() ? 0.0 : seconds_[static_cast<std::size_t>(it - names_.begin())];
+  for (const Phase& p : phases_) {
+    if (p.name == name) return p.seconds;
+  }
+  return 0.0;
+}
+
+std::int64_t StepProfile::peakAllocatedBytes(const std::string& name) const {
+  for (const Phase& p : phases_) {
+    if (p.name == name) return p.peak_allocated;
+  }
+  return 0;
 }
 
 double StepProfile::totalSeconds() const {
-  return std::accumulate(seconds_.begin(), seconds_.end(), 0.0);
+  return std::accumulate(phases_.begin(), phases_.end(), 0.0,
+                         [](double sum, const Phase& p) { return sum + p.seconds; });
 }
 
 std::string StepProfile::table() const {
   const double total = totalSeconds();
   const double per = 1000.0 / std::max(1, iterations_);
-  std::string out = "| phase | total s | ms / iteration | share |\n|---|---|---|---|\n";
-  char line[256];
-  for (std::size_t k = 0; k < names_.size(); ++k) {
-    std::snprintf(line, sizeof line, "| %s | %.3f | %.3f | %.1f %% |\n", names_[k].c_str(),
-                  seconds_[k], seconds_[k] * per, total > 0 ? 100.0 * seconds_[k] / total : 0.0);
+  const bool memory = device_.is_cuda();
+  constexpr double kMiB = 1024.0 * 1024.0;
+  std::string out = memory ? "| phase | total s | ms / iteration | share | peak allocated MiB |\n"
+                             "|---|---|---|---|---|\n"
+                           : "| phase | total s | ms / iteration | share |\n|---|---|---|---|\n";
+  char line[512];
+  std::int64_t peak = 0;
+  for (const Phase& p : phases_) {
+    std::snprintf(line, sizeof line, "| %s | %.3f | %.3f | %.1f %% |", p.name.c_str(), p.seconds,
+                  p.seconds * per, total > 0 ? 100.0 * p.seconds / total : 0.0);
+    out += line;
+    if (memory) {
+      std::snprintf(line, sizeof line, " %.0f |", p.peak_allocated / kMiB);
+      out += line;
+    }
+    out += "\n";
+    peak = std::max(peak, p.peak_allocated);
+  }
+  std::snprintf(line, sizeof line, "| **total** (%d iterations) | %.3f | %.3f | 100 %% |%s\n",
+                iterations_, total, total * per, memory ? " |" : "");
+  out += line;
+  if (memory) {
+    std::snprintf(line, sizeof line,
+                  "\nDevice memory over the profiled phases: peak allocated %.0f MiB, peak "
+                  "reserved by the caching allocator %.0f MiB.\n",
+                  peak / kMiB, peak_reserved_ / kMiB);
     out += line;
   }
-  std::snprintf(line, sizeof line, "| **total** (%d iterations) | %.3f | %.3f | 100 %% |\n",
-                iterations_, total, total * per);
-  return out + line;
+  return out;
 }
 
 }  // namespace gaussians

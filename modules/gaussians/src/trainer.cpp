@@ -461,6 +461,7 @@ StepStats Trainer::step() {
   const TrainConfig& c = s.config;
   const int it = s.iteration;
   StepProfile* profile = s.profile.get();
+  const ActiveProfileScope active(profile);  // the rasterizer's steps show as nested phases
   enterPhase(profile, "views and parameters");
   // Position learning rate: exponential from init to final over the run (3DGS).
   const double t = std::min(1.0, static_cast<double>(it) / std::max(1, c.iterations));

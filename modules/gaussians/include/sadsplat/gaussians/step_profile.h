@@ -5,10 +5,17 @@
 /// and before it stops, so on a GPU the split is exact but the run is slower than an unprofiled
 /// one (the CPU can no longer queue work ahead of the GPU); compare the total with an unprofiled
 /// run to see what the synchronisation itself costs.
+///
+/// Phases nest: library code deeper down (the rasterizer's steps, the SSIM) opens a
+/// ScopedPhase, which the active profile (setActiveProfile / ActiveProfileScope) records as
+/// "parent / name". A phase's time is its own (exclusive): the time of the phases nested in it
+/// is not counted twice, so the phases still add up to the total. On a CUDA device each phase
+/// also records the largest amount of device memory allocated while it ran.
 
 #include <ATen/ATen.h>
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,8 +26,9 @@ namespace gaussians {
 /// \brief Blocks until every kernel queued on `device` has finished (no-op on the CPU).
 void synchronizeDevice(const at::Device& device);
 
-/// \brief Accumulated wall time per phase of training steps. One phase runs at a time:
-/// enter() ends the current phase and starts the next, leave() ends it.
+/// \brief Accumulated wall time (and, on CUDA, peak device memory) per phase of training steps.
+/// enter() ends the current phase and starts the next at the top level, push() opens a phase
+/// nested in the current one, pop() closes it, leave() closes all.
 class StepProfile {
  public:
   using Ptr = std::shared_ptr<StepProfile>;
@@ -28,34 +36,95 @@ class StepProfile {
   /// \param[in] device the device whose queue each phase boundary waits for
   explicit StepProfile(const at::Device& device);
 
-  /// \brief Ends the current phase (if any) and starts `name` (phases appear in the table in
-  /// first-use order).
+  /// \brief Ends the current phases (if any) and starts the top-level phase `name` (phases
+  /// appear in the table in first-use order).
   void enter(const std::string& name);
-  /// \brief Ends the current phase (if any).
+  /// \brief Ends every open phase.
   void leave();
+  /// \brief Opens "<current phase> / name" nested in the current phase (or the top-level phase
+  /// `name` when none is open); the current phase's clock pauses until pop().
+  void push(const std::string& name);
+  /// \brief Closes the innermost phase; its parent's clock runs again.
+  void pop();
+  /// \brief Whether a phase is open.
+  bool inPhase() const { return !stack_.empty(); }
   /// \brief Counts one iteration (the table's per-iteration column divides by this).
   void countIteration() { ++iterations_; }
   int iterations() const { return iterations_; }
-  /// \brief Total seconds spent in `name` so far (0 for a phase never timed).
+  /// \brief Total seconds spent in `name` itself so far, nested phases excluded (0 for a phase
+  /// never timed). Nested phases are named "parent / child".
   double seconds(const std::string& name) const;
   /// \brief Total seconds of all phases.
   double totalSeconds() const;
-  /// \brief A Markdown table: phase, total seconds, milliseconds per iteration, share.
+  /// \brief The largest device memory allocated while `name` ran (bytes; 0 on the CPU).
+  std::int64_t peakAllocatedBytes(const std::string& name) const;
+  /// \brief A Markdown table: phase, total seconds, milliseconds per iteration, share (and on
+  /// CUDA the peak allocated MiB per phase, and the peaks of the whole run).
   std::string table() const;
 
  private:
+  struct Phase {
+    std::string name;
+    double seconds = 0.0;
+    std::int64_t peak_allocated = 0;
+  };
+  int indexOf(const std::string& name);
+  void closeSlice();  // waits for the device, credits the innermost phase with its time
+  void openSlice();   // starts the clock (and the device's peak memory counters) afresh
+
   at::Device device_;
-  std::vector<std::string> names_;
-  std::vector<double> seconds_;
-  int current_ = -1;
+  std::vector<Phase> phases_;
+  std::vector<int> stack_;
   std::chrono::steady_clock::time_point start_;
   int iterations_ = 0;
+  std::int64_t peak_reserved_ = 0;
 };
 
 /// \brief profile->enter(name), or nothing when `profile` is null.
 inline void enterPhase(StepProfile* profile, const std::string& name) {
   if (profile != nullptr) profile->enter(name);
 }
+
+/// \brief The profile that ScopedPhase reports to (process-wide: the autograd engine runs CUDA
+/// backward passes in its own thread); null when none.
+StepProfile* activeProfile();
+/// \brief Makes `profile` (may be null) the active one.
+void setActiveProfile(StepProfile* profile);
+
+/// \brief Makes a profile active for a scope and restores the previous one after it.
+class ActiveProfileScope {
+ public:
+  explicit ActiveProfileScope(StepProfile* profile) : previous_(activeProfile()) {
+    setActiveProfile(profile);
+  }
+  ~ActiveProfileScope() { setActiveProfile(previous_); }
+  ActiveProfileScope(const ActiveProfileScope&) = delete;
+  ActiveProfileScope& operator=(const ActiveProfileScope&) = delete;
+
+ private:
+  StepProfile* previous_;
+};
+
+/// \brief A nested phase of the active profile for the lifetime of this object; nothing when no
+/// profile is active or it has no open phase.
+class ScopedPhase {
+ public:
+  explicit ScopedPhase(const char* name) : profile_(activeProfile()) {
+    if (profile_ != nullptr && profile_->inPhase()) {
+      profile_->push(name);
+    } else {
+      profile_ = nullptr;
+    }
+  }
+  ~ScopedPhase() {
+    if (profile_ != nullptr) profile_->pop();
+  }
+  ScopedPhase(const ScopedPhase&) = delete;
+  ScopedPhase& operator=(const ScopedPhase&) = delete;
+
+ private:
+  StepProfile* profile_;
+};
 
 }  // namespace gaussians
 }  // namespace sadsplat
