@@ -11,7 +11,9 @@
 #        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt
 #        pseudo_labels_train_decoder = false (e.g. none_decgt_pl), _recN recovery_iterations = N
 #        and _cutX recovery_prune = X (e.g. full_p1_lambda0.2_rec1000_cut0.3_pl), _refssim
-#        fused_ssim = false, _gthX densify_grad_threshold = X (fewer Gaussians without a drop).
+#        fused_ssim = false, _gthX densify_grad_threshold = X (fewer Gaussians without a drop),
+#        _radX max_screen_radius = X (e.g. none_rad100000_nopl: no screen-size pruning, as gsplat's
+#        default strategy).
 # $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
 # summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
 # name suffix for the work dir and the outputs, so that two label variants can run side by side).
@@ -49,6 +51,7 @@ train_one() {
   case "$name" in *_decgt*) keys+=("\"pseudo_labels_train_decoder\": false") ;; esac
   case "$name" in *_gth*) local gth=${name#*_gth}; keys+=("\"densify_grad_threshold\": ${gth%%_*}") ;; esac
   case "$name" in *_refssim*) keys+=("\"fused_ssim\": false") ;; esac
+  case "$name" in *_rad*) local rad=${name#*_rad}; keys+=("\"max_screen_radius\": ${rad%%_*}") ;; esac
   case "$name" in *_rec*) local rec=${name#*_rec}; keys+=("\"recovery_iterations\": ${rec%%_*}") ;; esac
   case "$name" in *_cut*) local cut=${name#*_cut}; keys+=("\"recovery_prune\": ${cut%%_*}") ;; esac
   if [ ${#keys[@]} -gt 0 ]; then

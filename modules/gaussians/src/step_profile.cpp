@@ -59,7 +59,11 @@ void synchronizeDevice(const at::Device& device) {
 StepProfile* activeProfile() { return g_active.load(); }
 void setActiveProfile(StepProfile* profile) { g_active.store(profile); }
 
-StepProfile::StepProfile(const at::Device& device) : device_(device) {}
+StepProfile::StepProfile(const at::Device& device) : device_(device) {
+  const DevicePeaks before = devicePeaks(device_);
+  peak_allocated_before_ = before.allocated;
+  peak_reserved_before_ = before.reserved;
+}
 
 int StepProfile::indexOf(const std::string& name) {
   const auto it =
@@ -155,8 +159,10 @@ std::string StepProfile::table() const {
   if (memory) {
     std::snprintf(line, sizeof line,
                   "\nDevice memory over the profiled phases: peak allocated %.0f MiB, peak "
-                  "reserved by the caching allocator %.0f MiB.\n",
-                  peak / kMiB, peak_reserved_ / kMiB);
+                  "reserved by the caching allocator %.0f MiB; before the first phase (scene "
+                  "loading, initialisation): %.0f MiB allocated, %.0f MiB reserved.\n",
+                  peak / kMiB, peak_reserved_ / kMiB, peak_allocated_before_ / kMiB,
+                  peak_reserved_before_ / kMiB);
     out += line;
   }
   return out;

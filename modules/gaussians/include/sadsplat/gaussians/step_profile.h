@@ -33,7 +33,8 @@ class StepProfile {
  public:
   using Ptr = std::shared_ptr<StepProfile>;
 
-  /// \param[in] device the device whose queue each phase boundary waits for
+  /// \param[in] device the device whose queue each phase boundary waits for; on CUDA the
+  /// device's memory peaks so far are kept as those "before the first phase"
   explicit StepProfile(const at::Device& device);
 
   /// \brief Ends the current phases (if any) and starts the top-level phase `name` (phases
@@ -78,6 +79,8 @@ class StepProfile {
   std::chrono::steady_clock::time_point start_;
   int iterations_ = 0;
   std::int64_t peak_reserved_ = 0;
+  // The device's peaks before this profile existed (scene loading, initialisation).
+  std::int64_t peak_allocated_before_ = 0, peak_reserved_before_ = 0;
 };
 
 /// \brief profile->enter(name), or nothing when `profile` is null.
