@@ -8,8 +8,13 @@ set -euo pipefail
 out="${OUT:-/tmp/sadsplat-gpu-out}"
 mkdir -p "$out"
 prefix=/tmp/sadsplat-deps
-rm -rf "$prefix" && mkdir -p "$prefix"
-for deb in .deps/debs/*.deb; do dpkg -x "$deb" "$prefix"; done
+# Unpacked once per set of packages (two builds on one machine share it).
+stamp=$(ls -l .deps/debs/ | md5sum | cut -d' ' -f1)
+if [ "$(cat "$prefix/.unpacked" 2>/dev/null)" != "$stamp" ]; then
+  rm -rf "$prefix" && mkdir -p "$prefix"
+  for deb in .deps/debs/*.deb; do dpkg -x "$deb" "$prefix"; done
+  echo "$stamp" > "$prefix/.unpacked"
+fi
 export LD_LIBRARY_PATH="$prefix/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 
 torch_cmake=/opt/torch/.venv/lib/python3.12/site-packages/torch/share/cmake
