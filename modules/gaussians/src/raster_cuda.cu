@@ -4,6 +4,10 @@
 #include <ATen/ATen.h>
 
 #include <cuda_runtime.h>
+#include <cub/device/device_radix_sort.cuh>
+
+#include <limits>
+#include <tuple>
 
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
@@ -139,6 +143,38 @@ __global__ void tileRangesKernel(int64_t m, const int64_t* __restrict__ keys, in
   }
 }
 
+// Sorts the (key, Gaussian id) pairs by key with a radix sort over the key's used bits only: the
+// 32 depth bits and as many tile bits as the tile count needs (11 at 800x450), not all 64. A
+// radix sort is stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
+std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
+                                                     const at::Tensor& values, int num_tiles,
+                                                     cudaStream_t stream) {
+  const int64_t m = keys.size(0);
+  if (m > std::numeric_limits<int>::max()) {
+    throw Error("<render>", "tile entries", "at most 2^31 - 1 (Gaussian, tile) pairs",
+                std::to_string(m) + " (fewer Gaussians or a smaller image)");
+  }
+  int tile_bits = 1;
+  while ((int64_t{1} << tile_bits) < num_tiles) ++tile_bits;
+  const int end_bit = 32 + tile_bits;
+  using Key = unsigned long long;  // keys are non-negative: the unsigned order is the same
+  const auto* keys_in = reinterpret_cast<const Key*>(keys.data_ptr<int64_t>());
+  at::Tensor sorted_keys = at::empty_like(keys), sorted_values = at::empty_like(values);
+  auto* keys_out = reinterpret_cast<Key*>(sorted_keys.data_ptr<int64_t>());
+  std::size_t temp_bytes = 0;
+  cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys_in, keys_out, values.data_ptr<int>(),
+                                  sorted_values.data_ptr<int>(), static_cast<int>(m), 0, end_bit,
+                                  stream);
+  at::Tensor temp = at::empty({static_cast<int64_t>(temp_bytes)}, keys.options().dtype(at::kByte));
+  const cudaError_t err = cub::DeviceRadixSort::SortPairs(
+      temp.data_ptr(), temp_bytes, keys_in, keys_out, values.data_ptr<int>(),
+      sorted_values.data_ptr<int>(), static_cast<int>(m), 0, end_bit, stream);
+  if (err != cudaSuccess) {
+    throw Error("<render>", "radix sort", "a successful sort", cudaGetErrorString(err));
+  }
+  return {sorted_keys, sorted_values};
+}
+
 Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
                      const at::Tensor& opacities, const at::Tensor& depths, int width, int height,
                      cudaStream_t stream) {
@@ -167,11 +203,8 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
         depths.data_ptr<float>(), offsets.data_ptr<int64_t>(), tiles_x, tiles_y,
         keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
-    // Stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
     const ScopedPhase sort_phase("sort");
-    auto sorted = at::sort(keys, /*stable=*/true, /*dim=*/0, /*descending=*/false);
-    keys = std::get<0>(sorted);
-    values = values.index_select(0, std::get<1>(sorted)).contiguous();
+    std::tie(keys, values) = sortByTileAndDepth(keys, values, tiles_x * tiles_y, stream);
     tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(m, keys.data_ptr<int64_t>(),
                                                               b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");
