@@ -9,7 +9,9 @@
 #   SCENE   (city_0, port_1, ...) trainings at 800x450, 7000 iterations, one at a time:
 #           sadsplat Net-1 (--drop none, no pseudo-labels), sadsplat full (pseudo-labels +
 #           --drop full), and the gsplat reference of Net-1 (GSPLAT_RUNS: ref = with SSIM,
-#           nossim = SSIM weight 0, a lower bound for gsplat with a fused SSIM).
+#           nossim = SSIM weight 0, a lower bound for gsplat with a fused SSIM). LIKE_FOR_LIKE=1
+#           adds sadsplat Net-1 with max_screen_radius 100000: no screen-size pruning, as
+#           gsplat's default strategy (the Gaussian counts then match).
 # No run starts when fewer than its expected seconds are left before LIMIT. $OUT gets
 # side_by_side.txt (the tables) and side_by_side.tgz (logs, metrics JSON).
 set -uo pipefail
@@ -92,6 +94,11 @@ for scene in "${args[@]}"; do
   cache="$work/${scene}.cache"
   "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" > "$work/logs/synth_$scene.log" 2>&1
   [ "$(left)" -gt 75 ] && train_sadsplat "${scene}_net1" "$cache" --drop none
+  if [ "${LIKE_FOR_LIKE:-0}" = 1 ] && [ "$(left)" -gt 90 ]; then
+    # Net-1 without the screen-size pruning, as gsplat's default strategy (refine_scale2d_stop_iter 0).
+    echo '{"max_screen_radius": 100000}' > "$work/no_screen_pruning.json"
+    train_sadsplat "${scene}_net1_nosr" "$cache" --drop none --config "$work/no_screen_pruning.json"
+  fi
   if [ $gs_ok = 0 ] && [ $smoke_done = 0 ]; then
     # 1400 iterations: densification (until 700) and the evaluation run once, in seconds.
     smoke_done=1
@@ -125,7 +132,9 @@ rows = []
 for scene in [a for a in sys.argv[2:] if a != "bench"]:
     n1 = load(f"{work}/metrics_{scene}_net1.json")
     fu = load(f"{work}/metrics_{scene}_full.json")
-    for name, m in (("sadsplat Net-1", n1), ("sadsplat full", fu)):
+    nosr = load(f"{work}/metrics_{scene}_net1_nosr.json")
+    for name, m in (("sadsplat Net-1", n1), ("sadsplat Net-1, no screen-size pruning", nosr),
+                    ("sadsplat full", fu)):
         if m:
             rows.append((scene, name, m["train_seconds"], m["num_gaussians"], 100 * m["miou"], m["psnr"]))
     for p in sorted(glob.glob(f"{work}/gsplat_{scene}_*.json")):
