@@ -18,8 +18,9 @@
 # summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
 # name suffix for the work dir and the outputs, so that two label variants can run side by side).
 set -uo pipefail
-# One training at 800x450 peaks near 30 GB of GPU memory on city (measured: 5 or 3 at once ran
-# out of memory on an 80 GB H100), so 2 at once is the default.
+# 2 at once by default. A training used ~30 GB in an earlier version (5 or 3 at once ran out of
+# memory on an 80 GB H100); the current code peaks near 2 GB per process
+# (docs/measurements/h100_screen_radius/), so JOBS=6 fits; the GPU's time is shared either way.
 export PYTORCH_CUDA_ALLOC_CONF=expandable_segments:True
 kind="$1"; seed="$2"; jobs="${3:-2}"; deadline="${4:-540}"; shift $(( $# < 4 ? $# : 4 ))
 runs=("$@")
