@@ -21,6 +21,10 @@
 #include "sadsplat/io/splat_formats.h"
 #include "sadsplat/io/train_log.h"
 
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#endif
+
 namespace sadsplat {
 namespace fuzz {
 
@@ -136,8 +140,36 @@ inline void fuzz_checkpoint(const std::uint8_t* data, std::size_t size) {
 }
 
 #if SADSPLAT_HAVE_OPENCV
+// A valid PNG built from fuzz bytes, so that the label checks (size, channels, bit depth, class
+// ids and colours) see what a mutated PNG file rarely gets past (libpng's CRC and zlib checks):
+// byte 0 picks the channels (1, 3, 4) and the depth (8 or 16 bit); bit 0 of byte 1 says whether
+// bytes 2-3 give the size (1-96 x 1-96) or the fixture's 64x48 is used; the rest are the pixel
+// bytes, repeated until the image is full.
+inline std::vector<unsigned char> labelPngFromBytes(const std::uint8_t* data, std::size_t size) {
+  const std::uint8_t mode = size > 0 ? data[0] : 0;
+  const int channels[] = {1, 3, 4};
+  const int depth = (mode / 3) % 2 == 1 ? CV_16U : CV_8U;
+  int width = 64, height = 48;
+  std::size_t pixels = std::min<std::size_t>(size, 2);
+  if (size > 3 && (data[1] & 1) == 1) {
+    width = 1 + data[2] % 96;
+    height = 1 + data[3] % 96;
+    pixels = 4;
+  }
+  cv::Mat image(height, width, CV_MAKETYPE(depth, channels[mode % 3]));
+  const std::size_t bytes = image.total() * image.elemSize();
+  for (std::size_t i = 0; i < bytes; ++i) {
+    image.data[i] = pixels < size ? data[pixels + i % (size - pixels)] : 0;
+  }
+  std::vector<unsigned char> png;
+  cv::imencode(".png", image, png);
+  return png;
+}
+
 // Fuzz target: a label map PNG, imported with a scene (`sadsplat import`, `train SCENE_DIR`): the
-// fixture scene is copied once, the input replaces its first label map.
+// fixture scene is copied once, the input replaces its first label map. An input that starts
+// with PNG's signature is written as it is; any other is made into a valid PNG first
+// (labelPngFromBytes).
 inline void fuzz_label_png(const std::uint8_t* data, std::size_t size) {
   static const std::string scene = [] {
     const std::string dir = fuzz::inputFile("scene");
@@ -146,7 +178,14 @@ inline void fuzz_label_png(const std::uint8_t* data, std::size_t size) {
                           std::filesystem::copy_options::recursive);
     return dir;
   }();
-  fuzz::writeInput(scene + "/labels/view_000.png", data, size);
+  const std::string path = scene + "/labels/view_000.png";
+  static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size >= 8 && std::memcmp(data, kSignature, 8) == 0) {
+    fuzz::writeInput(path, data, size);
+  } else {
+    const std::vector<unsigned char> png = labelPngFromBytes(data, size);
+    fuzz::writeInput(path, png.data(), png.size());
+  }
   fuzz::expectOnlySadsplatErrors([&] { io::importScene(scene, io::ImportOptions()); });
 }
 #endif
