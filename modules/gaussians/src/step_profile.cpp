@@ -65,10 +65,14 @@ StepProfile::StepProfile(const at::Device& device) : device_(device) {
   peak_reserved_before_ = before.reserved;
 }
 
-int StepProfile::indexOf(const std::string& name) {
+const StepProfile::Phase* StepProfile::find(const std::string& name) const {
   const auto it =
       std::find_if(phases_.begin(), phases_.end(), [&](const Phase& p) { return p.name == name; });
-  if (it != phases_.end()) return static_cast<int>(it - phases_.begin());
+  return it == phases_.end() ? nullptr : &*it;
+}
+
+int StepProfile::indexOf(const std::string& name) {
+  if (const Phase* p = find(name)) return static_cast<int>(p - phases_.data());
   phases_.push_back(Phase{name});
   return static_cast<int>(phases_.size()) - 1;
 }
@@ -114,17 +118,13 @@ void StepProfile::pop() {
 }
 
 double StepProfile::seconds(const std::string& name) const {
-  for (const Phase& p : phases_) {
-    if (p.name == name) return p.seconds;
-  }
-  return 0.0;
+  const Phase* p = find(name);
+  return p == nullptr ? 0.0 : p->seconds;
 }
 
 std::int64_t StepProfile::peakAllocatedBytes(const std::string& name) const {
-  for (const Phase& p : phases_) {
-    if (p.name == name) return p.peak_allocated;
-  }
-  return 0;
+  const Phase* p = find(name);
+  return p == nullptr ? 0 : p->peak_allocated;
 }
 
 double StepProfile::totalSeconds() const {

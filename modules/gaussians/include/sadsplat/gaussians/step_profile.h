@@ -69,7 +69,8 @@ class StepProfile {
     double seconds = 0.0;
     std::int64_t peak_allocated = 0;
   };
-  int indexOf(const std::string& name);
+  const Phase* find(const std::string& name) const;  // null when never timed
+  int indexOf(const std::string& name);              // find(), or a new phase
   void closeSlice();  // waits for the device, credits the innermost phase with its time
   void openSlice();   // starts the clock (and the device's peak memory counters) afresh
 
