@@ -6,6 +6,8 @@
 #   bash scripts/gpu/profile_training.sh [ITERATIONS=7000] [KIND_SEED ...]
 # RUNS (env) picks among full_plain full_profile none_plain none_profile. PL=1 (env): the full
 # runs train on the scene with the built-in pseudo-labels (the default method, Net-4); Net-1 never.
+# CONFIG (env): a training configuration JSON passed to every run (e.g. {"fused_semantic_loss":
+# false} to profile a reference path).
 # $OUT gets profile_<scene>_<run>.md, train logs, metrics and summary.txt.
 set -euo pipefail
 iterations="${1:-7000}"; shift $(( $# < 1 ? $# : 1 ))
@@ -29,6 +31,7 @@ for scene in "${scenes[@]}"; do
   fi
   for run in ${RUNS:-full_plain full_profile none_profile}; do
     drop=${run%_*}; flags=(); [ "${run#*_}" = profile ] && flags=(--profile)
+    [ -n "${CONFIG:-}" ] && flags+=(--config "$CONFIG")
     scene_file="$cache"; [ "${PL:-0}" = 1 ] && [ "$drop" = full ] && scene_file="$pl_cache"
     dir="$work/${scene}_$run"; rm -rf "$dir"
     start=$(date +%s%N)

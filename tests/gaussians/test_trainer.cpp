@@ -2,8 +2,6 @@
 // state consistent, resume is exact, configuration JSON.
 #include <gtest/gtest.h>
 
-#include <torch/csrc/autograd/autograd.h>
-
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
@@ -141,29 +139,6 @@ TEST_F(TrainerTest, PseudoLabelsCanLeaveTheDecoderToGroundTruth) {
   run(true, &decoder_change, &feature_change);
   EXPECT_GT(decoder_change, 0.0);
   EXPECT_GT(feature_change, 0.0);
-}
-
-TEST(SemanticLoss, UnsupervisedPixelsGiveNoGradientAndNoValue) {
-  at::manual_seed(3);
-  const auto opts = at::TensorOptions().dtype(at::kDouble);
-  at::Tensor features = at::randn({2, 3, 4}, opts).requires_grad_(true);
-  const at::Tensor labels =
-      at::tensor({1, -1, 0, -1, -1, 2}, at::TensorOptions().dtype(at::kLong)).view({2, 3});
-  const at::Tensor W = at::randn({3, 4}, opts), b = at::randn({3}, opts);
-  const at::Tensor loss = gaussians::semanticLoss(features, labels, W, b);
-  // By hand: mean over the three supervised pixels of 1 - logit[c] / |logit|.
-  double want = 0;
-  for (auto [y, x, c] : std::vector<std::tuple<int, int, int>>{{0, 0, 1}, {0, 2, 0}, {1, 2, 2}}) {
-    const at::Tensor logit = at::linear(features[y][x].detach(), W, b);
-    want += (1 - logit[c].item<double>() / logit.norm().item<double>()) / 3;
-  }
-  EXPECT_NEAR(loss.item<double>(), want, 1e-12);
-  const at::Tensor grad = torch::autograd::grad({loss}, {features})[0];
-  EXPECT_EQ(grad[0][1].abs().sum().item<double>(), 0.0);
-  EXPECT_EQ(grad[1][0].abs().sum().item<double>(), 0.0);
-  EXPECT_EQ(grad[1][1].abs().sum().item<double>(), 0.0);
-  EXPECT_GT(grad[0][0].abs().sum().item<double>(), 0.0);
-  EXPECT_GT(grad[1][2].abs().sum().item<double>(), 0.0);
 }
 
 TEST_P(TrainerOnDevice, DensificationAndPruningKeepTensorsAndOptimiserStateConsistent) {

@@ -90,6 +90,7 @@ std::string TrainConfig::toJson() const {
                       {"sh_increase_interval", sh_increase_interval},
                       {"lambda_ssim", lambda_ssim},
                       {"fused_ssim", fused_ssim},
+                      {"fused_semantic_loss", fused_semantic_loss},
                       {"lambda_rgb", lambda_rgb},
                       {"lambda_semantic", lambda_semantic},
                       {"semantic_interval", semantic_interval},
@@ -160,6 +161,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.sh_increase_interval = integer<int>(d, "sh_increase_interval", origin);
   c.lambda_ssim = real(d, "lambda_ssim", origin);
   c.fused_ssim = d["fused_ssim"].get<bool>();
+  c.fused_semantic_loss = d["fused_semantic_loss"].get<bool>();
   c.lambda_rgb = real(d, "lambda_rgb", origin);
   c.lambda_semantic = real(d, "lambda_semantic", origin);
   c.semantic_interval = integer<int>(d, "semantic_interval", origin);

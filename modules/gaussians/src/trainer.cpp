@@ -17,6 +17,7 @@
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
+#include "sadsplat/gaussians/semantic_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 
 namespace sadsplat {
@@ -41,17 +42,6 @@ constexpr double kSettledLogAlpha = 20.0;
 
 at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
   return at::detail::createCPUGenerator(mixBits(seed ^ mixBits(purpose ^ mixBits(iteration))));
-}
-
-at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
-                        const at::Tensor& weight, const at::Tensor& bias) {
-  const at::Tensor supervised = labels >= 0;
-  const at::Tensor logits = at::linear(features, weight, bias);
-  const at::Tensor target = labels.clamp_min(0).unsqueeze(2);
-  const at::Tensor cosine = logits.gather(2, target).squeeze(2) / logits.norm(2, 2).clamp_min(1e-8);
-  // where() (not a multiplication by the mask) so unsupervised pixels get exactly zero gradient.
-  const at::Tensor per_pixel = at::where(supervised, 1 - cosine, at::zeros_like(cosine));
-  return per_pixel.sum() / supervised.sum().clamp_min(1).to(per_pixel.scalar_type());
 }
 
 struct Trainer::State {
@@ -554,9 +544,9 @@ StepStats Trainer::step() {
       const bool decoder_learns = role.decoder_learns;
       const at::Tensor& w = s.p("decoder_w").value;
       const at::Tensor& b = s.p("decoder_b").value;
-      const at::Tensor sem = decoder_learns
-                                 ? semanticLoss(r.features, labels, w, b)
-                                 : semanticLoss(r.features, labels, w.detach(), b.detach());
+      const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
+      const at::Tensor sem = decoder_learns ? loss_of(r.features, labels, w, b)
+                                            : loss_of(r.features, labels, w.detach(), b.detach());
       loss = loss + s.semantic_weight[v] * sem;
       accumulate(sem_sum, sem);
     }

@@ -20,6 +20,9 @@ struct TrainConfig {
   /// On CUDA, the SSIM loss in fused kernels (gaussians::ssim); false: the reference composition
   /// of convolutions (gaussians::ssimReference), the same value ~10x slower (for comparisons).
   bool fused_ssim = true;
+  /// On CUDA, the semantic loss in fused kernels (gaussians::semanticLoss); false: the reference
+  /// composition of ATen operations (gaussians::semanticLossReference), for comparisons.
+  bool fused_semantic_loss = true;
   double lambda_rgb = 1.0;
   double lambda_semantic = 1.0;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss

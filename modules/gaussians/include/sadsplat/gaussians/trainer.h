@@ -23,16 +23,6 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief The semantic loss of the paper ("Training Loss"): 1 - cosine similarity between the
-/// decoded feature (linear layer W, b) and the one-hot embedding of the pixel's class, averaged
-/// over supervised pixels only (labels >= 0); pixels with label -1 contribute neither value nor
-/// gradient.
-/// \param[in] features [H, W, D] rendered feature image
-/// \param[in] labels [H, W] int64 class ids, -1 = not supervised
-/// \param[in] weight [C, D] decoder weight; \param[in] bias [C] decoder bias
-at::Tensor semanticLoss(const at::Tensor& features, const at::Tensor& labels,
-                        const at::Tensor& weight, const at::Tensor& bias);
-
 /// \brief A CPU generator determined by (seed, purpose, iteration): the trainer's randomness, so
 /// that a resumed run draws the same numbers as an uninterrupted one.
 at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration);

@@ -1,0 +1,37 @@
+#pragma once
+// Internal interface of the fused semantic loss (semantic_loss.cpp <-> semantic_loss_cuda.cu).
+// Per supervised pixel p with feature f (D channels), logits l = W f + b (C classes), target t:
+//   loss_p = 1 - l_t / max(|l|, 1e-8),  loss = sum_p loss_p / max(#supervised, 1).
+// The forward pass reduces the sum and the count on the device; the backward pass recomputes the
+// logits (cheaper than storing them), writes d loss / d f and sums the decoder's gradients.
+
+#include <ATen/ATen.h>
+
+#include <array>
+
+namespace sadsplat {
+namespace gaussians {
+namespace semantic_loss_fused {
+
+/// Largest feature and class counts of the fused kernels.
+constexpr int kMaxChannels = 64;
+constexpr int kMaxClasses = 64;
+
+#if SADSPLAT_COMPILE_CUDA
+/// [2] float64 on the device: the sum of the supervised pixels' losses and their count.
+/// features [P, D], labels [P] int64, weight [C, D], bias [C]: contiguous, float32 (labels int64),
+/// on the current CUDA device; stream a cudaStream_t.
+at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
+                       const at::Tensor& weight, const at::Tensor& bias, void* stream);
+/// {d(upstream * loss)/d features [P, D], .../d weight [C, D], .../d bias [C]} given forwardCuda's
+/// sums; `upstream` a float32 scalar tensor on the device (no host synchronisation). The decoder's
+/// gradients are undefined unless `decoder`.
+std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Tensor& labels,
+                                       const at::Tensor& weight, const at::Tensor& bias,
+                                       const at::Tensor& sums, const at::Tensor& upstream,
+                                       bool decoder, void* stream);
+#endif
+
+}  // namespace semantic_loss_fused
+}  // namespace gaussians
+}  // namespace sadsplat
