@@ -75,23 +75,30 @@ TEST(SemanticLoss, CpuTensorsTakeTheReferencePath) {
 }
 
 // Fused (CUDA) against the reference (CPU, float64) for H x W pixels, D channels, C classes.
+// Strided: the features are channels 3.. of a [H, W, 3 + D] image, as the rasterizer returns them.
 void expectFusedMatchesReference(int H, int W, int D, int C, bool decoder_grad,
-                                 double unsupervised_fraction) {
+                                 double unsupervised_fraction, bool strided = false) {
   at::manual_seed(11);
   const at::Tensor f_cpu = at::randn({H, W, D});
   at::Tensor l_cpu = at::randint(0, C, {H, W}, at::TensorOptions().dtype(at::kLong));
   l_cpu = at::where(at::rand({H, W}) < unsupervised_fraction, at::full_like(l_cpu, -1), l_cpu);
   const at::Tensor w_cpu = at::randn({C, D}) * 0.3, b_cpu = at::randn({C}) * 0.1;
 
-  const at::Tensor f = f_cpu.cuda().requires_grad_(true), l = l_cpu.cuda();
+  const at::Tensor image =
+      (strided ? at::cat({at::randn({H, W, 3}), f_cpu}, 2) : f_cpu).cuda().requires_grad_(true);
+  const at::Tensor f = strided ? image.slice(2, 3, 3 + D) : image, l = l_cpu.cuda();
   const at::Tensor w = w_cpu.cuda().requires_grad_(decoder_grad);
   const at::Tensor b = b_cpu.cuda().requires_grad_(decoder_grad);
   ASSERT_TRUE(gaussians::semanticLossIsFused(f, l, w, b));
   const at::Tensor fused = semanticLoss(f, l, w, b);
-  std::vector<at::Tensor> inputs{f};
-  if (decoder_grad) inputs = {f, w, b};
+  std::vector<at::Tensor> inputs{image};
+  if (decoder_grad) inputs = {image, w, b};
   // Scaled by 2: the upstream gradient must reach every output.
-  const auto g_fused = torch::autograd::grad({fused * 2.0}, inputs);
+  auto g_fused = torch::autograd::grad({fused * 2.0}, inputs);
+  if (strided) {
+    EXPECT_EQ(g_fused[0].slice(2, 0, 3).abs().sum().item<double>(), 0.0);
+    g_fused[0] = g_fused[0].slice(2, 3, 3 + D);
+  }
 
   const at::Tensor f_ref = f_cpu.to(at::kDouble).requires_grad_(true);
   const at::Tensor w_ref = w_cpu.to(at::kDouble).requires_grad_(true);
@@ -119,6 +126,8 @@ TEST(SemanticLoss, FusedCudaMatchesTheReferenceValueAndGradients) {
   expectFusedMatchesReference(7, 5, 32, 16, false, 0.5);    // a frozen decoder, partial block
   expectFusedMatchesReference(33, 17, 40, 20, true, 0.1);   // the large instantiation
   expectFusedMatchesReference(450, 800, 32, 8, true, 0.6);  // a full view
+  expectFusedMatchesReference(45, 80, 32, 6, true, 0.3, true);    // the rasterizer's slice
+  expectFusedMatchesReference(9, 13, 40, 33, false, 0.2, true);   // strided, large
 }
 
 TEST(SemanticLoss, FusedCudaWithNoSupervisedPixelIsZeroWithZeroGradient) {

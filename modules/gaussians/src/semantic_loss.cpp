@@ -31,7 +31,10 @@ class FusedSemanticLoss : public torch::autograd::Function<FusedSemanticLoss> {
                             const at::Tensor& bias) {
     const ScopedPhase phase("semantic loss");
     const c10::cuda::CUDAGuard guard(features.device());
-    const at::Tensor f = features.reshape({-1, features.size(-1)}).contiguous();
+    // The rasterizer's feature image is a slice of its [H, W, 3 + D] output: read in place when
+    // the pixels can be addressed with one stride (reshape then gives a view).
+    at::Tensor f = features.reshape({-1, features.size(-1)});
+    if (f.stride(1) != 1) f = f.contiguous();
     const at::Tensor l = labels.reshape({-1}).contiguous();
     const at::Tensor w = weight.contiguous(), b = bias.contiguous();
     const at::Tensor sums = semantic_loss_fused::forwardCuda(f, l, w, b, currentStream(f));

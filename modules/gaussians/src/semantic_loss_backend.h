@@ -19,8 +19,9 @@ constexpr int kMaxClasses = 64;
 
 #if SADSPLAT_COMPILE_CUDA
 /// [2] float64 on the device: the sum of the supervised pixels' losses and their count.
-/// features [P, D], labels [P] int64, weight [C, D], bias [C]: contiguous, float32 (labels int64),
-/// on the current CUDA device; stream a cudaStream_t.
+/// features [P, D] float32 with unit channel stride (any pixel stride: a slice of the rasterizer's
+/// image is read in place), labels [P] int64, weight [C, D] and bias [C] contiguous float32, all
+/// on the current CUDA device; stream a cudaStream_t. The gradient of the features is contiguous.
 at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
                        const at::Tensor& weight, const at::Tensor& bias, void* stream);
 /// {d(upstream * loss)/d features [P, D], .../d weight [C, D], .../d bias [C]} given forwardCuda's

@@ -36,13 +36,13 @@ struct Pixel {
 };
 
 template <int S, int K>
-__device__ Pixel<S, K> loadPixel(const float* features, int64_t p, int t, const float* sW,
-                                 const float* sb, int D, int C, int lane) {
+__device__ Pixel<S, K> loadPixel(const float* features, int64_t ld, int64_t p, int t,
+                                 const float* sW, const float* sb, int D, int C, int lane) {
   Pixel<S, K> px;
 #pragma unroll
   for (int s = 0; s < S; ++s) {
     const int d = lane + 32 * s;
-    px.f[s] = d < D ? features[p * D + d] : 0.0f;
+    px.f[s] = d < D ? features[p * ld + d] : 0.0f;
   }
 #pragma unroll
   for (int k = 0; k < K; ++k) px.l[k] = 0.0f;
@@ -90,8 +90,8 @@ __device__ void loadDecoder(const float* W, const float* b, int D, int C, float*
 }
 
 template <int S, int K>
-__global__ void lossForward(const float* features, const int64_t* labels, const float* W,
-                            const float* b, int64_t P, int D, int C, double* sums) {
+__global__ void lossForward(const float* features, int64_t ld, const int64_t* labels,
+                            const float* W, const float* b, int64_t P, int D, int C, double* sums) {
   extern __shared__ float shared[];
   float* sW = shared;
   float* sb = shared + C * D;
@@ -103,7 +103,7 @@ __global__ void lossForward(const float* features, const int64_t* labels, const 
     const int64_t t = labels[p];  // the same on every lane: no divergence below
     // Labels >= C are a caller's error (the reference's gather rejects them); they count as unset.
     if (t < 0 || t >= C) continue;
-    const Pixel<S, K> px = loadPixel<S, K>(features, p, static_cast<int>(t), sW, sb, D, C, w.lane);
+    const Pixel<S, K> px = loadPixel<S, K>(features, ld, p, static_cast<int>(t), sW, sb, D, C, w.lane);
     value += 1.0 - static_cast<double>(px.target / fmaxf(px.norm, kMinNorm));
     count += 1;
   }
@@ -128,8 +128,9 @@ __global__ void lossForward(const float* features, const int64_t* labels, const 
 // constant and d / d l_c = -delta_ct / 1e-8. Scaled by upstream / max(count, 1).
 // grad_w, grad_b: null when the decoder needs no gradient, else zeroed [C, D] and [C].
 template <int S, int K>
-__global__ void lossBackward(const float* features, const int64_t* labels, const float* W,
-                             const float* b, int64_t P, int D, int C, const double* sums,
+__global__ void lossBackward(const float* features, int64_t ld, const int64_t* labels,
+                             const float* W, const float* b, int64_t P, int D, int C,
+                             const double* sums,
                              const float* upstream, float* grad_features, float* grad_w,
                              float* grad_b) {
   extern __shared__ float shared[];
@@ -161,7 +162,7 @@ __global__ void lossBackward(const float* features, const int64_t* labels, const
       }
       continue;
     }
-    const Pixel<S, K> px = loadPixel<S, K>(features, p, static_cast<int>(t), sW, sb, D, C, w.lane);
+    const Pixel<S, K> px = loadPixel<S, K>(features, ld, p, static_cast<int>(t), sW, sb, D, C, w.lane);
     const bool clamped = px.norm < kMinNorm;
     const float inv_n = 1.0f / fmaxf(px.norm, kMinNorm);
     const float k3 = clamped ? 0.0f : px.target * inv_n * inv_n * inv_n;
@@ -245,7 +246,8 @@ at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
   const size_t shared = sizeof(float) * (C * D + C);
   auto launch = [&](auto kernel) {
     kernel<<<gridFor(P), kThreads, shared, stream>>>(
-        features.data_ptr<float>(), labels.data_ptr<int64_t>(), weight.data_ptr<float>(),
+        features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
+        weight.data_ptr<float>(),
         bias.data_ptr<float>(), P, D, C, sums.data_ptr<double>());
   };
   if (small(D, C))
@@ -263,7 +265,7 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t P = features.size(0);
   const int D = static_cast<int>(features.size(1)), C = static_cast<int>(weight.size(0));
-  at::Tensor grad_features = at::empty_like(features);
+  at::Tensor grad_features = at::empty({P, D}, features.options());
   at::Tensor grad_w, grad_b;
   if (decoder) {
     grad_w = at::zeros_like(weight);
@@ -273,7 +275,8 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
   const size_t shared = sizeof(float) * 2 * (C * D + C);
   auto launch = [&](auto kernel) {
     kernel<<<gridFor(P), kThreads, shared, stream>>>(
-        features.data_ptr<float>(), labels.data_ptr<int64_t>(), weight.data_ptr<float>(),
+        features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
+        weight.data_ptr<float>(),
         bias.data_ptr<float>(), P, D, C, sums.data_ptr<double>(), upstream.data_ptr<float>(),
         grad_features.data_ptr<float>(), decoder ? grad_w.data_ptr<float>() : nullptr,
         decoder ? grad_b.data_ptr<float>() : nullptr);
