@@ -1,9 +1,4 @@
-// The fused semantic loss on CUDA (see semantic_loss_backend.h). One warp per pixel, one lane
-// per feature channel (and per class): a pixel's D features are one coalesced load, each logit
-// a butterfly sum over the lanes, and d loss / d f is written back coalesced. The decoder lives
-// in shared memory; its gradients are summed in registers per warp, then per block in shared
-// memory, then once per block into global memory. Warps stride over the pixels (a grid of a few
-// blocks per multiprocessor), so these block sums stay few.
+// The fused semantic loss on CUDA (see semantic_loss_backend.h).
 #include <ATen/ATen.h>
 #include <cuda_runtime.h>
 
@@ -17,203 +12,219 @@ namespace gaussians {
 namespace semantic_loss_fused {
 namespace {
 
-constexpr int kThreads = 256;
-constexpr int kWarps = kThreads / 32;
+// Tiles of 32 pixels: a warp loads a tile's features with coalesced loads into shared memory
+// (row stride D + 1: conflict-free when each lane then reads its own pixel's row), each lane
+// computes one pixel, and in the backward pass the warp writes d loss / d f back coalesced and
+// sums the decoder's gradient over the tile (lane = channel). The decoder lives in shared memory;
+// its gradient is summed in registers per warp, per block in shared memory, then once per block
+// into global memory. Warps stride over the tiles (a grid of a few blocks per multiprocessor), so
+// these block sums stay few.
 constexpr float kMinNorm = 1e-8f;  // the reference's clamp_min of |l|
+constexpr int kTile = 32;
 
-__device__ float warpSum(float v) {
-  for (int off = 16; off > 0; off /= 2) v += __shfl_xor_sync(0xffffffffu, v, off);
-  return v;
-}
-
-// One pixel's features and logits. S = channel slots per lane (channel lane + 32 s), K = class
-// slots per lane (class lane + 32 k): the lane of class c holds l_c.
-template <int S, int K>
-struct Pixel {
-  float f[S];
-  float l[K];
-  float norm, target;  // |l| and l_t, on every lane
+// Shared memory of a block: the decoder (W [C, D], b [C]), the block's decoder gradient (the same
+// size; backward only) and per warp a feature tile [32, D + 1] and a logit-gradient tile [32, C].
+struct Layout {
+  int D, C, warps;
+  __host__ __device__ int decoder() const { return C * D + C; }
+  __host__ __device__ int perWarp() const { return kTile * (D + 1) + kTile * C; }
+  __host__ __device__ size_t bytes(bool backward) const {
+    return sizeof(float) * ((backward ? 2 : 1) * decoder() + warps * perWarp());
+  }
 };
 
-template <int S, int K>
-__device__ Pixel<S, K> loadPixel(const float* features, int64_t ld, int64_t p, int t,
-                                 const float* sW, const float* sb, int D, int C, int lane) {
-  Pixel<S, K> px;
-#pragma unroll
-  for (int s = 0; s < S; ++s) {
-    const int d = lane + 32 * s;
-    px.f[s] = d < D ? features[p * ld + d] : 0.0f;
+struct Tile {
+  float* f;  // [32, D + 1]
+  float* g;  // [32, C]
+};
+
+__device__ Tile warpTile(float* shared, const Layout& L, bool backward, int warp) {
+  float* base = shared + (backward ? 2 : 1) * L.decoder() + warp * L.perWarp();
+  return {base, base + kTile * (L.D + 1)};
+}
+
+// Loads pixels p0 .. p0 + 31 (those < P) into the tile; lane i then owns pixel p0 + i.
+__device__ void loadTile(const float* features, int64_t ld, int64_t p0, int64_t P, int D,
+                         int lane, float* tile) {
+  for (int i = 0; i < kTile; ++i) {
+    const int64_t p = p0 + i;
+    for (int d = lane; d < D; d += 32) tile[i * (D + 1) + d] = p < P ? features[p * ld + d] : 0.0f;
   }
+  __syncwarp();
+}
+
+// Logits of the lane's pixel (row `row` of the tile) with W [C, D], b [C] in shared memory.
+template <int MC>
+__device__ void logits(const float* row, const float* W, const float* b, int D, int C,
+                       float* l) {
 #pragma unroll
-  for (int k = 0; k < K; ++k) px.l[k] = 0.0f;
+  for (int c = 0; c < MC; ++c) l[c] = c < C ? b[c] : 0.0f;
+  for (int d = 0; d < D; ++d) {
+    const float f = row[d];
 #pragma unroll
-  for (int c = 0; c < 32 * K; ++c) {
-    if (c >= C) break;
-    float partial = 0;
-#pragma unroll
-    for (int s = 0; s < S; ++s) {
-      const int d = lane + 32 * s;
-      if (d < D) partial += sW[c * D + d] * px.f[s];
-    }
-    const float sum = warpSum(partial);
-    if (lane == c % 32) px.l[c / 32] = sum + sb[c];
+    for (int c = 0; c < MC; ++c)
+      if (c < C) l[c] += W[c * D + d] * f;
   }
+}
+
+template <int MC>
+__device__ void normAndTarget(const float* l, int t, float* norm, float* target) {
   float sq = 0;
+  *target = 0;
 #pragma unroll
-  for (int k = 0; k < K; ++k) sq += px.l[k] * px.l[k];  // zero on lanes without a class
-  px.norm = sqrtf(warpSum(sq));
-  float mine = 0;
-#pragma unroll
-  for (int k = 0; k < K; ++k)
-    if (k == t / 32) mine = px.l[k];
-  px.target = __shfl_sync(0xffffffffu, mine, t % 32);
-  return px;
+  for (int c = 0; c < MC; ++c) {
+    sq += l[c] * l[c];  // zero beyond C
+    if (c == t) *target = l[c];
+  }
+  *norm = sqrtf(sq);
 }
 
-// Grid-stride over warps: pixel p of warp w is w, w + number of warps, ...
-struct WarpIndex {
-  int lane, warp;
-  int64_t first, stride;
-};
-__device__ WarpIndex warpIndex() {
-  WarpIndex w;
-  w.lane = threadIdx.x % 32;
-  w.warp = threadIdx.x / 32;
-  w.first = static_cast<int64_t>(blockIdx.x) * kWarps + w.warp;
-  w.stride = static_cast<int64_t>(gridDim.x) * kWarps;
-  return w;
+__device__ void loadDecoder(const float* W, const float* b, const Layout& L, float* shared) {
+  for (int k = threadIdx.x; k < L.C * L.D; k += blockDim.x) shared[k] = W[k];
+  for (int k = threadIdx.x; k < L.C; k += blockDim.x) shared[L.C * L.D + k] = b[k];
 }
 
-__device__ void loadDecoder(const float* W, const float* b, int D, int C, float* sW, float* sb) {
-  for (int k = threadIdx.x; k < C * D; k += blockDim.x) sW[k] = W[k];
-  for (int k = threadIdx.x; k < C; k += blockDim.x) sb[k] = b[k];
-}
-
-template <int S, int K>
+template <int MC>
 __global__ void lossForward(const float* features, int64_t ld, const int64_t* labels,
-                            const float* W, const float* b, int64_t P, int D, int C, double* sums) {
+                            const float* W, const float* b, int64_t P, Layout L, double* sums) {
   extern __shared__ float shared[];
-  float* sW = shared;
-  float* sb = shared + C * D;
-  loadDecoder(W, b, D, C, sW, sb);
+  loadDecoder(W, b, L, shared);
   __syncthreads();
-  const WarpIndex w = warpIndex();
-  double value = 0, count = 0;  // meaningful on lane 0
-  for (int64_t p = w.first; p < P; p += w.stride) {
-    const int64_t t = labels[p];  // the same on every lane: no divergence below
+  const float* sW = shared;
+  const float* sb = shared + L.C * L.D;
+  const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+  const Tile tile = warpTile(shared, L, false, warp);
+  const int64_t tiles = (P + kTile - 1) / kTile;
+  double value = 0, count = 0;
+  for (int64_t k = static_cast<int64_t>(blockIdx.x) * L.warps + warp; k < tiles;
+       k += static_cast<int64_t>(gridDim.x) * L.warps) {
+    const int64_t p0 = k * kTile, p = p0 + lane;
+    loadTile(features, ld, p0, P, L.D, lane, tile.f);
+    const int64_t t = p < P ? labels[p] : -1;
     // Labels >= C are a caller's error (the reference's gather rejects them); they count as unset.
-    if (t < 0 || t >= C) continue;
-    const Pixel<S, K> px = loadPixel<S, K>(features, ld, p, static_cast<int>(t), sW, sb, D, C, w.lane);
-    value += 1.0 - static_cast<double>(px.target / fmaxf(px.norm, kMinNorm));
-    count += 1;
-  }
-  __shared__ double block_sums[2][kWarps];
-  if (w.lane == 0) {
-    block_sums[0][w.warp] = value;
-    block_sums[1][w.warp] = count;
-  }
-  __syncthreads();
-  if (threadIdx.x == 0) {
-    double v = 0, n = 0;
-    for (int k = 0; k < kWarps; ++k) {
-      v += block_sums[0][k];
-      n += block_sums[1][k];
+    if (t >= 0 && t < L.C) {
+      float l[MC], norm, target;
+      logits<MC>(tile.f + lane * (L.D + 1), sW, sb, L.D, L.C, l);
+      normAndTarget<MC>(l, static_cast<int>(t), &norm, &target);
+      value += 1.0 - static_cast<double>(target / fmaxf(norm, kMinNorm));
+      count += 1;
     }
-    atomicAdd(&sums[0], v);
-    atomicAdd(&sums[1], n);
+    __syncwarp();  // the tile is reloaded next
+  }
+  for (int off = 16; off > 0; off /= 2) {
+    value += __shfl_down_sync(0xffffffffu, value, off);
+    count += __shfl_down_sync(0xffffffffu, count, off);
+  }
+  if (lane == 0) {
+    atomicAdd(&sums[0], value);
+    atomicAdd(&sums[1], count);
   }
 }
 
 // d loss_p / d l_c = -(delta_ct / n - l_t l_c / n^3) for n = |l| >= 1e-8; below, the clamp is
 // constant and d / d l_c = -delta_ct / 1e-8. Scaled by upstream / max(count, 1).
 // grad_w, grad_b: null when the decoder needs no gradient, else zeroed [C, D] and [C].
-template <int S, int K>
+template <int S, int MC>
 __global__ void lossBackward(const float* features, int64_t ld, const int64_t* labels,
-                             const float* W, const float* b, int64_t P, int D, int C,
-                             const double* sums,
-                             const float* upstream, float* grad_features, float* grad_w,
-                             float* grad_b) {
+                             const float* W, const float* b, int64_t P, Layout L,
+                             const double* sums, const float* upstream, float* grad_features,
+                             float* grad_w, float* grad_b) {
   extern __shared__ float shared[];
-  float* sW = shared;
-  float* sb = sW + C * D;
-  float* block_gw = sb + C;  // the block's decoder gradient, [C, D] then [C]
-  float* block_gb = block_gw + C * D;
-  loadDecoder(W, b, D, C, sW, sb);
-  for (int k = threadIdx.x; k < C * D + C; k += blockDim.x) block_gw[k] = 0;
+  loadDecoder(W, b, L, shared);
+  float* block_grad = shared + L.decoder();  // [C, D] then [C]
+  for (int k = threadIdx.x; k < L.decoder(); k += blockDim.x) block_grad[k] = 0;
   __syncthreads();
-  const WarpIndex w = warpIndex();
+  const float* sW = shared;
+  const float* sb = shared + L.C * L.D;
+  const int D = L.D, C = L.C;
+  const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+  const Tile tile = warpTile(shared, L, true, warp);
   const bool decoder = grad_w != nullptr;
   const float scale = static_cast<float>(*upstream / fmax(sums[1], 1.0));
-  float acc_w[S][32 * K];  // this lane's channels x all classes
-  float acc_b[K];
+  // This lane's share of the decoder gradient: channels lane (+ 32 when S = 2) x all classes;
+  // bias of class lane (+ 32).
+  float acc_w[S][MC], acc_b[S];
 #pragma unroll
-  for (int k = 0; k < K; ++k) acc_b[k] = 0;
+  for (int s = 0; s < S; ++s) acc_b[s] = 0;
 #pragma unroll
   for (int s = 0; s < S; ++s)
 #pragma unroll
-    for (int c = 0; c < 32 * K; ++c) acc_w[s][c] = 0;
-  for (int64_t p = w.first; p < P; p += w.stride) {
-    const int64_t t = labels[p];
-    if (t < 0 || t >= C) {
+    for (int c = 0; c < MC; ++c) acc_w[s][c] = 0;
+  const int64_t tiles = (P + kTile - 1) / kTile;
+  for (int64_t k = static_cast<int64_t>(blockIdx.x) * L.warps + warp; k < tiles;
+       k += static_cast<int64_t>(gridDim.x) * L.warps) {
+    const int64_t p0 = k * kTile, p = p0 + lane;
+    loadTile(features, ld, p0, P, D, lane, tile.f);
+    const int64_t t = p < P ? labels[p] : -1;
+    float g[MC];
 #pragma unroll
-      for (int s = 0; s < S; ++s) {
-        const int d = w.lane + 32 * s;
-        if (d < D) grad_features[p * D + d] = 0;
-      }
-      continue;
+    for (int c = 0; c < MC; ++c) g[c] = 0;
+    if (t >= 0 && t < C) {
+      float l[MC], norm, target;
+      logits<MC>(tile.f + lane * (D + 1), sW, sb, D, C, l);
+      normAndTarget<MC>(l, static_cast<int>(t), &norm, &target);
+      const float inv_n = 1.0f / fmaxf(norm, kMinNorm);
+      const float k3 = norm < kMinNorm ? 0.0f : target * inv_n * inv_n * inv_n;
+#pragma unroll
+      for (int c = 0; c < MC; ++c)
+        if (c < C) g[c] = scale * (k3 * l[c] - (c == t ? inv_n : 0.0f));
     }
-    const Pixel<S, K> px = loadPixel<S, K>(features, ld, p, static_cast<int>(t), sW, sb, D, C, w.lane);
-    const bool clamped = px.norm < kMinNorm;
-    const float inv_n = 1.0f / fmaxf(px.norm, kMinNorm);
-    const float k3 = clamped ? 0.0f : px.target * inv_n * inv_n * inv_n;
-    float g[K];  // d loss / d l_c of this lane's classes
 #pragma unroll
-    for (int k = 0; k < K; ++k) {
-      const int c = w.lane + 32 * k;
-      g[k] = c < C ? scale * (k3 * px.l[k] - (c == t ? inv_n : 0.0f)) : 0.0f;
-      acc_b[k] += g[k];
-    }
-    float gf[S];
+    for (int c = 0; c < MC; ++c)
+      if (c < C) tile.g[lane * C + c] = g[c];
+    __syncwarp();
+    if (decoder) {
+      // Lane = channel: sum over the tile's pixels of g_c f_d; lane = class for the bias.
+      for (int i = 0; i < kTile; ++i) {
 #pragma unroll
-    for (int s = 0; s < S; ++s) gf[s] = 0;
+        for (int s = 0; s < S; ++s) {
+          const int d = lane + 32 * s;
+          if (d >= D) continue;
+          const float f = tile.f[i * (D + 1) + d];
 #pragma unroll
-    for (int c = 0; c < 32 * K; ++c) {
-      if (c >= C) break;
-      float gc = 0;
+          for (int c = 0; c < MC; ++c)
+            if (c < C) acc_w[s][c] += tile.g[i * C + c] * f;
+        }
 #pragma unroll
-      for (int k = 0; k < K; ++k)
-        if (k == c / 32) gc = __shfl_sync(0xffffffffu, g[k], c % 32);
-#pragma unroll
-      for (int s = 0; s < S; ++s) {
-        const int d = w.lane + 32 * s;
-        if (d < D) {
-          gf[s] += sW[c * D + d] * gc;
-          acc_w[s][c] += gc * px.f[s];
+        for (int s = 0; s < S; ++s) {
+          const int c = lane + 32 * s;
+          if (c < C) acc_b[s] += tile.g[i * C + c];
         }
       }
+      __syncwarp();  // the feature tile is overwritten with the gradient below
     }
+    // d loss / d f_d = sum_c W_cd g_c, into the lane's own row, then written out coalesced.
+    float* row = tile.f + lane * (D + 1);
+    for (int d = 0; d < D; ++d) {
+      float acc = 0;
 #pragma unroll
-    for (int s = 0; s < S; ++s) {
-      const int d = w.lane + 32 * s;
-      if (d < D) grad_features[p * D + d] = gf[s];
+      for (int c = 0; c < MC; ++c)
+        if (c < C) acc += sW[c * D + d] * g[c];
+      row[d] = acc;
     }
+    __syncwarp();
+    for (int i = 0; i < kTile; ++i) {
+      const int64_t q = p0 + i;
+      if (q >= P) break;
+      for (int d = lane; d < D; d += 32) grad_features[q * D + d] = tile.f[i * (D + 1) + d];
+    }
+    __syncwarp();
   }
   if (!decoder) return;
 #pragma unroll
-  for (int s = 0; s < S; ++s)
+  for (int s = 0; s < S; ++s) {
+    const int d = lane + 32 * s;
+    if (d < D) {
 #pragma unroll
-    for (int c = 0; c < 32 * K; ++c) {
-      const int d = w.lane + 32 * s;
-      if (c < C && d < D) atomicAdd(&block_gw[c * D + d], acc_w[s][c]);
+      for (int c = 0; c < MC; ++c)
+        if (c < C) atomicAdd(&block_grad[c * D + d], acc_w[s][c]);
     }
-#pragma unroll
-  for (int k = 0; k < K; ++k) {
-    const int c = w.lane + 32 * k;
-    if (c < C) atomicAdd(&block_gb[c], acc_b[k]);
+    const int c = lane + 32 * s;
+    if (c < C) atomicAdd(&block_grad[C * D + c], acc_b[s]);
   }
   __syncthreads();
-  for (int k = threadIdx.x; k < C * D; k += blockDim.x) atomicAdd(&grad_w[k], block_gw[k]);
-  for (int k = threadIdx.x; k < C; k += blockDim.x) atomicAdd(&grad_b[k], block_gb[k]);
+  for (int k = threadIdx.x; k < C * D; k += blockDim.x) atomicAdd(&grad_w[k], block_grad[k]);
+  for (int k = threadIdx.x; k < C; k += blockDim.x) atomicAdd(&grad_b[k], block_grad[C * D + k]);
 }
 
 void check(const char* what) {
@@ -221,18 +232,36 @@ void check(const char* what) {
   if (err != cudaSuccess) throw Error("<semantic loss>", what, "success", cudaGetErrorString(err));
 }
 
-// A few resident blocks per multiprocessor, fewer when there are fewer pixels.
-unsigned gridFor(int64_t P) {
+// Warps per block: 4, fewer where the tiles would not fit in 48 KiB of shared memory.
+Layout layoutFor(int D, int C, bool backward) {
+  Layout L{D, C, 4};
+  while (L.warps > 1 && L.bytes(backward) > 48 * 1024) --L.warps;
+  return L;
+}
+
+// Above 48 KiB of dynamic shared memory (one warp, 64 channels x 64 classes) a kernel must opt in.
+template <typename Kernel>
+void allowSharedMemory(Kernel kernel, size_t bytes) {
+  if (bytes > 48 * 1024)
+    cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                         static_cast<int>(bytes));
+}
+
+// A few resident blocks per multiprocessor, fewer when there are fewer tiles.
+unsigned gridFor(int64_t P, const Layout& L) {
   int device = 0, sms = 0;
   cudaGetDevice(&device);
   cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device);
-  const int64_t wanted = (P + kWarps - 1) / kWarps;
-  return static_cast<unsigned>(std::max<int64_t>(1, std::min<int64_t>(wanted, 4 * sms)));
+  const int64_t tiles = (P + kTile - 1) / kTile;
+  const int64_t wanted = (tiles + L.warps - 1) / L.warps;
+  return static_cast<unsigned>(std::max<int64_t>(1, std::min<int64_t>(wanted, 8 * sms)));
 }
 
-// The smallest instantiation that holds D channels and C classes.
-bool small(int D, int C) { return D <= 32 && C <= 32; }
-static_assert(kMaxChannels == 64 && kMaxClasses == 64, "the large instantiation is <2, 2>");
+// The instantiations: <channel slots per lane, classes held in registers>; the small one covers
+// the paper's 32 channels and up to 16 classes.
+constexpr int kSmallClasses = 16;
+bool small(int D, int C) { return D <= 32 && C <= kSmallClasses; }
+static_assert(kMaxChannels <= 64, "a lane holds two channels of the decoder gradient");
 
 }  // namespace
 
@@ -243,17 +272,17 @@ at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
   const int D = static_cast<int>(features.size(1)), C = static_cast<int>(weight.size(0));
   at::Tensor sums = at::zeros({2}, features.options().dtype(at::kDouble));
   if (P == 0) return sums;
-  const size_t shared = sizeof(float) * (C * D + C);
+  const Layout L = layoutFor(D, C, false);
   auto launch = [&](auto kernel) {
-    kernel<<<gridFor(P), kThreads, shared, stream>>>(
+    allowSharedMemory(kernel, L.bytes(false));
+    kernel<<<gridFor(P, L), 32 * L.warps, L.bytes(false), stream>>>(
         features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
-        weight.data_ptr<float>(),
-        bias.data_ptr<float>(), P, D, C, sums.data_ptr<double>());
+        weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>());
   };
   if (small(D, C))
-    launch(lossForward<1, 1>);
+    launch(lossForward<kSmallClasses>);
   else
-    launch(lossForward<2, 2>);
+    launch(lossForward<kMaxClasses>);
   check("lossForward");
   return sums;
 }
@@ -272,19 +301,19 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
     grad_b = at::zeros_like(bias);
   }
   if (P == 0) return {grad_features, grad_w, grad_b};
-  const size_t shared = sizeof(float) * 2 * (C * D + C);
+  const Layout L = layoutFor(D, C, true);
   auto launch = [&](auto kernel) {
-    kernel<<<gridFor(P), kThreads, shared, stream>>>(
+    allowSharedMemory(kernel, L.bytes(true));
+    kernel<<<gridFor(P, L), 32 * L.warps, L.bytes(true), stream>>>(
         features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
-        weight.data_ptr<float>(),
-        bias.data_ptr<float>(), P, D, C, sums.data_ptr<double>(), upstream.data_ptr<float>(),
-        grad_features.data_ptr<float>(), decoder ? grad_w.data_ptr<float>() : nullptr,
-        decoder ? grad_b.data_ptr<float>() : nullptr);
+        weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>(),
+        upstream.data_ptr<float>(), grad_features.data_ptr<float>(),
+        decoder ? grad_w.data_ptr<float>() : nullptr, decoder ? grad_b.data_ptr<float>() : nullptr);
   };
   if (small(D, C))
-    launch(lossBackward<1, 1>);
+    launch(lossBackward<1, kSmallClasses>);
   else
-    launch(lossBackward<2, 2>);
+    launch(lossBackward<2, kMaxClasses>);
   check("lossBackward");
   return {grad_features, grad_w, grad_b};
 }
