@@ -124,10 +124,22 @@ TEST(SemanticLoss, FusedCudaMatchesTheReferenceValueAndGradients) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
   expectFusedMatchesReference(45, 80, 32, 6, true, 0.3);    // the training case
   expectFusedMatchesReference(7, 5, 32, 16, false, 0.5);    // a frozen decoder, partial block
-  expectFusedMatchesReference(33, 17, 40, 20, true, 0.1);   // the large instantiation
+  expectFusedMatchesReference(33, 17, 24, 11, true, 0.1);   // fewer channels than lanes
   expectFusedMatchesReference(450, 800, 32, 8, true, 0.6);  // a full view
   expectFusedMatchesReference(45, 80, 32, 6, true, 0.3, true);    // the rasterizer's slice
-  expectFusedMatchesReference(9, 13, 40, 33, false, 0.2, true);   // strided, large
+  expectFusedMatchesReference(9, 13, 32, 16, false, 0.2, true);   // strided, most classes
+}
+
+TEST(SemanticLoss, MoreChannelsOrClassesThanTheKernelsHoldTakeTheReferencePath) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const auto cuda = at::TensorOptions().device(at::kCUDA);
+  const at::Tensor l = at::zeros({2, 2}, cuda.dtype(at::kLong));
+  EXPECT_FALSE(gaussians::semanticLossIsFused(at::zeros({2, 2, 33}, cuda), l,
+                                              at::zeros({3, 33}, cuda), at::zeros({3}, cuda)));
+  EXPECT_FALSE(gaussians::semanticLossIsFused(at::zeros({2, 2, 32}, cuda), l,
+                                              at::zeros({17, 32}, cuda), at::zeros({17}, cuda)));
+  EXPECT_TRUE(gaussians::semanticLossIsFused(at::zeros({2, 2, 32}, cuda), l,
+                                             at::zeros({16, 32}, cuda), at::zeros({16}, cuda)));
 }
 
 TEST(SemanticLoss, FusedCudaWithNoSupervisedPixelIsZeroWithZeroGradient) {

@@ -43,36 +43,37 @@ __device__ Tile warpTile(float* shared, const Layout& L, bool backward, int warp
   return {base, base + kTile * (L.D + 1)};
 }
 
-// Loads pixels p0 .. p0 + 31 (those < P) into the tile; lane i then owns pixel p0 + i.
-__device__ void loadTile(const float* features, int64_t ld, int64_t p0, int64_t P, int D,
-                         int lane, float* tile) {
-  for (int i = 0; i < kTile; ++i) {
-    const int64_t p = p0 + i;
-    for (int d = lane; d < D; d += 32) tile[i * (D + 1) + d] = p < P ? features[p * ld + d] : 0.0f;
-  }
+// Loads pixels p0 .. p0 + 31 (those < P) into the tile; lane i then owns pixel p0 + i. Lane d
+// holds channel d (D <= 32): the 32 loads go out together, then into shared memory.
+__device__ void loadTile(const float* __restrict__ features, int64_t ld, int64_t p0, int64_t P,
+                         int D, int lane, float* tile) {
+  float v[kTile];
+#pragma unroll
+  for (int i = 0; i < kTile; ++i)
+    v[i] = p0 + i < P && lane < D ? features[(p0 + i) * ld + lane] : 0.0f;
+#pragma unroll
+  for (int i = 0; i < kTile; ++i)
+    if (lane < D) tile[i * (D + 1) + lane] = v[i];
   __syncwarp();
 }
 
 // Logits of the lane's pixel (row `row` of the tile) with W [C, D], b [C] in shared memory.
-template <int MC>
-__device__ void logits(const float* row, const float* W, const float* b, int D, int C,
-                       float* l) {
+__device__ void logits(const float* row, const float* W, const float* b, int D, int C, float* l) {
 #pragma unroll
-  for (int c = 0; c < MC; ++c) l[c] = c < C ? b[c] : 0.0f;
+  for (int c = 0; c < kMaxClasses; ++c) l[c] = c < C ? b[c] : 0.0f;
   for (int d = 0; d < D; ++d) {
     const float f = row[d];
 #pragma unroll
-    for (int c = 0; c < MC; ++c)
+    for (int c = 0; c < kMaxClasses; ++c)
       if (c < C) l[c] += W[c * D + d] * f;
   }
 }
 
-template <int MC>
 __device__ void normAndTarget(const float* l, int t, float* norm, float* target) {
   float sq = 0;
   *target = 0;
 #pragma unroll
-  for (int c = 0; c < MC; ++c) {
+  for (int c = 0; c < kMaxClasses; ++c) {
     sq += l[c] * l[c];  // zero beyond C
     if (c == t) *target = l[c];
   }
@@ -84,7 +85,6 @@ __device__ void loadDecoder(const float* W, const float* b, const Layout& L, flo
   for (int k = threadIdx.x; k < L.C; k += blockDim.x) shared[L.C * L.D + k] = b[k];
 }
 
-template <int MC>
 __global__ void lossForward(const float* features, int64_t ld, const int64_t* labels,
                             const float* W, const float* b, int64_t P, Layout L, double* sums) {
   extern __shared__ float shared[];
@@ -103,9 +103,9 @@ __global__ void lossForward(const float* features, int64_t ld, const int64_t* la
     const int64_t t = p < P ? labels[p] : -1;
     // Labels >= C are a caller's error (the reference's gather rejects them); they count as unset.
     if (t >= 0 && t < L.C) {
-      float l[MC], norm, target;
-      logits<MC>(tile.f + lane * (L.D + 1), sW, sb, L.D, L.C, l);
-      normAndTarget<MC>(l, static_cast<int>(t), &norm, &target);
+      float l[kMaxClasses], norm, target;
+      logits(tile.f + lane * (L.D + 1), sW, sb, L.D, L.C, l);
+      normAndTarget(l, static_cast<int>(t), &norm, &target);
       value += 1.0 - static_cast<double>(target / fmaxf(norm, kMinNorm));
       count += 1;
     }
@@ -124,7 +124,6 @@ __global__ void lossForward(const float* features, int64_t ld, const int64_t* la
 // d loss_p / d l_c = -(delta_ct / n - l_t l_c / n^3) for n = |l| >= 1e-8; below, the clamp is
 // constant and d / d l_c = -delta_ct / 1e-8. Scaled by upstream / max(count, 1).
 // grad_w, grad_b: null when the decoder needs no gradient, else zeroed [C, D] and [C].
-template <int S, int MC>
 __global__ void lossBackward(const float* features, int64_t ld, const int64_t* labels,
                              const float* W, const float* b, int64_t P, Layout L,
                              const double* sums, const float* upstream, float* grad_features,
@@ -141,55 +140,41 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
   const Tile tile = warpTile(shared, L, true, warp);
   const bool decoder = grad_w != nullptr;
   const float scale = static_cast<float>(*upstream / fmax(sums[1], 1.0));
-  // This lane's share of the decoder gradient: channels lane (+ 32 when S = 2) x all classes;
-  // bias of class lane (+ 32).
-  float acc_w[S][MC], acc_b[S];
+  // This lane's share of the decoder gradient: channel lane x all classes; bias of class lane.
+  float acc_w[kMaxClasses], acc_b = 0;
 #pragma unroll
-  for (int s = 0; s < S; ++s) acc_b[s] = 0;
-#pragma unroll
-  for (int s = 0; s < S; ++s)
-#pragma unroll
-    for (int c = 0; c < MC; ++c) acc_w[s][c] = 0;
+  for (int c = 0; c < kMaxClasses; ++c) acc_w[c] = 0;
   const int64_t tiles = (P + kTile - 1) / kTile;
   for (int64_t k = static_cast<int64_t>(blockIdx.x) * L.warps + warp; k < tiles;
        k += static_cast<int64_t>(gridDim.x) * L.warps) {
     const int64_t p0 = k * kTile, p = p0 + lane;
     loadTile(features, ld, p0, P, D, lane, tile.f);
     const int64_t t = p < P ? labels[p] : -1;
-    float g[MC];
+    float g[kMaxClasses];
 #pragma unroll
-    for (int c = 0; c < MC; ++c) g[c] = 0;
+    for (int c = 0; c < kMaxClasses; ++c) g[c] = 0;
     if (t >= 0 && t < C) {
-      float l[MC], norm, target;
-      logits<MC>(tile.f + lane * (D + 1), sW, sb, D, C, l);
-      normAndTarget<MC>(l, static_cast<int>(t), &norm, &target);
+      float l[kMaxClasses], norm, target;
+      logits(tile.f + lane * (D + 1), sW, sb, D, C, l);
+      normAndTarget(l, static_cast<int>(t), &norm, &target);
       const float inv_n = 1.0f / fmaxf(norm, kMinNorm);
       const float k3 = norm < kMinNorm ? 0.0f : target * inv_n * inv_n * inv_n;
 #pragma unroll
-      for (int c = 0; c < MC; ++c)
+      for (int c = 0; c < kMaxClasses; ++c)
         if (c < C) g[c] = scale * (k3 * l[c] - (c == t ? inv_n : 0.0f));
     }
 #pragma unroll
-    for (int c = 0; c < MC; ++c)
+    for (int c = 0; c < kMaxClasses; ++c)
       if (c < C) tile.g[lane * C + c] = g[c];
     __syncwarp();
     if (decoder) {
-      // Lane = channel: sum over the tile's pixels of g_c f_d; lane = class for the bias.
+      // Lane = channel: the sum over the tile's pixels of g_c f_d; lane = class for the bias.
       for (int i = 0; i < kTile; ++i) {
+        const float f = lane < D ? tile.f[i * (D + 1) + lane] : 0.0f;
 #pragma unroll
-        for (int s = 0; s < S; ++s) {
-          const int d = lane + 32 * s;
-          if (d >= D) continue;
-          const float f = tile.f[i * (D + 1) + d];
-#pragma unroll
-          for (int c = 0; c < MC; ++c)
-            if (c < C) acc_w[s][c] += tile.g[i * C + c] * f;
-        }
-#pragma unroll
-        for (int s = 0; s < S; ++s) {
-          const int c = lane + 32 * s;
-          if (c < C) acc_b[s] += tile.g[i * C + c];
-        }
+        for (int c = 0; c < kMaxClasses; ++c)
+          if (c < C) acc_w[c] += tile.g[i * C + c] * f;
+        if (lane < C) acc_b += tile.g[i * C + lane];
       }
       __syncwarp();  // the feature tile is overwritten with the gradient below
     }
@@ -198,7 +183,7 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
     for (int d = 0; d < D; ++d) {
       float acc = 0;
 #pragma unroll
-      for (int c = 0; c < MC; ++c)
+      for (int c = 0; c < kMaxClasses; ++c)
         if (c < C) acc += sW[c * D + d] * g[c];
       row[d] = acc;
     }
@@ -206,22 +191,17 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
     for (int i = 0; i < kTile; ++i) {
       const int64_t q = p0 + i;
       if (q >= P) break;
-      for (int d = lane; d < D; d += 32) grad_features[q * D + d] = tile.f[i * (D + 1) + d];
+      if (lane < D) grad_features[q * D + lane] = tile.f[i * (D + 1) + lane];
     }
     __syncwarp();
   }
   if (!decoder) return;
+  if (lane < D) {
 #pragma unroll
-  for (int s = 0; s < S; ++s) {
-    const int d = lane + 32 * s;
-    if (d < D) {
-#pragma unroll
-      for (int c = 0; c < MC; ++c)
-        if (c < C) atomicAdd(&block_grad[c * D + d], acc_w[s][c]);
-    }
-    const int c = lane + 32 * s;
-    if (c < C) atomicAdd(&block_grad[C * D + c], acc_b[s]);
+    for (int c = 0; c < kMaxClasses; ++c)
+      if (c < C) atomicAdd(&block_grad[c * D + lane], acc_w[c]);
   }
+  if (lane < C) atomicAdd(&block_grad[C * D + lane], acc_b);
   __syncthreads();
   for (int k = threadIdx.x; k < C * D; k += blockDim.x) atomicAdd(&grad_w[k], block_grad[k]);
   for (int k = threadIdx.x; k < C; k += blockDim.x) atomicAdd(&grad_b[k], block_grad[C * D + k]);
@@ -232,36 +212,19 @@ void check(const char* what) {
   if (err != cudaSuccess) throw Error("<semantic loss>", what, "success", cudaGetErrorString(err));
 }
 
-// Warps per block: 4, fewer where the tiles would not fit in 48 KiB of shared memory.
-Layout layoutFor(int D, int C, bool backward) {
-  Layout L{D, C, 4};
-  while (L.warps > 1 && L.bytes(backward) > 48 * 1024) --L.warps;
-  return L;
-}
-
-// Above 48 KiB of dynamic shared memory (one warp, 64 channels x 64 classes) a kernel must opt in.
-template <typename Kernel>
-void allowSharedMemory(Kernel kernel, size_t bytes) {
-  if (bytes > 48 * 1024)
-    cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                         static_cast<int>(bytes));
-}
+// 4 warps per block: at most 2 x 528 decoder floats + 4 x 1,568 tile floats, 29 KiB.
+constexpr int kWarps = 4;
+static_assert(kMaxChannels <= 32, "a lane holds one channel");
 
 // A few resident blocks per multiprocessor, fewer when there are fewer tiles.
-unsigned gridFor(int64_t P, const Layout& L) {
+unsigned gridFor(int64_t P) {
   int device = 0, sms = 0;
   cudaGetDevice(&device);
   cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device);
   const int64_t tiles = (P + kTile - 1) / kTile;
-  const int64_t wanted = (tiles + L.warps - 1) / L.warps;
+  const int64_t wanted = (tiles + kWarps - 1) / kWarps;
   return static_cast<unsigned>(std::max<int64_t>(1, std::min<int64_t>(wanted, 8 * sms)));
 }
-
-// The instantiations: <channel slots per lane, classes held in registers>; the small one covers
-// the paper's 32 channels and up to 16 classes.
-constexpr int kSmallClasses = 16;
-bool small(int D, int C) { return D <= 32 && C <= kSmallClasses; }
-static_assert(kMaxChannels <= 64, "a lane holds two channels of the decoder gradient");
 
 }  // namespace
 
@@ -269,20 +232,12 @@ at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
                        const at::Tensor& weight, const at::Tensor& bias, void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t P = features.size(0);
-  const int D = static_cast<int>(features.size(1)), C = static_cast<int>(weight.size(0));
+  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0)), kWarps};
   at::Tensor sums = at::zeros({2}, features.options().dtype(at::kDouble));
   if (P == 0) return sums;
-  const Layout L = layoutFor(D, C, false);
-  auto launch = [&](auto kernel) {
-    allowSharedMemory(kernel, L.bytes(false));
-    kernel<<<gridFor(P, L), 32 * L.warps, L.bytes(false), stream>>>(
-        features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
-        weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>());
-  };
-  if (small(D, C))
-    launch(lossForward<kSmallClasses>);
-  else
-    launch(lossForward<kMaxClasses>);
+  lossForward<<<gridFor(P), 32 * kWarps, L.bytes(false), stream>>>(
+      features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
+      weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>());
   check("lossForward");
   return sums;
 }
@@ -293,27 +248,19 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
                                        bool decoder, void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t P = features.size(0);
-  const int D = static_cast<int>(features.size(1)), C = static_cast<int>(weight.size(0));
-  at::Tensor grad_features = at::empty({P, D}, features.options());
+  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0)), kWarps};
+  at::Tensor grad_features = at::empty({P, L.D}, features.options());
   at::Tensor grad_w, grad_b;
   if (decoder) {
     grad_w = at::zeros_like(weight);
     grad_b = at::zeros_like(bias);
   }
   if (P == 0) return {grad_features, grad_w, grad_b};
-  const Layout L = layoutFor(D, C, true);
-  auto launch = [&](auto kernel) {
-    allowSharedMemory(kernel, L.bytes(true));
-    kernel<<<gridFor(P, L), 32 * L.warps, L.bytes(true), stream>>>(
-        features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
-        weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>(),
-        upstream.data_ptr<float>(), grad_features.data_ptr<float>(),
-        decoder ? grad_w.data_ptr<float>() : nullptr, decoder ? grad_b.data_ptr<float>() : nullptr);
-  };
-  if (small(D, C))
-    launch(lossBackward<1, kSmallClasses>);
-  else
-    launch(lossBackward<2, kMaxClasses>);
+  lossBackward<<<gridFor(P), 32 * kWarps, L.bytes(true), stream>>>(
+      features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
+      weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>(),
+      upstream.data_ptr<float>(), grad_features.data_ptr<float>(),
+      decoder ? grad_w.data_ptr<float>() : nullptr, decoder ? grad_b.data_ptr<float>() : nullptr);
   check("lossBackward");
   return {grad_features, grad_w, grad_b};
 }

@@ -9,7 +9,7 @@ namespace gaussians {
 /// \brief The semantic loss of the paper ("Training Loss"): 1 - cosine similarity between the
 /// decoded feature (linear layer W, b) and the one-hot embedding of the pixel's class, averaged
 /// over supervised pixels only (labels >= 0); pixels with label -1 contribute neither value nor
-/// gradient. On CUDA (float32, D <= 64 feature channels, C <= 64 classes) the value and the
+/// gradient. On CUDA (float32, D <= 32 feature channels, C <= 16 classes) the value and the
 /// gradients come from fused kernels (semanticLossIsFused); otherwise as semanticLossReference.
 /// \param[in] features [H, W, D] rendered feature image
 /// \param[in] labels [H, W] int64 class ids in [0, C) or -1 = not supervised
