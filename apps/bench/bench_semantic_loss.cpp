@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
   const auto opts = at::TensorOptions().dtype(at::kFloat).device(device);
   const at::Tensor image_data = at::randn({height, width, 3 + features}, opts);
   at::Tensor labels = at::randint(0, classes, {height, width}, opts.dtype(at::kLong));
-  labels = at::where(at::rand({height, width}, opts) < supervised, labels, at::full_like(labels, -1));
+  labels =
+      at::where(at::rand({height, width}, opts) < supervised, labels, at::full_like(labels, -1));
   const at::Tensor weight_data = at::randn({classes, features}, opts) * 0.3;
   const at::Tensor bias_data = at::randn({classes}, opts) * 0.1;
   std::printf("| variant | fused | forward ms | forward+backward ms |\n|---|---|---|---|\n");
@@ -80,8 +81,7 @@ int main(int argc, char** argv) {
       }
     }
     std::printf("| %dx%d %s D=%d C=%d | %s | %.3f | %.3f |\n", width, height, device_name.c_str(),
-                features, classes, took_fused ? "yes" : "no", fwd_ms / repeats,
-                both_ms / repeats);
+                features, classes, took_fused ? "yes" : "no", fwd_ms / repeats, both_ms / repeats);
   }
   return 0;
 }

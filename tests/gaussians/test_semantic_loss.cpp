@@ -106,8 +106,8 @@ void expectFusedMatchesReference(int H, int W, int D, int C, bool decoder_grad,
   const at::Tensor ref = semanticLossReference(f_ref, l_cpu, w_ref, b_ref);
   const auto g_ref = torch::autograd::grad({ref * 2.0}, {f_ref, w_ref, b_ref});
 
-  const std::string where = std::to_string(H) + "x" + std::to_string(W) + " D=" +
-                            std::to_string(D) + " C=" + std::to_string(C);
+  const std::string where = std::to_string(H) + "x" + std::to_string(W) +
+                            " D=" + std::to_string(D) + " C=" + std::to_string(C);
   EXPECT_NEAR(fused.item<double>(), ref.item<double>(), 1e-5) << where;
   for (std::size_t k = 0; k < g_fused.size(); ++k) {
     const at::Tensor want = g_ref[k];
@@ -122,12 +122,12 @@ void expectFusedMatchesReference(int H, int W, int D, int C, bool decoder_grad,
 
 TEST(SemanticLoss, FusedCudaMatchesTheReferenceValueAndGradients) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
-  expectFusedMatchesReference(45, 80, 32, 6, true, 0.3);    // the training case
-  expectFusedMatchesReference(7, 5, 32, 16, false, 0.5);    // a frozen decoder, partial block
-  expectFusedMatchesReference(33, 17, 24, 11, true, 0.1);   // fewer channels than lanes
-  expectFusedMatchesReference(450, 800, 32, 8, true, 0.6);  // a full view
-  expectFusedMatchesReference(45, 80, 32, 6, true, 0.3, true);    // the rasterizer's slice
-  expectFusedMatchesReference(9, 13, 32, 16, false, 0.2, true);   // strided, most classes
+  expectFusedMatchesReference(45, 80, 32, 6, true, 0.3);         // the training case
+  expectFusedMatchesReference(7, 5, 32, 16, false, 0.5);         // a frozen decoder, partial block
+  expectFusedMatchesReference(33, 17, 24, 11, true, 0.1);        // fewer channels than lanes
+  expectFusedMatchesReference(450, 800, 32, 8, true, 0.6);       // a full view
+  expectFusedMatchesReference(45, 80, 32, 6, true, 0.3, true);   // the rasterizer's slice
+  expectFusedMatchesReference(9, 13, 32, 16, false, 0.2, true);  // strided, most classes
 }
 
 TEST(SemanticLoss, MoreChannelsOrClassesThanTheKernelsHoldTakeTheReferencePath) {
