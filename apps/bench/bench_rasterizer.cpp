@@ -19,10 +19,7 @@
 #include <thread>
 #include <vector>
 
-#if SADSPLAT_HAVE_CUDA
-#include <cuda_runtime_api.h>
-#endif
-
+#include "bench_support.h"
 #include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/step_profile.h"
@@ -30,12 +27,6 @@
 namespace {
 
 using sadsplat::gaussians::GaussianParams;
-
-void synchronize(const at::Device& device) {
-#if SADSPLAT_HAVE_CUDA
-  if (device.is_cuda()) cudaDeviceSynchronize();
-#endif
-}
 
 // Gaussians uniformly in the camera frustum between depths 2 and 10.
 GaussianParams randomInFrustum(int64_t n, int64_t features,
@@ -103,18 +94,18 @@ int main(int argc, char** argv) {
       double fwd_ms = 0, both_ms = 0;
       double tiles_per_gaussian = 0;
       for (int it = 0; it < warmup + repeats; ++it) {
-        synchronize(device);
+        sadsplat::bench::synchronize(device);
         const auto t0 = Clock::now();
         sadsplat::gaussians::RenderResult r;
         {
           c10::AutoGradMode no_grad(false);
           r = sadsplat::gaussians::render(g, cam);
         }
-        synchronize(device);
+        sadsplat::bench::synchronize(device);
         const auto t1 = Clock::now();
         const auto r2 = sadsplat::gaussians::render(g, cam);
         (r2.rgb.sum() + r2.features.sum()).backward();
-        synchronize(device);
+        sadsplat::bench::synchronize(device);
         const auto t2 = Clock::now();
         if (it >= warmup) {
           fwd_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();

@@ -12,22 +12,8 @@
 #include <cstdio>
 #include <string>
 
-#if SADSPLAT_HAVE_CUDA
-#include <cuda_runtime_api.h>
-#endif
-
+#include "bench_support.h"
 #include "sadsplat/gaussians/semantic_loss.h"
-
-namespace {
-
-void synchronize(const at::Device& device) {
-#if SADSPLAT_HAVE_CUDA
-  if (device.is_cuda()) cudaDeviceSynchronize();
-#endif
-  (void)device;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Semantic loss: fused vs reference, forward and forward+backward"};
@@ -66,14 +52,14 @@ int main(int argc, char** argv) {
       const at::Tensor b = bias_data.clone().requires_grad_(true);
       const at::Tensor f = image.slice(2, 3, 3 + features);
       took_fused = fused && sadsplat::gaussians::semanticLossIsFused(f, labels, w, b);
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t0 = Clock::now();
       const at::Tensor value = fused ? sadsplat::gaussians::semanticLoss(f, labels, w, b)
                                      : sadsplat::gaussians::semanticLossReference(f, labels, w, b);
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t1 = Clock::now();
       torch::autograd::grad({value}, {image, w, b});
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t2 = Clock::now();
       if (r >= 0) {
         fwd_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();

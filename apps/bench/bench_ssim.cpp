@@ -10,22 +10,8 @@
 #include <cstdio>
 #include <string>
 
-#if SADSPLAT_HAVE_CUDA
-#include <cuda_runtime_api.h>
-#endif
-
+#include "bench_support.h"
 #include "sadsplat/gaussians/image_metrics.h"
-
-namespace {
-
-void synchronize(const at::Device& device) {
-#if SADSPLAT_HAVE_CUDA
-  if (device.is_cuda()) cudaDeviceSynchronize();
-#endif
-  (void)device;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"SSIM loss: fused vs reference, forward and forward+backward"};
@@ -51,14 +37,14 @@ int main(int argc, char** argv) {
     double fwd_ms = 0, both_ms = 0;
     for (int r = -3; r < repeats; ++r) {
       const at::Tensor a = image.clone().requires_grad_(true);
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t0 = Clock::now();
       at::Tensor value = fused ? sadsplat::gaussians::ssim(a, target)
                                : sadsplat::gaussians::ssimReference(a, target);
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t1 = Clock::now();
       torch::autograd::grad({value}, {a});
-      synchronize(device);
+      sadsplat::bench::synchronize(device);
       const auto t2 = Clock::now();
       if (r >= 0) {
         fwd_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();

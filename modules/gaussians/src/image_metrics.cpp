@@ -6,9 +6,9 @@
 
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
-#include <c10/cuda/CUDAStream.h>
 #endif
 
+#include "cuda_stream.h"
 #include "sadsplat/gaussians/step_profile.h"
 #include "ssim_backend.h"
 
@@ -36,10 +36,6 @@ namespace {
 #if SADSPLAT_HAVE_CUDA
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
-
-void* currentStream(const at::Tensor& t) {
-  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
-}
 
 // mean(SSIM map) of a (differentiable) against b (a constant target).
 class FusedSsim : public torch::autograd::Function<FusedSsim> {

@@ -9,9 +9,9 @@
 
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
-#include <c10/cuda/CUDAStream.h>
 #endif
 
+#include "cuda_stream.h"
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
@@ -67,13 +67,6 @@ CameraParams unpackCamera(const std::vector<double>& v) {
   throw Error("<render>", "device", "CPU tensors (this sadsplat build has no CUDA backend)",
               "CUDA tensors");
 }
-
-#if SADSPLAT_HAVE_CUDA
-// LibTorch's current stream on the tensor's device (which the guard in the caller makes current).
-void* currentStream(const at::Tensor& t) {
-  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
-}
-#endif
 
 at::Tensor orZeros(const at::Tensor& grad, const at::Tensor& like) {
   return grad.defined() ? grad.contiguous() : at::zeros_like(like);

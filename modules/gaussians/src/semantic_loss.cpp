@@ -4,9 +4,9 @@
 
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
-#include <c10/cuda/CUDAStream.h>
 #endif
 
+#include "cuda_stream.h"
 #include "sadsplat/gaussians/step_profile.h"
 #include "semantic_loss_backend.h"
 
@@ -18,10 +18,6 @@ namespace {
 #if SADSPLAT_HAVE_CUDA
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
-
-void* currentStream(const at::Tensor& t) {
-  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
-}
 
 // The loss of features [H, W, D] against labels [H, W]; gradients for features, weight, bias.
 class FusedSemanticLoss : public torch::autograd::Function<FusedSemanticLoss> {
