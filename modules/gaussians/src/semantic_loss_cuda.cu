@@ -21,15 +21,17 @@ namespace {
 // these block sums stay few.
 constexpr float kMinNorm = 1e-8f;  // the reference's clamp_min of |l|
 constexpr int kTile = 32;
+// 4 warps per block: at most 2 x 528 decoder floats + 4 x 1,568 tile floats, 29 KiB.
+constexpr int kWarps = 4;
 
 // Shared memory of a block: the decoder (W [C, D], b [C]), the block's decoder gradient (the same
 // size; backward only) and per warp a feature tile [32, D + 1] and a logit-gradient tile [32, C].
 struct Layout {
-  int D, C, warps;
+  int D, C;
   __host__ __device__ int decoder() const { return C * D + C; }
   __host__ __device__ int perWarp() const { return kTile * (D + 1) + kTile * C; }
   __host__ __device__ size_t bytes(bool backward) const {
-    return sizeof(float) * ((backward ? 2 : 1) * decoder() + warps * perWarp());
+    return sizeof(float) * ((backward ? 2 : 1) * decoder() + kWarps * perWarp());
   }
 };
 
@@ -96,8 +98,8 @@ __global__ void lossForward(const float* features, int64_t ld, const int64_t* la
   const Tile tile = warpTile(shared, L, false, warp);
   const int64_t tiles = (P + kTile - 1) / kTile;
   double value = 0, count = 0;
-  for (int64_t k = static_cast<int64_t>(blockIdx.x) * L.warps + warp; k < tiles;
-       k += static_cast<int64_t>(gridDim.x) * L.warps) {
+  for (int64_t k = static_cast<int64_t>(blockIdx.x) * kWarps + warp; k < tiles;
+       k += static_cast<int64_t>(gridDim.x) * kWarps) {
     const int64_t p0 = k * kTile, p = p0 + lane;
     loadTile(features, ld, p0, P, L.D, lane, tile.f);
     const int64_t t = p < P ? labels[p] : -1;
@@ -145,8 +147,8 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
 #pragma unroll
   for (int c = 0; c < kMaxClasses; ++c) acc_w[c] = 0;
   const int64_t tiles = (P + kTile - 1) / kTile;
-  for (int64_t k = static_cast<int64_t>(blockIdx.x) * L.warps + warp; k < tiles;
-       k += static_cast<int64_t>(gridDim.x) * L.warps) {
+  for (int64_t k = static_cast<int64_t>(blockIdx.x) * kWarps + warp; k < tiles;
+       k += static_cast<int64_t>(gridDim.x) * kWarps) {
     const int64_t p0 = k * kTile, p = p0 + lane;
     loadTile(features, ld, p0, P, D, lane, tile.f);
     const int64_t t = p < P ? labels[p] : -1;
@@ -212,8 +214,6 @@ void check(const char* what) {
   if (err != cudaSuccess) throw Error("<semantic loss>", what, "success", cudaGetErrorString(err));
 }
 
-// 4 warps per block: at most 2 x 528 decoder floats + 4 x 1,568 tile floats, 29 KiB.
-constexpr int kWarps = 4;
 static_assert(kMaxChannels <= 32, "a lane holds one channel");
 
 // A few resident blocks per multiprocessor, fewer when there are fewer tiles.
@@ -232,7 +232,7 @@ at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
                        const at::Tensor& weight, const at::Tensor& bias, void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t P = features.size(0);
-  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0)), kWarps};
+  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0))};
   at::Tensor sums = at::zeros({2}, features.options().dtype(at::kDouble));
   if (P == 0) return sums;
   lossForward<<<gridFor(P), 32 * kWarps, L.bytes(false), stream>>>(
@@ -248,7 +248,7 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
                                        bool decoder, void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t P = features.size(0);
-  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0)), kWarps};
+  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0))};
   at::Tensor grad_features = at::empty({P, L.D}, features.options());
   at::Tensor grad_w, grad_b;
   if (decoder) {
