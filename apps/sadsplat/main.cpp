@@ -88,6 +88,7 @@ struct SynthArgs {
   std::string out;
   std::string cache;
   bool preview = false;
+  bool colmap_binary = false;
 };
 
 int runSynth(const SynthArgs& a) {
@@ -119,7 +120,8 @@ int runSynth(const SynthArgs& a) {
   if (!a.cache.empty()) io::writeSceneCache(a.cache, synth::toScene(scene));
   if (!a.out.empty()) {
 #if SADSPLAT_HAVE_OPENCV
-    synth::writeScene(scene, a.out);
+    synth::writeScene(scene, a.out,
+                      a.colmap_binary ? synth::ColmapFormat::kBinary : synth::ColmapFormat::kText);
     if (a.preview) synth::writeContactSheet(scene, a.out + "/preview.png");
 #else
     throw Error(a.out, "--out", "a sadsplat build with OpenCV to write PNG scene directories",
@@ -394,6 +396,8 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--out", synth_args.out, "scene directory to write (PNG, needs OpenCV)");
   synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
+  synth_cmd->add_flag("--colmap-binary", synth_args.colmap_binary,
+                     "with --out: write sparse/0 as a binary COLMAP model (cameras.bin, ...)");
 
 #if SADSPLAT_HAVE_VIZ
   auto* view = app.add_subcommand(

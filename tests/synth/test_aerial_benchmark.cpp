@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
@@ -16,6 +17,7 @@
 
 namespace sadsplat {
 namespace {
+namespace fs = std::filesystem;
 
 synth::SynthOptions small(synth::SceneKind kind, std::uint64_t seed) {
   synth::SynthOptions o;
@@ -170,6 +172,35 @@ TEST(AerialBenchmark, WrittenScenesLoadThroughTheSceneImport) {
     EXPECT_DOUBLE_EQ(direct.views[i].camera.fx, imported.views[i].camera.fx);
   }
   EXPECT_EQ(direct.points.size(), imported.points.size());
+}
+
+TEST(AerialBenchmark, BinaryColmapModelHoldsWhatTheTextModelHolds) {
+  const auto scene = synth::generate(small(synth::SceneKind::kCity, 3));
+  test::TempDir dir;
+  synth::writeScene(scene, dir.file("text"));
+  synth::writeScene(scene, dir.file("bin"), synth::ColmapFormat::kBinary);
+  EXPECT_TRUE(fs::exists(dir.file("bin/sparse/0/points3D.bin")));
+  EXPECT_FALSE(fs::exists(dir.file("bin/sparse/0/points3D.txt")));
+  EXPECT_FALSE(fs::exists(dir.file("text/sparse/0/points3D.bin")));
+  const io::ColmapModel t = io::readColmapModel(dir.file("text/sparse/0"));
+  const io::ColmapModel b = io::readColmapModel(dir.file("bin/sparse/0"));
+  ASSERT_EQ(b.cameras.size(), t.cameras.size());
+  EXPECT_EQ(b.cameras[0].params, t.cameras[0].params);
+  ASSERT_EQ(b.images.size(), scene.views.size());
+  ASSERT_EQ(b.images.size(), t.images.size());
+  for (std::size_t i = 0; i < b.images.size(); ++i) {
+    EXPECT_EQ(b.images[i].name, t.images[i].name);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.images[i].tvec[k], t.images[i].tvec[k], 1e-9);
+    EXPECT_EQ(b.images[i].points2d.size(), t.images[i].points2d.size());
+  }
+  ASSERT_EQ(b.points.size(), scene.points.size());
+  for (std::size_t k = 0; k < b.points.size(); k += 37) {
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(b.points[k].xyz[a], scene.points[k].xyz[a], 1e-5);
+    EXPECT_EQ(b.points[k].track.size(), t.points[k].track.size());
+  }
+  // Both load through the scene import as the same scene.
+  EXPECT_EQ(io::importScene(dir.file("bin")).points.size(),
+            io::importScene(dir.file("text")).points.size());
 }
 
 TEST(AerialBenchmark, BadOptionsAreClearErrors) {

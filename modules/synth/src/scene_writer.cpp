@@ -64,7 +64,7 @@ cv::Mat bgr(const SynthView& v) {
 
 }  // namespace
 
-void writeScene(const SynthScene& scene, const std::string& dir) {
+void writeScene(const SynthScene& scene, const std::string& dir, ColmapFormat colmap) {
   io::makeDirectory(dir);
   for (const char* sub : {"/images", "/labels", "/depth", "/sparse", "/sparse/0"})
     io::makeDirectory(dir + sub);
@@ -108,7 +108,11 @@ void writeScene(const SynthScene& scene, const std::string& dir) {
     }
     model.points.push_back(std::move(out));
   }
-  io::writeColmapText(dir + "/sparse/0", model);
+  if (colmap == ColmapFormat::kBinary) {
+    io::writeColmapBinary(dir + "/sparse/0", model);
+  } else {
+    io::writeColmapText(dir + "/sparse/0", model);
+  }
   io::writeClassesJson(dir + "/classes.json", scene.classes);
   io::writeSplitJson(dir + "/split.json", scene.split);
 }
