@@ -3,6 +3,7 @@
 # 600-iteration run (start-up and scene loading cancel), on the demo city at two image sizes,
 # Net-1 (--drop none). Build first (cmake --build build).
 #   bash scripts/cpu_speed.sh [OUT_DIR=/tmp/sadsplat-cpu-speed] [THREADS=all cores]
+# BIN (env): the sadsplat binary to time (build/bin/sadsplat).
 # OPENSPLAT_SRC (env): a checkout of OpenSplat's public source (github.com/pierotofy/OpenSplat).
 # The script then builds it for the CPU (-DGPU_RUNTIME=CPU against Debian's LibTorch; its
 # FetchContent dependencies replaced by Debian's libnanoflann-dev, libcxxopts-dev and
@@ -18,7 +19,7 @@ threads="${2:-}"
 [ -n "$threads" ] && export OMP_NUM_THREADS="$threads"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
-bin=build/bin/sadsplat
+bin="${BIN:-build/bin/sadsplat}"
 
 # OpenSplat, built once per OUT_DIR.
 opensplat=""

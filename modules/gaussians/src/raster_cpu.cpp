@@ -184,6 +184,129 @@ std::vector<T> skipThresholds(const T* opacities, int64_t n) {
   return thresholds;
 }
 
+// One Gaussian of a tile's list, gathered: what a pixel needs to decide on it and blend it.
+template <typename T>
+struct PackedGaussian {
+  T mean2d[2];
+  T conic[3];
+  T opacity;
+  T skip;  // skipThresholds
+};
+
+// A tile's Gaussians copied front to back into contiguous arrays (values as [L, D]): every pixel
+// of the tile walks the same list, so gathering it once per tile turns 256 indirect, scattered
+// reads per Gaussian into one. The arithmetic per pixel is unchanged.
+template <typename T>
+struct TileList {
+  std::vector<PackedGaussian<T>> gaussians;
+  std::vector<T> values;
+  const int* ids = nullptr;  // into the binning's gaussian_ids
+  int size = 0;
+
+  void gather(const int* tile_ids, int count, const T* means2d, const T* conics, const T* opacities,
+              const T* skip, const T* all_values, int64_t D) {
+    ids = tile_ids;
+    size = count;
+    gaussians.resize(static_cast<std::size_t>(count));
+    values.resize(static_cast<std::size_t>(count * D));
+    for (int j = 0; j < count; ++j) {
+      const int g = tile_ids[j];
+      PackedGaussian<T>& p = gaussians[j];
+      p.mean2d[0] = means2d[2 * g];
+      p.mean2d[1] = means2d[2 * g + 1];
+      for (int k = 0; k < 3; ++k) p.conic[k] = conics[3 * g + k];
+      p.opacity = opacities[g];
+      p.skip = skip[g];
+      std::copy(all_values + g * D, all_values + (g + 1) * D, values.begin() + j * D);
+    }
+  }
+};
+
+// Blends one tile of the forward pass. kD > 0: the channel count as a compile-time constant (the
+// RGB-only renders); 0: `dynamic_d` channels.
+template <int kD, typename T>
+void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
+                 T* accum, T* img, T* alpha_out, int* last_out) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const PackedGaussian<T>* pg = list.gaussians.data();
+  const T* val = list.values.data();
+  for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
+    for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
+      const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+      std::fill(accum, accum + D, T(0));
+      T trans = T(1);
+      int last = 0;
+      for (int j = 0; j < list.size; ++j) {
+        const PackedGaussian<T>& p = pg[j];
+        if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+        T G;
+        bool clamped;
+        const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+        if (alpha == T(0)) continue;
+        const T next = trans * (T(1) - alpha);
+        if (next < T(kMinTransmittance)) break;
+        const T w = alpha * trans;
+        const T* v = val + j * D;
+        for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
+        trans = next;
+        last = j + 1;
+      }
+      const int64_t pix = static_cast<int64_t>(py) * width + px;
+      std::copy(accum, accum + D, img + pix * D);
+      alpha_out[pix] = T(1) - trans;
+      last_out[pix] = last;
+    }
+  }
+}
+
+// The backward of one tile: gradients of the tile's Gaussians, in list order, into `grads`
+// ([L, 6 + D]: mean2d, conic, opacity, values), which the caller has zeroed.
+template <int kD, typename T>
+void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width,
+                  int height, const T* gimg, const T* galpha, const T* alpha_fwd,
+                  const int* last_fwd, T* accum, T* last_value, T* grads) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const int64_t row = 6 + D;
+  const PackedGaussian<T>* pg = list.gaussians.data();
+  const T* val = list.values.data();
+  for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
+    for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
+      const int64_t pix = static_cast<int64_t>(py) * width + px;
+      const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+      const T final_trans = T(1) - alpha_fwd[pix];
+      const T* gpix = gimg + pix * D;
+      T trans = final_trans;
+      std::fill(accum, accum + D, T(0));
+      std::fill(last_value, last_value + D, T(0));
+      T last_alpha = T(0);
+      for (int j = last_fwd[pix] - 1; j >= 0; --j) {
+        const PackedGaussian<T>& p = pg[j];
+        if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+        T G;
+        bool clamped;
+        const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+        if (alpha == T(0)) continue;
+        trans = trans / (T(1) - alpha);
+        const T w = alpha * trans;
+        T* gb = grads + j * row;
+        const T* v = val + j * D;
+        T g_a = T(0);
+        for (int64_t ch = 0; ch < D; ++ch) {
+          accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
+          last_value[ch] = v[ch];
+          g_a += (v[ch] - accum[ch]) * gpix[ch];
+          gb[6 + ch] += w * gpix[ch];
+        }
+        g_a *= trans;
+        g_a += galpha[pix] * final_trans / (T(1) - alpha);
+        last_alpha = alpha;
+        pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2,
+                           gb + 5);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
@@ -214,35 +337,15 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
       std::vector<T> accum(static_cast<std::size_t>(D));
+      TileList<T> list;
       for (int64_t tile = begin; tile < end; ++tile) {
         const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
-        for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
-          for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
-            const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-            std::fill(accum.begin(), accum.end(), T(0));
-            T trans = T(1);
-            int last = 0;
-            for (int k = start; k < stop; ++k) {
-              const int g = ids[k];
-              const T* mg = m2 + 2 * g;
-              if (gaussianPower(co + 3 * g, mg[0] - fx, mg[1] - fy) < skip[g]) continue;
-              T G;
-              bool clamped;
-              const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
-              if (alpha == T(0)) continue;
-              const T next = trans * (T(1) - alpha);
-              if (next < T(kMinTransmittance)) break;
-              const T w = alpha * trans;
-              for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * val[g * D + ch];
-              trans = next;
-              last = k - start + 1;
-            }
-            const int64_t pix = static_cast<int64_t>(py) * width + px;
-            for (int64_t ch = 0; ch < D; ++ch) img[pix * D + ch] = accum[ch];
-            alpha_out[pix] = T(1) - trans;
-            last_out[pix] = last;
-          }
+        list.gather(ids + start, stop - start, m2, co, op, skip.data(), val, D);
+        if (D == 3) {
+          forwardTile<3>(list, D, tx, ty, width, height, accum.data(), img, alpha_out, last_out);
+        } else {
+          forwardTile<0>(list, D, tx, ty, width, height, accum.data(), img, alpha_out, last_out);
         }
       }
     });
@@ -258,7 +361,8 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
   const int64_t D = values.size(1);
   const int height = static_cast<int>(fwd.alpha.size(0));
   const int width = static_cast<int>(fwd.alpha.size(1));
-  // One gradient buffer per thread (tiles share Gaussians), summed at the end. Row layout:
+  // One gradient buffer per thread (tiles share Gaussians), summed at the end; each tile sums
+  // into its own list-ordered rows first and adds them to its thread's buffer once. Row layout:
   // mean2d (2), conic (3), opacity (1), values (D).
   const int64_t row = 6 + D;
   const int threads = at::get_num_threads();
@@ -282,44 +386,32 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
       T* buf = buf_base + static_cast<int64_t>(at::get_thread_num()) * n * row;
       std::vector<T> accum(static_cast<std::size_t>(D)), last_value(static_cast<std::size_t>(D));
+      std::vector<T> grads;
+      TileList<T> list;
       for (int64_t tile = begin; tile < end; ++tile) {
         const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
-        const int start = ranges[2 * tile];
+        const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
+        // Only the Gaussians up to the tile's last contributor have gradients.
+        int used = 0;
         for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
           for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
-            const int64_t pix = static_cast<int64_t>(py) * width + px;
-            const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-            const T final_trans = T(1) - alpha_fwd[pix];
-            const T* gpix = gimg + pix * D;
-            T trans = final_trans;
-            std::fill(accum.begin(), accum.end(), T(0));
-            std::fill(last_value.begin(), last_value.end(), T(0));
-            T last_alpha = T(0);
-            for (int k = start + last_fwd[pix] - 1; k >= start; --k) {
-              const int g = ids[k];
-              const T* mg = m2 + 2 * g;
-              if (gaussianPower(co + 3 * g, mg[0] - fx, mg[1] - fy) < skip[g]) continue;
-              T G;
-              bool clamped;
-              const T alpha = pixelAlpha(m2 + 2 * g, co + 3 * g, op[g], fx, fy, &G, &clamped);
-              if (alpha == T(0)) continue;
-              trans = trans / (T(1) - alpha);
-              const T w = alpha * trans;
-              T* gb = buf + static_cast<int64_t>(g) * row;
-              T g_a = T(0);
-              for (int64_t ch = 0; ch < D; ++ch) {
-                accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
-                last_value[ch] = val[g * D + ch];
-                g_a += (val[g * D + ch] - accum[ch]) * gpix[ch];
-                gb[6 + ch] += w * gpix[ch];
-              }
-              g_a *= trans;
-              g_a += galpha[pix] * final_trans / (T(1) - alpha);
-              last_alpha = alpha;
-              pixelAlphaBackward(m2 + 2 * g, co + 3 * g, op[g], fx, fy, G, clamped, g_a, gb, gb + 2,
-                                 gb + 5);
-            }
+            used = std::max(used, last_fwd[static_cast<int64_t>(py) * width + px]);
           }
+        }
+        if (used == 0) continue;
+        list.gather(ids + start, std::min(used, stop - start), m2, co, op, skip.data(), val, D);
+        grads.assign(static_cast<std::size_t>(list.size * row), T(0));
+        if (D == 3) {
+          backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
+                          accum.data(), last_value.data(), grads.data());
+        } else {
+          backwardTile<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
+                          accum.data(), last_value.data(), grads.data());
+        }
+        for (int j = 0; j < list.size; ++j) {
+          T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
+          const T* gt = grads.data() + j * row;
+          for (int64_t c = 0; c < row; ++c) gb[c] += gt[c];
         }
       }
     });
