@@ -2,6 +2,8 @@
 // state consistent, resume is exact, configuration JSON.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
@@ -384,6 +386,36 @@ TEST_F(TrainerTest, ResumeFromACheckpointIsExact) {
   EXPECT_TRUE(at::equal(a.means, b.means));
   EXPECT_TRUE(at::equal(a.sh, b.sh));
   EXPECT_TRUE(at::equal(a.opacity_logits, b.opacity_logits));
+  EXPECT_TRUE(at::equal(a.features, b.features));
+}
+
+TEST_F(TrainerTest, StepsThatDoNotReadTheLossesTrainTheSame) {
+  TrainConfig c = small(30);
+  c.densify_from = 5;
+  c.densify_interval = 10;
+  c.densify_grad_threshold = 1e-6;
+  Trainer reading(scene_, c), quiet(scene_, c);
+  gaussians::StepStats read_stats, quiet_stats;
+  for (int i = 0; i < 30; ++i) {
+    read_stats = reading.step(true);
+    quiet_stats = quiet.step(i == 29 || i == 14);
+    if (i == 13) {
+      EXPECT_FALSE(quiet_stats.losses_read);
+      EXPECT_TRUE(std::isnan(quiet_stats.loss) && std::isnan(quiet_stats.rgb_loss));
+      EXPECT_TRUE(read_stats.losses_read);
+      EXPECT_TRUE(std::isfinite(read_stats.loss));
+    }
+    if (i == 14) {
+      EXPECT_DOUBLE_EQ(quiet_stats.loss, read_stats.loss);
+    }
+  }
+  EXPECT_TRUE(quiet_stats.losses_read);
+  EXPECT_DOUBLE_EQ(quiet_stats.loss, read_stats.loss);
+  EXPECT_DOUBLE_EQ(quiet_stats.rgb_loss, read_stats.rgb_loss);
+  EXPECT_EQ(quiet_stats.num_gaussians, read_stats.num_gaussians);
+  const auto a = reading.parameters(), b = quiet.parameters();
+  ASSERT_EQ(a.means.size(0), b.means.size(0));
+  EXPECT_TRUE(at::equal(a.means, b.means));
   EXPECT_TRUE(at::equal(a.features, b.features));
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <tuple>
 #include <utility>
@@ -446,7 +447,7 @@ const TrainConfig& Trainer::config() const { return state_->config; }
 std::int64_t Trainer::numGaussians() const { return state_->n(); }
 GaussianParams Trainer::parameters() const { return state_->gaussians(); }
 
-StepStats Trainer::step() {
+StepStats Trainer::step(bool read_losses) {
   State& s = *state_;
   const TrainConfig& c = s.config;
   const int it = s.iteration;
@@ -659,22 +660,28 @@ StepStats Trainer::step() {
       }
     }
   }
-  enterPhase(profile, "loss values to host");
-  const at::Tensor zero = at::zeros({}, total.options());
-  at::Tensor values = at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero,
-                                 at::full({}, static_cast<double>(views.size()), total.options())});
-  if (s.collective) s.collective->sum(values);
-  values = values.to(at::kDouble).cpu();
-  const double* value = values.data_ptr<double>();
+  StepStats stats;
+  stats.iteration = s.iteration;
+  stats.losses_read = read_losses;
+  if (read_losses) {
+    enterPhase(profile, "loss values to host");
+    const at::Tensor zero = at::zeros({}, total.options());
+    at::Tensor values =
+        at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero,
+                   at::full({}, static_cast<double>(views.size()), total.options())});
+    if (s.collective) s.collective->sum(values);
+    values = values.to(at::kDouble).cpu();
+    const double* value = values.data_ptr<double>();
+    stats.rgb_loss = value[1] / value[3];
+    stats.semantic_loss = value[2] / batch;
+    stats.loss = value[0];
+  } else {
+    stats.loss = stats.rgb_loss = stats.semantic_loss = std::numeric_limits<double>::quiet_NaN();
+  }
   if (profile) {
     profile->leave();
     profile->countIteration();
   }
-  StepStats stats;
-  stats.iteration = s.iteration;
-  stats.rgb_loss = value[1] / value[3];
-  stats.semantic_loss = value[2] / batch;
-  stats.loss = value[0];
   stats.num_gaussians = s.n();
   stats.dropped = dropped;
   stats.removed_closed_gates = closed_at_end;

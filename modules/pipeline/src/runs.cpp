@@ -37,6 +37,10 @@ namespace sadsplat {
 namespace pipeline {
 namespace {
 
+// Iterations between two reads of the loss values (train log records, progress line, the
+// divergence check); the steps in between run without waiting for the device.
+constexpr int kLossInterval = 10;
+
 using Clock = std::chrono::steady_clock;
 using io::isDirectory;
 using io::makeDirectory;
@@ -119,7 +123,7 @@ void logStep(io::TrainLogWriter& log, const gaussians::StepStats& s, double seco
     r.gaussians = s.num_gaussians;
     log.append(r);
   }
-  if (s.iteration % 10 == 0 || last) {
+  if (s.losses_read && (s.iteration % kLossInterval == 0 || last)) {
     io::TrainLogRecord r;
     r.iteration = s.iteration;
     r.loss = s.loss;
@@ -242,8 +246,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
       throw TrainingInterrupted(o.out, trainer.iteration());
     }
     gaussians::StepStats stats;
+    // The losses are read where the log and the progress line show them (every 10th iteration
+    // and the last): the steps in between do not wait for the GPU.
+    const int next = trainer.iteration() + 1;
+    const bool read_losses = next % kLossInterval == 0 || next == config.iterations;
     try {
-      stats = trainer.step();
+      stats = trainer.step(read_losses);
     } catch (const c10::Error& e) {
       if (std::string(e.what()).find("out of memory") == std::string::npos) throw;
       throw Error(o.out, "training at iteration " + std::to_string(trainer.iteration() + 1),
@@ -253,7 +261,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   "CUDA out of memory");
     }
     const int it = stats.iteration;
-    if (!std::isfinite(stats.loss)) {
+    if (stats.losses_read && !std::isfinite(stats.loss)) {
       const std::string kept = last_checkpoint > 0 ? "; checkpoint.bin keeps iteration " +
                                                          std::to_string(last_checkpoint)
                                                    : "; no checkpoint was written yet";
@@ -297,7 +305,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
       *o.progress << "\n[floaters] end of training: removed " << stats.removed_floaters
                   << " Gaussians " << rule << ", " << stats.num_gaussians << " left\n";
     }
-    if (o.progress && (it % 10 == 0 || it == config.iterations)) {
+    if (o.progress && stats.losses_read) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = (it - first) / std::max(1e-9, elapsed);
       // Formatted apart so that the fixed-point state does not leak into the caller's stream.

@@ -69,6 +69,8 @@ class DropStrategy {
 /// \brief Numbers reported after each step.
 struct StepStats {
   int iteration = 0;
+  /// Whether the loss values below were read (step(true)); after step(false) they are NaN.
+  bool losses_read = true;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;
   std::int64_t num_gaussians = 0;
   std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
@@ -113,7 +115,11 @@ class Trainer {
   /// drop strategy, densification prunes by the opacity a Gaussian renders with at evaluation
   /// (opacity x deterministic gate), and the last step removes the Gaussians whose gate is closed;
   /// with TrainConfig::recovery_iterations the gates end earlier (see there).
-  StepStats step();
+  /// \param[in] read_losses whether to copy the step's loss values to the host. Reading them waits
+  /// for the device to finish the step; without it (false) a GPU step returns as soon as its work
+  /// is queued, so the host prepares the next step while the device runs this one. Every rank of
+  /// a group must pass the same value.
+  StepStats step(bool read_losses = true);
   /// \brief Iterations done so far.
   int iteration() const;
   const TrainConfig& config() const;
