@@ -39,6 +39,7 @@
 #include <cstdlib>
 
 #include "sadsplat/viz/display.h"
+#include "sadsplat/viz/experiment_charts.h"
 #include "sadsplat/viz/splat_view.h"
 #include "sadsplat/viz/training_report.h"
 #endif
@@ -369,6 +370,16 @@ int main(int argc, char** argv) {
   table->add_option("--baseline", table_baseline, "configuration to compare the counts with")
       ->capture_default_str();
   table->add_option("--out", table_out, "also write the Markdown to this file");
+  std::string table_plots;
+  table->add_option("--plots", table_plots,
+                    "write the frontier charts (frontier_psnr.png, frontier_miou.png) here (VTK)");
+  double table_goal_fewer = 12, table_goal_psnr = 0.3;
+  table->add_option("--goal-fewer", table_goal_fewer,
+                    "charts: the target's times fewer Gaussians (0: no target drawn)")
+      ->capture_default_str();
+  table->add_option("--goal-psnr-loss", table_goal_psnr,
+                    "charts: the target's largest PSNR loss in dB")
+      ->capture_default_str();
 
   auto* demo = app.add_subcommand("demo",
                                   "Generate the demo city, pseudo-label it, train on CPU with the "
@@ -551,12 +562,27 @@ int main(int argc, char** argv) {
       pseudo_options.progress = &std::cout;
       std::cout << sadsplat::pipeline::pseudoLabelRun(pseudo_options);
     } else if (*table) {
-      const std::string text = sadsplat::eval::experimentTables(
-          sadsplat::eval::readExperimentRuns(table_results), table_baseline);
+#if SADSPLAT_HAVE_VIZ
+      if (!table_plots.empty()) rerunUnderXvfbIfHeadless(argc, argv);  // before any output
+#endif
+      const auto runs = sadsplat::eval::readExperimentRuns(table_results);
+      const std::string text = sadsplat::eval::experimentTables(runs, table_baseline);
       if (!table_out.empty()) {
         sadsplat::io::writeFileAtomically(table_out, [&](std::ostream& o) { o << text; });
       }
       std::cout << text;
+      if (!table_plots.empty()) {
+#if SADSPLAT_HAVE_VIZ
+        for (const std::string& path : sadsplat::viz::writeFrontierCharts(
+                 table_plots, sadsplat::eval::frontierPoints(runs, table_baseline),
+                 table_baseline, {table_goal_fewer, table_goal_psnr})) {
+          std::cout << "wrote " << path << "\n";
+        }
+#else
+        throw sadsplat::Error(table_plots, "--plots", "a build with VTK (charts)",
+                              "this sadsplat was built without it");
+#endif
+      }
     } else if (*evaluate) {
       std::cout << sadsplat::pipeline::evalRun(eval_run, eval_scene);
 #if SADSPLAT_HAVE_VIZ

@@ -9,7 +9,8 @@
 #              pseudo-labels), drop (Net-2: full drop), pl (Net-3: pseudo-labels), full (Net-4:
 #              both) x training seeds 0-2
 #   pbase      the 3 seed-0 scenes x full drop with pseudo-labels, P_base 0 / 0.5 / 1 / 1.5 / 2
-#              (configurations full_p0 ... full_p2) x training seeds 0-2
+#              (configurations full_p0 ... full_p2) x training seeds 0-2; full_p1 is the ablation's
+#              `full` (same flags: P_base 1 is the default), its runs copied into the pbase folder
 # Env: SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
 # WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup (e.g. a quick CPU check).
 # No run starts after DEADLINE_S and every run stops at it. $OUT gets table_TABLE.tgz (the new

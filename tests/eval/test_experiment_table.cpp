@@ -64,6 +64,33 @@ TEST(ExperimentTable, MeanAndStdPerSceneAndKindWithTheBaselineFirst) {
   EXPECT_NE(text.find("| full | 50.0 |"), std::string::npos) << text;
 }
 
+// Each configuration against the baseline on the same scene, means over the training seeds;
+// scenes without baseline runs give no points.
+TEST(ExperimentTable, FrontierPointsCompareEachSceneWithItsBaseline) {
+  test::TempDir dir;
+  const std::string root = dir.path();
+  io::makeDirectory(root + "/city_0");
+  writeMetrics(root + "/city_0/none_t0", 0.70, 32.0, 1000, 0);
+  writeMetrics(root + "/city_0/none_t1", 0.72, 30.0, 1400, 0);
+  writeMetrics(root + "/city_0/full_t0", 0.80, 29.0, 100, 0);
+  writeMetrics(root + "/city_0/full_t1", 0.84, 30.0, 140, 0);
+  io::makeDirectory(root + "/port_1");
+  writeMetrics(root + "/port_1/full_t0", 0.9, 25.0, 10, 0);  // no baseline here
+
+  const auto points = eval::frontierPoints(eval::readExperimentRuns(root), "none");
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_EQ(points[0].scene, "city_0");
+  EXPECT_EQ(points[0].config, "full");
+  EXPECT_EQ(points[0].runs, 2);
+  EXPECT_NEAR(points[0].fewer, 1200.0 / 120.0, 1e-9);  // mean counts 1200 / 120
+  EXPECT_NEAR(points[0].miou_change, 82.0 - 71.0, 1e-9);
+  EXPECT_NEAR(points[0].psnr_change, 29.5 - 31.0, 1e-9);
+  EXPECT_EQ(points[1].config, "none");
+  EXPECT_NEAR(points[1].fewer, 1.0, 1e-12);
+  EXPECT_NEAR(points[1].psnr_change, 0.0, 1e-12);
+  EXPECT_TRUE(eval::frontierPoints(eval::readExperimentRuns(root), "nothing").empty());
+}
+
 TEST(ExperimentTable, MalformedFoldersAndMetricsAreClearErrors) {
   test::TempDir dir;
   io::makeDirectory(dir.file("city_0"));

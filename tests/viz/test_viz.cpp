@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene.h"
 #include "sadsplat/viz/color_mode.h"
@@ -270,6 +271,43 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
   EXPECT_GT(differ, cam.pixels.size() / 50) << "the view from view_002 is not the aerial view";
   EXPECT_EQ(test::runCommand(kCli + " report " + dir.file("nothing"), &out), 1);
   EXPECT_NE(out.find("run directory"), std::string::npos) << out;
+}
+
+// `sadsplat table --plots`: two frontier charts with a point per configuration and scene, the
+// target drawn; without baseline runs a clear error.
+TEST(FrontierCharts, TableWritesBothChartsWithTheirPoints) {
+  test::TempDir dir;
+  const std::string results = dir.file("results");
+  const auto metrics = [&](const std::string& run, double miou, double psnr, int gaussians) {
+    io::makeDirectory(results + "/" + run);
+    test::writeFile(results + "/" + run + "/metrics.json",
+                    "{\"miou\": " + std::to_string(miou) + ", \"psnr\": " +
+                        std::to_string(psnr) + ", \"ssim\": 0.9, \"num_gaussians\": " +
+                        std::to_string(gaussians) + "}");
+  };
+  metrics("city_0/none_t0", 0.70, 32.0, 1000);
+  metrics("city_0/full_t0", 0.80, 29.0, 100);
+  metrics("port_0/none_t0", 0.80, 31.0, 900);
+  metrics("port_0/full_t0", 0.85, 30.0, 60);
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " table " + results + " --plots " + dir.file("plots"), &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("wrote " + dir.file("plots/frontier_psnr.png")), std::string::npos) << out;
+  EXPECT_EQ(out.find("| city_0 | none |"), out.rfind("| city_0 | none |")) << "printed once";
+  for (const char* name : {"frontier_psnr.png", "frontier_miou.png"}) {
+    const Png png = readPng(dir.file(std::string("plots/") + name));
+    EXPECT_EQ(png.width, 900) << name;
+    EXPECT_EQ(png.height, 550) << name;
+    // The baseline's points (blue) and the full method's (orange) are drawn.
+    EXPECT_GT(share(png, 0, png.width, {31, 119, 180}), 0.0) << name;
+    EXPECT_GT(share(png, 0, png.width, {255, 127, 14}), 0.0) << name;
+  }
+  EXPECT_EQ(test::runCommand(kCli + " table " + results + " --baseline nothing --plots " +
+                                 dir.file("plots2"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("runs of the baseline configuration 'nothing'"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
@@ -214,6 +215,35 @@ std::string experimentTables(const std::vector<ExperimentRun>& runs, const std::
     }
   }
   return out.str();
+}
+
+std::vector<FrontierPoint> frontierPoints(const std::vector<ExperimentRun>& runs,
+                                          const std::string& baseline) {
+  struct Sums {
+    std::vector<double> miou, psnr, gaussians;
+  };
+  std::map<std::pair<std::string, std::string>, Sums> groups;  // (scene, config)
+  for (const ExperimentRun& r : runs) {
+    Sums& s = groups[{r.scene, r.config}];
+    s.miou.push_back(r.miou);
+    s.psnr.push_back(r.psnr);
+    s.gaussians.push_back(r.gaussians);
+  }
+  std::vector<FrontierPoint> points;
+  for (const auto& [key, sums] : groups) {
+    const auto base = groups.find({key.first, baseline});
+    if (base == groups.end()) continue;
+    const double gaussians = meanStd(sums.gaussians).mean;
+    FrontierPoint p;
+    p.scene = key.first;
+    p.config = key.second;
+    p.runs = static_cast<int>(sums.miou.size());
+    p.fewer = gaussians > 0 ? meanStd(base->second.gaussians).mean / gaussians : 0;
+    p.miou_change = 100 * (meanStd(sums.miou).mean - meanStd(base->second.miou).mean);
+    p.psnr_change = meanStd(sums.psnr).mean - meanStd(base->second.psnr).mean;
+    points.push_back(p);
+  }
+  return points;
 }
 
 }  // namespace eval

@@ -45,5 +45,21 @@ MeanStd meanStd(const std::vector<double>& values);
 /// absent).
 std::string experimentTables(const std::vector<ExperimentRun>& runs, const std::string& baseline);
 
+/// \brief One point of the compactness-quality frontier: a configuration on one scene against the
+/// baseline configuration on the same scene, each the mean over its training seeds.
+struct FrontierPoint {
+  std::string scene;
+  std::string config;
+  int runs = 0;              ///< trainings of this configuration on this scene
+  double fewer = 0;          ///< baseline Gaussians / these (means)
+  double miou_change = 0;    ///< mIoU minus the baseline's, in points (%)
+  double psnr_change = 0;    ///< PSNR minus the baseline's, in dB
+};
+
+/// \brief The frontier points of every configuration (the baseline included, at 1x / 0 / 0) on
+/// every scene that has baseline runs, sorted by scene and configuration.
+std::vector<FrontierPoint> frontierPoints(const std::vector<ExperimentRun>& runs,
+                                          const std::string& baseline);
+
 }  // namespace eval
 }  // namespace sadsplat
