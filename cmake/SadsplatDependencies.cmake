@@ -95,6 +95,8 @@ if(SADSPLAT_COMPILE_CUDA)
   enable_language(CUDA)
   set(CMAKE_CUDA_STANDARD 17)
   set(CMAKE_CUDA_STANDARD_REQUIRED ON)
+  # nvcc flags of every module's kernels.
+  set(SADSPLAT_CUDA_FLAGS $<$<COMPILE_LANGUAGE:CUDA>:--expt-relaxed-constexpr -lineinfo>)
   if(TARGET c10_cuda)
     set(SADSPLAT_HAVE_CUDA ON)
   endif()

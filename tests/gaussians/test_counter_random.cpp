@@ -35,6 +35,15 @@ TEST(CounterRandom, OpenUnitIntervalAndUniformMoments) {
   EXPECT_LT(std::abs((x * y).mean().item<double>()) * 12, 0.01);
 }
 
+// The per-element form that kernels use gives the tensor draw's numbers, bit for bit.
+TEST(CounterRandom, OneElementAtATimeGivesTheTensorNumbers) {
+  const at::Tensor u = counterUniform(3000, 42, 13, 7, at::TensorOptions().dtype(at::kFloat));
+  const gaussians::CounterKey key = gaussians::counterKey(42, 13, 7);
+  for (std::int64_t i = 0; i < 3000; ++i) {
+    ASSERT_EQ(gaussians::counterUniformAt(key, i), u[i].item<float>()) << i;
+  }
+}
+
 TEST(CounterRandom, CudaGivesTheCpuNumbers) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
   const auto cpu = at::TensorOptions().dtype(at::kFloat);

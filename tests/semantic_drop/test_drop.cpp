@@ -8,6 +8,7 @@
 #include <set>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/counter_random.h"
 
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/semantic_drop/drop_filters.h"
@@ -49,6 +50,33 @@ TEST(HardConcrete, GradientsReachLogAlpha) {
   const double p = probabilityNonZero(0.0);
   const auto gp = torch::autograd::grad({probabilityNonZero(log_alpha).sum()}, {log_alpha})[0];
   EXPECT_NEAR(gp[0].item<double>(), p * (1 - p), 1e-12);
+}
+
+// The training gate with the counter-based noise: on the CPU exactly sampleGate of
+// counterUniform; on CUDA the fused kernels give the same gates and log_alpha gradients.
+TEST(HardConcrete, CounterGateIsSampleGateOfTheCounterNoise) {
+  at::manual_seed(5);
+  const at::Tensor log_alpha = (at::randn({5000}) * 3).requires_grad_(true);
+  const at::Tensor weights = at::randn({5000});
+  const at::Tensor u = gaussians::counterUniform(5000, 42, 13, 77, log_alpha.options());
+  const at::Tensor reference = sampleGate(log_alpha, u);
+  const at::Tensor reference_grad =
+      torch::autograd::grad({(reference * weights).sum()}, {log_alpha})[0];
+  const at::Tensor gate = sampleCounterGate(log_alpha, 42, 13, 77);
+  EXPECT_FALSE(counterGateIsFused(log_alpha));
+  EXPECT_TRUE(at::equal(gate, reference));
+  EXPECT_GT((gate == 0).sum().item<int64_t>(), 100) << "closed gates are in the test";
+  EXPECT_GT((gate == 1).sum().item<int64_t>(), 100) << "open gates are in the test";
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const at::Tensor cuda_alpha = log_alpha.detach().cuda().requires_grad_(true);
+  EXPECT_TRUE(counterGateIsFused(cuda_alpha));
+  const at::Tensor cuda_gate = sampleCounterGate(cuda_alpha, 42, 13, 77);
+  EXPECT_TRUE(at::allclose(cuda_gate.cpu(), reference.detach(), 1e-5, 1e-5))
+      << (cuda_gate.cpu() - reference).abs().max();
+  const at::Tensor cuda_grad =
+      torch::autograd::grad({(cuda_gate * weights.cuda()).sum()}, {cuda_alpha})[0];
+  EXPECT_TRUE(at::allclose(cuda_grad.cpu(), reference_grad, 1e-4, 1e-5))
+      << (cuda_grad.cpu() - reference_grad).abs().max();
 }
 
 TEST(SemanticConfidence, EqualsAHandComputationOnATwoViewToyScene) {

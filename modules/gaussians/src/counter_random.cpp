@@ -26,11 +26,18 @@ at::Tensor hash32(at::Tensor x) {
 
 }  // namespace
 
+CounterKey counterKey(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
+  const std::uint64_t key = mixBits(seed ^ mixBits(purpose ^ mixBits(iteration)));
+  CounterKey k;
+  k.low = static_cast<std::uint32_t>(key & 0xFFFFFFFFull);
+  k.high = static_cast<std::uint32_t>(key >> 32);
+  return k;
+}
+
 at::Tensor counterUniform(std::int64_t n, std::uint64_t seed, std::uint64_t purpose,
                           std::uint64_t iteration, const at::TensorOptions& options) {
-  const std::uint64_t key = mixBits(seed ^ mixBits(purpose ^ mixBits(iteration)));
-  const std::int64_t low = static_cast<std::int64_t>(key & 0xFFFFFFFFull);
-  const std::int64_t high = static_cast<std::int64_t>(key >> 32);
+  const CounterKey key = counterKey(seed, purpose, iteration);
+  const std::int64_t low = key.low, high = key.high;
   const at::Tensor index = at::arange(n, options.dtype(at::kLong));
   // Two rounds keyed by both halves of the key; the index's high bits enter the second round.
   at::Tensor x = hash32(at::bitwise_xor(at::bitwise_and(index, std::int64_t{0xFFFFFFFF}), low));

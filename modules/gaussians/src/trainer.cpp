@@ -15,6 +15,7 @@
 #include "sadsplat/gaussians/adam.h"
 #include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/counter_random.h"
+#include "sadsplat/gaussians/densification_stats.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -576,15 +577,8 @@ StepStats Trainer::step(bool read_losses) {
       const RenderResult& r = renders[k];
       const RasterCamera& cam = s.cameras[views[k]];
       if (!r.means2d.grad().defined()) continue;
-      // Scaled column by column: no small tensor built on the host and copied every step.
-      const at::Tensor grad = r.means2d.grad();
-      const at::Tensor gx = grad.select(1, 0) * (cam.width * 0.5 * batch);
-      const at::Tensor gy = grad.select(1, 1) * (cam.height * 0.5 * batch);
-      const at::Tensor norm = at::sqrt(gx * gx + gy * gy);
-      const at::Tensor visible = r.radii > 0;
-      grad_accum += at::where(visible, norm, at::zeros_like(norm));
-      denom += visible.to(at::kFloat);
-      max_radii = at::where(visible, at::max(max_radii, r.radii.to(at::kFloat)), max_radii);
+      accumulateScreenGradients(r.means2d.grad(), r.radii, cam.width * 0.5 * batch,
+                                cam.height * 0.5 * batch, grad_accum, denom, max_radii);
     }
     if (s.collective) {
       enterPhase(profile, "all-reduce");

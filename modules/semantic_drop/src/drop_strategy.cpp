@@ -24,9 +24,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
     // Counter-based noise on the parameters' device: nothing drawn on the host and copied.
-    const at::Tensor u = gaussians::counterUniform(
-        log_alpha.size(0), seed_, 13, static_cast<std::uint64_t>(iteration), log_alpha.options());
-    return sampleGate(log_alpha, u, hc_);
+    return sampleCounterGate(log_alpha, seed_, 13, static_cast<std::uint64_t>(iteration), hc_);
   }
 
   at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {

@@ -9,12 +9,18 @@
 
 #include <cstdint>
 
+#include "sadsplat/gaussians/counter_hash.h"
+
 namespace sadsplat {
 namespace gaussians {
 
 /// \brief splitmix64's finaliser: a well-mixed 64-bit key from any 64-bit input (the trainer's
 /// seeded shuffles and generators are keyed by it too).
 std::uint64_t mixBits(std::uint64_t x);
+
+/// \brief The key of the draw (seed, purpose, iteration): counterUniform's element i is
+/// counterUniformAt(counterKey(seed, purpose, iteration), i) (counter_hash.h).
+CounterKey counterKey(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration);
 
 /// \brief n numbers uniform in (0, 1) (multiples of 2^-24, offset by 2^-25: never 0 or 1).
 /// \param[in] options device and floating dtype of the result

@@ -13,6 +13,8 @@
 
 #include <ATen/ATen.h>
 
+#include <cstdint>
+
 namespace sadsplat {
 namespace semantic_drop {
 
@@ -31,6 +33,15 @@ at::Tensor probabilityNonZero(const at::Tensor& log_alpha, const HardConcretePar
 /// in (0, 1) of the same shape.
 at::Tensor sampleGate(const at::Tensor& log_alpha, const at::Tensor& uniform,
                       const HardConcreteParams& p = {});
+/// \brief sampleGate with the trainer's counter-based noise, counterUniform(n, seed, purpose,
+/// iteration) (sadsplat/gaussians/counter_random.h). On CUDA (float32) the noise, the gate and
+/// its gradient come from one kernel each (nothing but log_alpha kept for the backward pass);
+/// elsewhere sampleGate(log_alpha, counterUniform(...)).
+at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed,
+                             std::uint64_t purpose, std::uint64_t iteration,
+                             const HardConcreteParams& p = {});
+/// \brief Whether sampleCounterGate takes the fused path for this tensor.
+bool counterGateIsFused(const at::Tensor& log_alpha);
 /// \brief The deterministic gate used at evaluation: clamp(sigmoid(log_alpha) (r - l) + l, 0, 1).
 at::Tensor deterministicGate(const at::Tensor& log_alpha, const HardConcreteParams& p = {});
 
