@@ -263,6 +263,15 @@ int main(int argc, char** argv) {
   train->add_option(
       "--lambda-l0", train_lambda_l0,
       "weight of the L0 sparsity loss (0.2; 0.1 renders 1.0-1.4 dB better and keeps ~1.7x more)");
+  int train_l0_from = -1, train_l0_ramp = -1;
+  train
+      ->add_option("--lambda-l0-from", train_l0_from,
+                   "the L0 loss starts at this iteration (not the paper; 0 = from the start)")
+      ->check(CLI::NonNegativeNumber);
+  train
+      ->add_option("--lambda-l0-ramp", train_l0_ramp,
+                   "the L0 weight rises linearly over this many iterations (0 = at once)")
+      ->check(CLI::NonNegativeNumber);
   int train_recovery = -1;
   train
       ->add_option("--recovery", train_recovery,
@@ -511,6 +520,8 @@ int main(int argc, char** argv) {
       if (!train_drop.empty()) config.drop = train_drop;
       if (train_p_base >= 0) config.p_base = train_p_base;
       if (train_lambda_l0 >= 0) config.lambda_l0 = train_lambda_l0;
+      if (train_l0_from >= 0) config.lambda_l0_from = train_l0_from;
+      if (train_l0_ramp >= 0) config.lambda_l0_ramp = train_l0_ramp;
       if (train_recovery >= 0) config.recovery_iterations = train_recovery;
       if (train_recovery_prune >= 0) config.recovery_prune = train_recovery_prune;
       if (train_views_per_step > 0) config.views_per_step = train_views_per_step;

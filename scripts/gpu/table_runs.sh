@@ -11,6 +11,9 @@
 #   pbase      the 3 seed-0 scenes x full drop with pseudo-labels, P_base 0 / 0.5 / 1 / 1.5 / 2
 #              (configurations full_p0 ... full_p2) x training seeds 0-2; full_p1 is the ablation's
 #              `full` (same flags: P_base 1 is the default), its runs copied into the pbase folder
+#   l0schedule the 3 seed-0 scenes x full drop with pseudo-labels and the L0 weight off until
+#              iteration N (_fromN), rising over M iterations (_rampM), weight X (_lambdaX)
+# A configuration full_<parts> takes any of the parts pX (P_base), lambdaX, fromN, rampM.
 # Env: SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
 # WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup (e.g. a quick CPU check).
 # No run starts after DEADLINE_S and every run stops at it. $OUT gets table_TABLE.tgz (the new
@@ -18,7 +21,7 @@
 #   tar xzf table_TABLE.tgz -C docs/experiments/TABLE && sadsplat table docs/experiments/TABLE \
 #     --out docs/experiments/TABLE/README.md
 set -uo pipefail
-table="${1:?usage: table_runs.sh ablation|pbase [JOBS] [DEADLINE_S]}"
+table="${1:?usage: table_runs.sh ablation|pbase|l0schedule [JOBS] [DEADLINE_S]}"
 parallel="${2:-4}"; deadline="${3:-540}"
 start=$(date +%s)
 out="${OUT:-/tmp/sadsplat-gpu-out}"
@@ -36,7 +39,9 @@ case "$table" in
             configs=(none full drop pl) ;;
   pbase)    scenes=(city_0 country_0 port_0)
             configs=(full_p1 full_p0 full_p2 full_p0.5 full_p1.5) ;;
-  *) echo "unknown table $table (ablation or pbase)"; exit 2 ;;
+  l0schedule) scenes=(city_0 country_0 port_0)
+            configs=(full_from3500 full_from3500_lambda0.4 full_from2000_ramp1500) ;;
+  *) echo "unknown table $table (ablation, pbase or l0schedule)"; exit 2 ;;
 esac
 [ -n "${SCENES:-}" ] && read -r -a scenes <<< "$SCENES"
 [ -n "${CONFIGS:-}" ] && read -r -a configs <<< "$CONFIGS"
@@ -71,8 +76,19 @@ run_one() {
     none) ;;
     drop) flags=(--drop full) ;;
     pl) cache="$dir/scene_pl.cache" ;;
-    full) cache="$dir/scene_pl.cache"; flags=(--drop full) ;;
-    full_p*) cache="$dir/scene_pl.cache"; flags=(--drop full --p-base "${config#full_p}") ;;
+    full|full_*)
+      cache="$dir/scene_pl.cache"; flags=(--drop full)
+      local token
+      for token in ${config//_/ }; do
+        case "$token" in
+          full) ;;
+          p[0-9]*) flags+=(--p-base "${token#p}") ;;
+          lambda*) flags+=(--lambda-l0 "${token#lambda}") ;;
+          from*) flags+=(--lambda-l0-from "${token#from}") ;;
+          ramp*) flags+=(--lambda-l0-ramp "${token#ramp}") ;;
+          *) echo "unknown part $token of configuration $config"; return 1 ;;
+        esac
+      done ;;
     *) echo "unknown configuration $config"; return 1 ;;
   esac
   local run="$work/runs/$scene/$name" dest="$new/$scene/$name"

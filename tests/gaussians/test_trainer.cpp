@@ -171,7 +171,7 @@ class EvenGatesClosed : public gaussians::DropStrategy {
     return (at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 2)
         .to(log_alpha.dtype());
   }
-  at::Tensor regularisation(const at::Tensor&) const override { return {}; }
+  at::Tensor regularisation(const at::Tensor&, int) const override { return {}; }
   bool dropNow(int) const override { return false; }
   gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
 };
@@ -256,7 +256,7 @@ class ThirdsGates : public gaussians::DropStrategy {
         at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 3;
     return (third.to(log_alpha.dtype()) * 0.5).to(log_alpha.device());
   }
-  at::Tensor regularisation(const at::Tensor& log_alpha) const override {
+  at::Tensor regularisation(const at::Tensor& log_alpha, int) const override {
     return 10 + 0 * log_alpha.sum();
   }
   bool dropNow(int done) const override {
@@ -445,9 +445,13 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   TrainConfig c;
   c.iterations = 123;
   c.background = {0.5f, 0.25f, 1.f};
+  c.lambda_l0_from = 3500;
+  c.lambda_l0_ramp = 700;
   const TrainConfig back = TrainConfig::fromJson(c.toJson(), "x");
   EXPECT_EQ(back.iterations, 123);
   EXPECT_EQ(back.background[1], 0.25f);
+  EXPECT_EQ(back.lambda_l0_from, 3500);
+  EXPECT_EQ(back.lambda_l0_ramp, 700);
   c.device = "tpu";
   EXPECT_THROW(Trainer(scene_, c), Error);
 }
@@ -463,6 +467,7 @@ TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRat
   EXPECT_EQ(b.opacity_reset_interval, 750);
   EXPECT_EQ(b.sh_increase_interval, 250);
   EXPECT_EQ(b.drop_interval, 125);
+  EXPECT_EQ(b.lambda_l0_from, 0);       // still the paper's constant weight
   EXPECT_EQ(b.densify_until, -1);       // still "half of the iterations"
   EXPECT_EQ(b.checkpoint_interval, 0);  // still none
   EXPECT_DOUBLE_EQ(b.lr_opacity, 2 * c.lr_opacity);

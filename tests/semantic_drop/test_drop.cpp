@@ -237,6 +237,47 @@ TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
   c.drop = "full";
   c.lambda_l0 = -0.1;
   EXPECT_THROW(makeDropStrategy(c), Error);
+  c.lambda_l0 = 0.2;
+  c.lambda_l0_from = -1;
+  EXPECT_THROW(makeDropStrategy(c), Error);
+  c.lambda_l0_from = 0;
+  c.lambda_l0_ramp = -5;
+  EXPECT_THROW(makeDropStrategy(c), Error);
+}
+
+TEST(DropStrategy, L0WeightFollowsItsSchedule) {
+  // The paper: constant.
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.2, 0, 0, 0), 0.2);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.2, 0, 0, 6999), 0.2);
+  // Off until iteration 100, then 1/4, 2/4, ... of the weight over 4 iterations.
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 4, 99), 0.0);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 4, 100), 0.1);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 4, 101), 0.2);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 4, 103), 0.4);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 4, 500), 0.4);
+  EXPECT_DOUBLE_EQ(scheduledL0Weight(0.4, 100, 0, 100), 0.4);
+}
+
+TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
+  gaussians::TrainConfig c;
+  c.drop = "full";
+  c.lambda_l0 = 0.5;
+  c.lambda_l0_from = 10;
+  c.lambda_l0_ramp = 2;
+  const auto drop = makeDropStrategy(c);
+  const at::Tensor log_alpha = at::zeros({4});
+  EXPECT_FALSE(drop->regularisation(log_alpha, 9).defined());
+  const double mean_p = probabilityNonZero(log_alpha, HardConcreteParams{}).mean().item<double>();
+  EXPECT_NEAR(drop->regularisation(log_alpha, 10).item<double>(), 0.25 * mean_p, 1e-6);
+  EXPECT_NEAR(drop->regularisation(log_alpha, 11).item<double>(), 0.5 * mean_p, 1e-6);
+  // The paper's rule: the full weight from the first iteration.
+  c.lambda_l0_from = 0;
+  c.lambda_l0_ramp = 0;
+  EXPECT_NEAR(makeDropStrategy(c)->regularisation(log_alpha, 0).item<double>(), 0.5 * mean_p,
+              1e-6);
+  // Without the structure term there is no L0 term at all.
+  c.drop = "semantic";
+  EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100).defined());
 }
 
 }  // namespace

@@ -74,6 +74,8 @@ TrainConfig TrainConfig::forGlobalBatch(int views) const {
   c.checkpoint_interval = steps(checkpoint_interval);
   c.drop_interval = steps(drop_interval);
   c.recovery_iterations = steps(recovery_iterations);
+  c.lambda_l0_from = steps(lambda_l0_from);
+  c.lambda_l0_ramp = steps(lambda_l0_ramp);
   const double lr = std::sqrt(static_cast<double>(views));
   for (double* rate :
        {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest, &c.lr_opacity,
@@ -127,6 +129,8 @@ std::string TrainConfig::toJson() const {
                       {"p_base", p_base},
                       {"drop_interval", drop_interval},
                       {"lambda_l0", lambda_l0},
+                      {"lambda_l0_from", lambda_l0_from},
+                      {"lambda_l0_ramp", lambda_l0_ramp},
                       {"lr_log_alpha", lr_log_alpha},
                       {"log_alpha_init", log_alpha_init},
                       {"recovery_iterations", recovery_iterations},
@@ -208,6 +212,8 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.p_base = real(d, "p_base", origin);
   c.drop_interval = integer<int>(d, "drop_interval", origin);
   c.lambda_l0 = real(d, "lambda_l0", origin);
+  c.lambda_l0_from = integer<int>(d, "lambda_l0_from", origin);
+  c.lambda_l0_ramp = integer<int>(d, "lambda_l0_ramp", origin);
   c.lr_log_alpha = real(d, "lr_log_alpha", origin);
   c.log_alpha_init = real(d, "log_alpha_init", origin);
   c.recovery_iterations = integer<int>(d, "recovery_iterations", origin);

@@ -559,7 +559,7 @@ StepStats Trainer::step(bool read_losses) {
   if (batch > 1) total = total / batch;
   if (gated) {
     // Added once over all ranks.
-    const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value);
+    const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value, it);
     if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);
   }
   enterPhase(profile, "backward");

@@ -1,5 +1,7 @@
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
+#include <algorithm>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/semantic_drop/semantic_confidence.h"
@@ -18,6 +20,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         interval_(c.drop_interval),
         iterations_(c.iterations),
         lambda_l0_(c.lambda_l0),
+        lambda_l0_from_(c.lambda_l0_from),
+        lambda_l0_ramp_(c.lambda_l0_ramp),
         seed_(c.seed),
         hc_(hc) {}
 
@@ -31,9 +35,12 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     return structure_ ? deterministicGate(log_alpha, hc_) : at::Tensor();
   }
 
-  at::Tensor regularisation(const at::Tensor& log_alpha) const override {
-    // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0.
-    return structure_ ? lambda_l0_ * probabilityNonZero(log_alpha, hc_).mean() : at::Tensor();
+  at::Tensor regularisation(const at::Tensor& log_alpha, int iteration) const override {
+    // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0 (or its schedule).
+    const double weight =
+        scheduledL0Weight(lambda_l0_, lambda_l0_from_, lambda_l0_ramp_, iteration);
+    if (!structure_ || weight == 0) return {};
+    return weight * probabilityNonZero(log_alpha, hc_).mean();
   }
 
   bool dropNow(int done) const override {
@@ -77,11 +84,18 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   double p_base_;
   int interval_, iterations_;
   double lambda_l0_;
+  int lambda_l0_from_, lambda_l0_ramp_;
   std::uint64_t seed_;
   HardConcreteParams hc_;
 };
 
 }  // namespace
+
+double scheduledL0Weight(double lambda, int from, int ramp, int iteration) {
+  if (iteration < from) return 0;
+  if (ramp <= 0) return lambda;
+  return lambda * std::min(1.0, static_cast<double>(iteration - from + 1) / ramp);
+}
 
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
                                                                 const HardConcreteParams& hc) {
@@ -89,6 +103,12 @@ std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians:
     throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
   if (!(c.lambda_l0 >= 0)) {
     throw Error("<config>", "lambda_l0", "a non-negative weight", std::to_string(c.lambda_l0));
+  }
+  if (c.lambda_l0_from < 0 || c.lambda_l0_ramp < 0) {
+    const bool from = c.lambda_l0_from < 0;
+    throw Error("<config>", from ? "lambda_l0_from" : "lambda_l0_ramp",
+                "a non-negative number of iterations",
+                std::to_string(from ? c.lambda_l0_from : c.lambda_l0_ramp));
   }
   if (c.drop_interval < 1) {
     throw Error("<config>", "drop_interval", "a positive number of iterations",

@@ -77,6 +77,12 @@ struct TrainConfig {
   /// Weight of L_L0. 0.2 was chosen on city seed 1 (0.1 / 0.2 / 0.4) for >= 5x fewer Gaussians
   /// at equal mIoU; it costs ~3 dB PSNR against no drop (0.1: ~1.7 dB, ~4x fewer). See README.
   double lambda_l0 = 0.2;
+  /// Not the paper: the L0 weight is 0 before iteration lambda_l0_from and then rises linearly
+  /// to lambda_l0 over lambda_l0_ramp iterations (semantic_drop::scheduledL0Weight), so that the
+  /// gates learn with the full, densified set before they are pushed shut. 0 / 0 = the paper's
+  /// constant weight.
+  int lambda_l0_from = 0;
+  int lambda_l0_ramp = 0;
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
   /// Not the paper: the last `recovery_iterations` iterations train without gates, L0 term and

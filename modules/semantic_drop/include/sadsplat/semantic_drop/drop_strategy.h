@@ -12,11 +12,16 @@
 namespace sadsplat {
 namespace semantic_drop {
 
+/// \brief The weight of L_L0 in (0-based) `iteration`: 0 before `from`, then rising linearly to
+/// `lambda` over `ramp` iterations (ramp 0: `lambda` at once; from 0, ramp 0: the paper's
+/// constant weight).
+double scheduledL0Weight(double lambda, int from, int ramp, int iteration);
+
 /// \brief The strategy for `config.drop` (none | semantic | structure | full), or nullptr for
 /// none. "semantic" uses only P_conf, "structure" only the gates (P_learned and L0), "full" both.
 /// Until pseudo-label confidence maps exist, P_conf comes from one-hot maps of the labelled
 /// views, so a Gaussian seen in none of them has P_conf = 0.
-/// \throws sadsplat::Error on an unknown mode or a negative P_base / interval
+/// \throws sadsplat::Error on an unknown mode or a negative P_base / interval / L0 schedule
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(
     const gaussians::TrainConfig& config, const HardConcreteParams& hc = {});
 
