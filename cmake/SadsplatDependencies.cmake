@@ -102,6 +102,28 @@ if(SADSPLAT_COMPILE_CUDA)
   endif()
 endif()
 
+# A module's CUDA kernels: sadsplat_add_cuda_sources(target SOURCES a.cu ... INCLUDES dir ...).
+# With a CUDA LibTorch they are part of the target. With nvcc but a CPU-only LibTorch they compile
+# into an object library nobody links (INCLUDES: the module include folders the kernels need,
+# since an object library gets none from the target), so a CPU-only build still sees them build.
+# Always (with or without CUDA) the target and the kernels see modules/common/cuda (sadsplat/common/cuda_support.h,
+# internal, not installed).
+function(sadsplat_add_cuda_sources target)
+  cmake_parse_arguments(ARG "" "" "SOURCES;INCLUDES" ${ARGN})
+  set(support ${PROJECT_SOURCE_DIR}/modules/common/cuda)
+  target_include_directories(${target} PRIVATE $<BUILD_INTERFACE:${support}>)
+  if(SADSPLAT_HAVE_CUDA)
+    target_sources(${target} PRIVATE ${ARG_SOURCES})
+    target_compile_options(${target} PRIVATE ${SADSPLAT_CUDA_FLAGS})
+  elseif(SADSPLAT_COMPILE_CUDA)
+    add_library(${target}_cuda_compile_check OBJECT ${ARG_SOURCES})
+    target_include_directories(${target}_cuda_compile_check PRIVATE ${support} ${ARG_INCLUDES})
+    target_link_libraries(${target}_cuda_compile_check PRIVATE sadsplat::torch
+                          sadsplat::build_flags)
+    target_compile_options(${target}_cuda_compile_check PRIVATE ${SADSPLAT_CUDA_FLAGS})
+  endif()
+endfunction()
+
 # --- OpenMP ---------------------------------------------------------------------------------
 # at::parallel_for is a header template: it runs on several threads only in code compiled with
 # OpenMP, LibTorch's CPU parallel backend (without it the CPU rasterizer used one core). Not with

@@ -3,7 +3,7 @@
 #include <cuda_runtime.h>
 
 #include "adam_math.h"
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -28,8 +28,7 @@ void stepCuda(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tens
   stepKernel<<<static_cast<unsigned>(blocks), kThreads, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
       value.data_ptr<float>(), grad.defined() ? grad.data_ptr<float>() : nullptr,
       m.data_ptr<float>(), v.data_ptr<float>(), n, c);
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) throw Error("<adam>", "CUDA launch", "success", cudaGetErrorString(err));
+  checkCudaLaunch("<adam>", "stepKernel");
 }
 
 }  // namespace adam

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "cuda_stream.h"
+#include "sadsplat/common/cuda_support.h"
 #include "sadsplat/common/error.h"
 
 namespace sadsplat {

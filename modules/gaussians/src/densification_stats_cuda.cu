@@ -2,7 +2,7 @@
 #include <ATen/ATen.h>
 #include <cuda_runtime.h>
 
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -36,10 +36,7 @@ void accumulateCuda(const at::Tensor& grad, const at::Tensor& radii, float scale
                      static_cast<cudaStream_t>(stream)>>>(
       n, reinterpret_cast<const float2*>(grad.data_ptr<float>()), radii.data_ptr<int>(), scale_x,
       scale_y, grad_accum.data_ptr<float>(), denom.data_ptr<float>(), max_radii.data_ptr<float>());
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) {
-    throw Error("<densification statistics>", "CUDA launch", "success", cudaGetErrorString(err));
-  }
+  checkCudaLaunch("<densification statistics>", "accumulateKernel");
 }
 
 }  // namespace densification_stats

@@ -10,7 +10,7 @@
 #include <tuple>
 
 #include "raster_backend.h"
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
 
@@ -29,12 +29,7 @@ void check(const at::Tensor& t, const char* name) {
   }
 }
 
-void checkLaunch(const char* kernel) {
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) {
-    throw Error("<render>", kernel, "a successful CUDA kernel launch", cudaGetErrorString(err));
-  }
-}
+void checkLaunch(const char* kernel) { checkCudaLaunch("<render>", kernel); }
 
 int blocksFor(int64_t n) { return static_cast<int>((n + kThreads1d - 1) / kThreads1d); }
 

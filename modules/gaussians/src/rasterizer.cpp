@@ -11,7 +11,7 @@
 #include <c10/cuda/CUDAGuard.h>
 #endif
 
-#include "cuda_stream.h"
+#include "sadsplat/common/cuda_support.h"
 #include "raster_backend.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"

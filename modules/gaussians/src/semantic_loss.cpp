@@ -6,7 +6,7 @@
 #include <c10/cuda/CUDAGuard.h>
 #endif
 
-#include "cuda_stream.h"
+#include "sadsplat/common/cuda_support.h"
 #include "sadsplat/gaussians/step_profile.h"
 #include "semantic_loss_backend.h"
 

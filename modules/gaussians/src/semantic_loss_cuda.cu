@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 #include "semantic_loss_backend.h"
 
 namespace sadsplat {
@@ -209,10 +209,7 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
   for (int k = threadIdx.x; k < C; k += blockDim.x) atomicAdd(&grad_b[k], block_grad[C * D + k]);
 }
 
-void check(const char* what) {
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) throw Error("<semantic loss>", what, "success", cudaGetErrorString(err));
-}
+void check(const char* what) { checkCudaLaunch("<semantic loss>", what); }
 
 static_assert(kMaxChannels <= 32, "a lane holds one channel");
 

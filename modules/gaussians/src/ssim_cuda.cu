@@ -5,7 +5,7 @@
 #include <ATen/ATen.h>
 #include <cuda_runtime.h>
 
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 #include "ssim_backend.h"
 
 namespace sadsplat {
@@ -107,10 +107,7 @@ __global__ void gradientVertical(const float* blurred, const float* a, const flo
   grad[i] = scale * (s[0] + 2 * a[i] * s[1] + b[i] * s[2]);
 }
 
-void check(const char* what) {
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) throw Error("<ssim>", what, "success", cudaGetErrorString(err));
-}
+void check(const char* what) { checkCudaLaunch("<ssim>", what); }
 
 Window makeWindow() {
   const std::array<float, 11> w = window();

@@ -4,7 +4,7 @@
 
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
-#include <c10/cuda/CUDAStream.h>
+#include "sadsplat/common/cuda_support.h"
 #endif
 
 #include <algorithm>
@@ -20,10 +20,6 @@ namespace {
 #if SADSPLAT_HAVE_CUDA
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
-
-void* currentStream(const at::Tensor& t) {
-  return static_cast<void*>(c10::cuda::getCurrentCUDAStream(t.device().index()).stream());
-}
 
 hard_concrete_fused::GateParams gateParams(const AutogradContext* ctx) {
   hard_concrete_fused::GateParams p;

@@ -3,7 +3,7 @@
 #include <cuda_runtime.h>
 
 #include "hard_concrete_backend.h"
-#include "sadsplat/common/error.h"
+#include "sadsplat/common/cuda_support.h"
 
 namespace sadsplat {
 namespace semantic_drop {
@@ -42,11 +42,7 @@ __global__ void backwardKernel(const float* __restrict__ log_alpha,
   grad_log_alpha[i] = inside ? grad_gate[i] * (p.r - p.l) * s * (1.f - s) * p.inv_beta : 0.f;
 }
 
-void check(const char* kernel) {
-  const cudaError_t err = cudaGetLastError();
-  if (err != cudaSuccess) throw Error("<hard concrete gate>", kernel, "a successful launch",
-                                      cudaGetErrorString(err));
-}
+void check(const char* kernel) { checkCudaLaunch("<hard concrete gate>", kernel); }
 
 unsigned blocks(int64_t n) { return static_cast<unsigned>((n + kThreads - 1) / kThreads); }
 
