@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
   -DCMAKE_C_FLAGS_DEBUG="-O1 -g" -DSADSPLAT_SANITIZE=address,undefined \
-  -DSADSPLAT_WITH_CUDA=OFF >/dev/null
+  -DSADSPLAT_WITH_CUDA=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build-asan
 supp=$(pwd)/tests/sanitizers
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_odr_violation=0:allocator_may_return_null=1"

@@ -12,7 +12,7 @@
 namespace sadsplat {
 namespace {
 
-const std::string kCli = SADSPLAT_CLI;
+using test::kCli;
 const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
 
 TEST(Cli, HelpListsTheSubcommands) {

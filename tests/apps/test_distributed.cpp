@@ -17,8 +17,9 @@
 namespace sadsplat {
 namespace {
 
-const std::string kCli = SADSPLAT_CLI;
-const std::string kCache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+using test::kCli;
+using test::kTinySceneCache;
+using test::runJsonIterations;
 
 bool haveGloo() {
   std::string out;
@@ -72,7 +73,7 @@ void expectTwoRanksTrainLikeOneProcess(const std::string& device) {
                   "{\"densify_from\": 5, \"densify_interval\": 10, \"densify_until\": 30, "
                   "\"densify_grad_threshold\": 1e-5, \"checkpoint_interval\": 0}");
   std::string out;
-  const std::string common = " train " + kCache + " --iterations 40 --device " + device +
+  const std::string common = " train " + kTinySceneCache + " --iterations 40 --device " + device +
                              " --config " + dir.file("cfg.json");
   ASSERT_EQ(test::runCommand(kCli + common + " --nproc 2 --out " + dir.file("two_ranks"), &out), 0)
       << out;
@@ -106,7 +107,7 @@ void expectAGroupOfOneTrainsLikeNoGroup(const std::string& device) {
   const bool exact = device == "cpu";
   test::TempDir dir;
   std::string out;
-  const std::string common = " train " + kCache + " --iterations 30 --device " + device;
+  const std::string common = " train " + kTinySceneCache + " --iterations 30 --device " + device;
   ASSERT_EQ(test::runCommand(kCli + common + " --nproc 1 --out " + dir.file("group"), &out), 0)
       << out;
   ASSERT_EQ(test::runCommand(kCli + common + " --out " + dir.file("plain"), &out), 0) << out;
@@ -148,7 +149,7 @@ TEST(Distributed, BatchScheduleTakesTheSameViewsInFewerSteps) {
   test::TempDir dir;
   std::string out;
   ASSERT_EQ(
-      test::runCommand(kCli + " train " + kCache +
+      test::runCommand(kCli + " train " + kTinySceneCache +
                            " --iterations 40 --nproc 2 --batch-schedule --out " + dir.file("run"),
                        &out),
       0)
@@ -166,7 +167,7 @@ TEST(Distributed, ARankThatDiesEndsTheJobWithAnError) {
   const auto start = std::chrono::steady_clock::now();
   const int rc = test::runCommand(
       "SADSPLAT_FAULT_KILL_AT_ITERATION=15 SADSPLAT_FAULT_KILL_RANK=1 SADSPLAT_DIST_TIMEOUT_S=20 " +
-          kCli + " train " + kCache + " --iterations 200 --nproc 2 --out " + dir.file("run"),
+          kCli + " train " + kTinySceneCache + " --iterations 200 --nproc 2 --out " + dir.file("run"),
       &out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -175,12 +176,6 @@ TEST(Distributed, ARankThatDiesEndsTheJobWithAnError) {
   EXPECT_TRUE(std::regex_search(out, std::regex("rank 0 of 2: all-reduce|rank 1 was killed")))
       << out;
   EXPECT_FALSE(io::pathExists(dir.file("run/model.ply")));
-}
-
-int runJsonIterations(const std::string& run) {
-  const std::string text = test::readFile(run + "/run.json");
-  std::smatch m;
-  return std::regex_search(text, m, std::regex("\"iterations\": *([0-9]+)")) ? std::stoi(m[1]) : -1;
 }
 
 // SIGINT to rank 0 alone: the ranks agree to stop after the same iteration, rank 0 writes its
@@ -192,7 +187,7 @@ TEST(Distributed, SigintStopsEveryRankAtOneCheckpointAndTheGroupResumes) {
   std::string out;
   const auto start = std::chrono::steady_clock::now();
   const int rc = test::runCommand(
-      "(" + kCli + " train " + kCache + " --nproc 2 --iterations 1000000 --out " + run +
+      "(" + kCli + " train " + kTinySceneCache + " --nproc 2 --iterations 1000000 --out " + run +
           " & pid=$!; for i in $(seq 100); do sleep 0.1; grep -q '\"device\"' " + run +
           "/config.json 2>/dev/null && break; done; sleep 1; kill -INT $pid; wait $pid)",
       &out);
@@ -201,7 +196,7 @@ TEST(Distributed, SigintStopsEveryRankAtOneCheckpointAndTheGroupResumes) {
   const int reached = runJsonIterations(run);
   ASSERT_GT(reached, 0) << out;
   EXPECT_EQ(reached % 10, 0) << "the ranks stop at an agreement iteration";
-  ASSERT_EQ(test::runCommand(kCli + " train " + kCache + " --nproc 2 --iterations " +
+  ASSERT_EQ(test::runCommand(kCli + " train " + kTinySceneCache + " --nproc 2 --iterations " +
                                  std::to_string(reached + 20) + " --resume --out " + run,
                              &out),
             0)
@@ -216,7 +211,7 @@ TEST(Distributed, RanksStartedByAnOutsideLauncherTrainLikeNproc) {
   if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
   test::TempDir dir;
   std::string out;
-  const std::string train = kCli + " train " + kCache + " --iterations 30 --out ";
+  const std::string train = kCli + " train " + kTinySceneCache + " --iterations 30 --out ";
   ASSERT_EQ(test::runCommand(train + dir.file("nproc") + " --nproc 2", &out), 0) << out;
   const std::string port = std::to_string(20000 + ::getpid() % 20000);
   // One CPU thread per rank, as --nproc 2 gives each on 2 cores (so the float sums run in the
@@ -240,7 +235,7 @@ TEST(Distributed, RanksStartedByAnOutsideLauncherTrainLikeNproc) {
 TEST(Distributed, MalformedRankVariablesAreClearErrors) {
   if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
   std::string out;
-  EXPECT_EQ(test::runCommand("RANK=5 WORLD_SIZE=2 " + kCli + " train " + kCache +
+  EXPECT_EQ(test::runCommand("RANK=5 WORLD_SIZE=2 " + kCli + " train " + kTinySceneCache +
                                  " --iterations 1 --out /tmp/unused_rank_run",
                              &out),
             1);

@@ -12,15 +12,9 @@
 namespace sadsplat {
 namespace {
 
-const std::string kCli = SADSPLAT_CLI;
-const std::string kCache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
-
-int runJsonIterations(const std::string& run) {
-  const std::string text = test::readFile(run + "/run.json");
-  std::smatch m;
-  if (!std::regex_search(text, m, std::regex("\"iterations\": (\\d+)"))) return -1;
-  return std::stoi(m[1]);
-}
+using test::kCli;
+using test::kTinySceneCache;
+using test::runJsonIterations;
 
 // A learning rate that overflows the decoder makes the loss NaN: the run stops with an error
 // naming the iteration, and the last checkpoint (and its run.json) stay as they were written.
@@ -28,7 +22,7 @@ TEST(Faults, DivergedTrainingStopsAndKeepsTheLastCheckpoint) {
   test::TempDir dir;
   test::writeFile(dir.file("cfg.json"), "{\"lr_decoder\": 1e38, \"checkpoint_interval\": 4}");
   std::string out;
-  EXPECT_EQ(test::runCommand(kCli + " train " + kCache + " --iterations 40 --config " +
+  EXPECT_EQ(test::runCommand(kCli + " train " + kTinySceneCache + " --iterations 40 --config " +
                                  dir.file("cfg.json") + " --out " + dir.file("run"),
                              &out),
             1);
@@ -52,7 +46,7 @@ TEST(Faults, SigintWritesACheckpointAndResumes) {
   const std::string run = dir.file("run");
   std::string out;
   const int rc = test::runCommand(
-      "(" + kCli + " train " + kCache + " --iterations 1000000 --out " + run +
+      "(" + kCli + " train " + kTinySceneCache + " --iterations 1000000 --out " + run +
           " & pid=$!; for i in $(seq 100); do sleep 0.1; grep -q '\"device\"' " + run +
           "/config.json 2>/dev/null && break; done; sleep 0.5; kill -INT $pid; wait $pid)",
       &out);
@@ -61,7 +55,7 @@ TEST(Faults, SigintWritesACheckpointAndResumes) {
   const int reached = runJsonIterations(run);
   ASSERT_GT(reached, 0) << out;
   EXPECT_TRUE(io::isRegularFile(run + "/checkpoint.bin"));
-  ASSERT_EQ(test::runCommand(kCli + " train " + kCache + " --iterations " +
+  ASSERT_EQ(test::runCommand(kCli + " train " + kTinySceneCache + " --iterations " +
                                  std::to_string(reached + 10) + " --resume --out " + run,
                              &out),
             0)
@@ -78,7 +72,7 @@ TEST(Faults, KillNineThenResumeIsBitIdentical) {
                   "{\"checkpoint_interval\": 10, \"densify_from\": 10, \"densify_interval\": 10, "
                   "\"densify_until\": 30}");
   const std::string train =
-      kCli + " train " + kCache + " --iterations 50 --config " + dir.file("cfg.json") + " --out ";
+      kCli + " train " + kTinySceneCache + " --iterations 50 --config " + dir.file("cfg.json") + " --out ";
   std::string out;
   ASSERT_EQ(test::runCommand(train + dir.file("whole"), &out), 0) << out;
   const std::string want = test::readFile(dir.file("whole/model.ply"));

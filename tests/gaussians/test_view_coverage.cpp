@@ -12,7 +12,7 @@ namespace {
 using gaussians::RasterCamera;
 
 // 100x100 pixels, focal length 100, looking along +z from `centre_x` on the x axis.
-RasterCamera camera(double centre_x) {
+RasterCamera viewCamera(double centre_x) {
   RasterCamera c;
   c.width = c.height = 100;
   c.fx = c.fy = 100;
@@ -22,7 +22,7 @@ RasterCamera camera(double centre_x) {
 }
 
 TEST(ViewCoverage, CountsTheCamerasThatSeeEachCentre) {
-  const std::vector<RasterCamera> cameras = {camera(0), camera(2)};
+  const std::vector<RasterCamera> cameras = {viewCamera(0), viewCamera(2)};
   // In front of both; behind both; in front but outside both images; seen by the first only
   // (x = -1 at z = 5: u = 100 * -1 / 5 + 50 = 30 for the first, 100 * -3 / 5 + 50 = -10 for the
   // second).
@@ -52,8 +52,8 @@ TEST(ViewCoverage, CountsTheCamerasThatSeeEachCentre) {
 
 TEST(ViewCoverage, SceneExtentIsTheCamerasRadiusTimes1point1) {
   // Centres (0, 0, 0) and (2, 0, 0): mean (1, 0, 0), radius 1.
-  EXPECT_NEAR(gaussians::sceneExtent({camera(0), camera(2)}), 1.1, 1e-12);
-  EXPECT_NEAR(gaussians::sceneExtent({camera(0)}), 1e-3, 1e-12);  // one camera: the floor
+  EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0), viewCamera(2)}), 1.1, 1e-12);
+  EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0)}), 1e-3, 1e-12);  // one camera: the floor
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 namespace sadsplat {
 namespace {
 
-const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+using test::kTinyScene;
 
 void expectSameModel(const io::ColmapModel& a, const io::ColmapModel& b) {
   ASSERT_EQ(a.cameras.size(), b.cameras.size());
@@ -48,7 +48,7 @@ void expectError(const std::string& dir, const std::string& file_suffix,
 }
 
 TEST(Colmap, TextAndIndependentlyWrittenBinaryAgree) {
-  const auto text = io::readColmapModel(kScene + "/sparse/0");
+  const auto text = io::readColmapModel(kTinyScene + "/sparse/0");
   const auto binary =
       io::readColmapModel(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene_colmap_bin");
   EXPECT_EQ(text.images.size(), 8u);
@@ -58,7 +58,7 @@ TEST(Colmap, TextAndIndependentlyWrittenBinaryAgree) {
 }
 
 TEST(Colmap, WritersRoundTripBothFormats) {
-  const auto model = io::readColmapModel(kScene + "/sparse/0");
+  const auto model = io::readColmapModel(kTinyScene + "/sparse/0");
   test::TempDir text_dir, bin_dir;
   io::writeColmapText(text_dir.path(), model);
   io::writeColmapBinary(bin_dir.path(), model);
@@ -97,7 +97,7 @@ TEST(Colmap, BadModelsGiveClearErrors) {
   test::TempDir dir;
   expectError(dir.path(), "cameras.txt", "missing");
 
-  const auto model = io::readColmapModel(kScene + "/sparse/0");
+  const auto model = io::readColmapModel(kTinyScene + "/sparse/0");
   io::writeColmapText(dir.path(), model);
   test::writeFile(dir.file("cameras.txt"), "1 FISHEYE_X 64 48 50 32 24\n");
   expectError(dir.path(), "cameras.txt", "MODEL: expected one of SIMPLE_PINHOLE");

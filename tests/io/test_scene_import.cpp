@@ -9,7 +9,7 @@
 namespace sadsplat {
 namespace {
 
-const std::string kScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+using test::kTinyScene;
 
 class SceneImport : public ::testing::Test {
  protected:
@@ -17,7 +17,7 @@ class SceneImport : public ::testing::Test {
     if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
   }
   // A writable copy of the fixture scene.
-  std::string copy() { return test::copyTree(kScene, tmp_.file("scene")); }
+  std::string copy() { return test::copyTree(kTinyScene, tmp_.file("scene")); }
 
   void expectError(const std::string& dir, const std::string& file_suffix,
                    const std::string& needle, const io::ImportOptions& options = {}) {
@@ -34,7 +34,7 @@ class SceneImport : public ::testing::Test {
 };
 
 TEST_F(SceneImport, ReadsTheFixtureWithRolesLabelsAndPoints) {
-  const io::Scene scene = io::importScene(kScene);
+  const io::Scene scene = io::importScene(kTinyScene);
   ASSERT_EQ(scene.views.size(), 8u);
   ASSERT_EQ(scene.classes.size(), 3u);
   EXPECT_EQ(scene.classes[2].name, "building");
@@ -58,7 +58,7 @@ TEST_F(SceneImport, ReadsTheFixtureWithRolesLabelsAndPoints) {
 TEST_F(SceneImport, ResizingScalesImagesAndIntrinsics) {
   io::ImportOptions options;
   options.scale = 0.5;
-  const io::Scene scene = io::importScene(kScene, options);
+  const io::Scene scene = io::importScene(kTinyScene, options);
   const auto& cam = scene.views[0].camera;
   EXPECT_EQ(cam.width, 32);
   EXPECT_EQ(cam.height, 24);
@@ -66,7 +66,7 @@ TEST_F(SceneImport, ResizingScalesImagesAndIntrinsics) {
   EXPECT_DOUBLE_EQ(cam.cx, 16.0);
   EXPECT_EQ(scene.views[0].labels.pixels.size(), 32u * 24u);
   options.scale = 1.5;
-  expectError(kScene, "<import options>", "(0, 1]", options);
+  expectError(kTinyScene, "<import options>", "(0, 1]", options);
 }
 
 TEST_F(SceneImport, UndistortsRadialCamerasAndMasksInvalidPixels) {
@@ -76,7 +76,7 @@ TEST_F(SceneImport, UndistortsRadialCamerasAndMasksInvalidPixels) {
   model.cameras[0].params = {52, 52, 32, 24, 0.0, 0.0, 0.0, 0.0};
   io::writeColmapText(dir + "/sparse/0", model);
   const io::Scene zero = io::importScene(dir);
-  const io::Scene plain = io::importScene(kScene);
+  const io::Scene plain = io::importScene(kTinyScene);
   // Zero distortion: identical pixels and labels.
   EXPECT_EQ(zero.views[0].rgb.pixels, plain.views[0].rgb.pixels);
   EXPECT_EQ(zero.views[0].labels.pixels, plain.views[0].labels.pixels);

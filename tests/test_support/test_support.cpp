@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -79,6 +80,12 @@ int runCommand(const std::string& command, std::string* output) {
   const int status = ::pclose(pipe);
   if (output) *output = text;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int runJsonIterations(const std::string& run_dir) {
+  const std::string text = readFile(run_dir + "/run.json");
+  std::smatch m;
+  return std::regex_search(text, m, std::regex("\"iterations\": *([0-9]+)")) ? std::stoi(m[1]) : -1;
 }
 
 }  // namespace test

@@ -11,6 +11,13 @@
 namespace sadsplat {
 namespace test {
 
+// Every suite is compiled with SADSPLAT_TEST_DATA_DIR and SADSPLAT_CLI (tests/CMakeLists.txt).
+/// The CLI under test.
+inline const std::string kCli = SADSPLAT_CLI;
+/// The small fixture scene (data/tiny_scene) and its scene cache.
+inline const std::string kTinyScene = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene";
+inline const std::string kTinySceneCache = kTinyScene + ".cache";
+
 /// A fresh, empty directory under the system temp dir, removed at destruction.
 class TempDir {
  public:
@@ -34,6 +41,9 @@ void writeFile(const std::string& path, const std::string& bytes);
 
 /// Copies a directory tree (cp -r); returns the destination.
 std::string copyTree(const std::string& from, const std::string& to);
+
+/// The iteration count a training run's RUN/run.json records (-1 when it has none).
+int runJsonIterations(const std::string& run_dir);
 
 /// Runs a shell command, returns its exit status; its stdout+stderr go to *output if given.
 int runCommand(const std::string& command, std::string* output = nullptr);

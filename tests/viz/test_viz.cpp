@@ -19,7 +19,7 @@
 namespace sadsplat {
 namespace {
 
-const std::string kCli = SADSPLAT_CLI;
+using test::kCli;
 const std::array<std::uint8_t, 3> kRed = {220, 30, 30};
 const std::array<std::uint8_t, 3> kBlue = {30, 60, 220};
 const std::array<std::uint8_t, 3> kBackground = {28, 30, 36};

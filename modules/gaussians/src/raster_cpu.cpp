@@ -184,6 +184,16 @@ std::vector<T> skipThresholds(const T* opacities, int64_t n) {
   return thresholds;
 }
 
+// Calls visit(px, py) for every pixel of tile (tx, ty) inside the image, row by row.
+template <typename Visit>
+inline void forEachTilePixel(int tx, int ty, int width, int height, Visit&& visit) {
+  const int y_end = std::min(height, (ty + 1) * kTileSize);
+  const int x_end = std::min(width, (tx + 1) * kTileSize);
+  for (int py = ty * kTileSize; py < y_end; ++py) {
+    for (int px = tx * kTileSize; px < x_end; ++px) visit(px, py);
+  }
+}
+
 // One Gaussian of a tile's list, gathered: what a pixel needs to decide on it and blend it.
 template <typename T>
 struct PackedGaussian {
@@ -201,12 +211,12 @@ struct TileList {
   std::vector<PackedGaussian<T>> gaussians;
   std::vector<T> values;
   const int* ids = nullptr;  // into the binning's gaussian_ids
-  int size = 0;
+
+  int size() const { return static_cast<int>(gaussians.size()); }
 
   void gather(const int* tile_ids, int count, const T* means2d, const T* conics, const T* opacities,
               const T* skip, const T* all_values, int64_t D) {
     ids = tile_ids;
-    size = count;
     gaussians.resize(static_cast<std::size_t>(count));
     values.resize(static_cast<std::size_t>(count * D));
     for (int j = 0; j < count; ++j) {
@@ -230,81 +240,77 @@ void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int
   const int64_t D = kD > 0 ? kD : dynamic_d;
   const PackedGaussian<T>* pg = list.gaussians.data();
   const T* val = list.values.data();
-  for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
-    for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
-      const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-      std::fill(accum, accum + D, T(0));
-      T trans = T(1);
-      int last = 0;
-      for (int j = 0; j < list.size; ++j) {
-        const PackedGaussian<T>& p = pg[j];
-        if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-        T G;
-        bool clamped;
-        const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-        if (alpha == T(0)) continue;
-        const T next = trans * (T(1) - alpha);
-        if (next < T(kMinTransmittance)) break;
-        const T w = alpha * trans;
-        const T* v = val + j * D;
-        for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
-        trans = next;
-        last = j + 1;
-      }
-      const int64_t pix = static_cast<int64_t>(py) * width + px;
-      std::copy(accum, accum + D, img + pix * D);
-      alpha_out[pix] = T(1) - trans;
-      last_out[pix] = last;
+  const int count = list.size();
+  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+    std::fill(accum, accum + D, T(0));
+    T trans = T(1);
+    int last = 0;
+    for (int j = 0; j < count; ++j) {
+      const PackedGaussian<T>& p = pg[j];
+      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+      T G;
+      bool clamped;
+      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+      if (alpha == T(0)) continue;
+      const T next = trans * (T(1) - alpha);
+      if (next < T(kMinTransmittance)) break;
+      const T w = alpha * trans;
+      const T* v = val + j * D;
+      for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
+      trans = next;
+      last = j + 1;
     }
-  }
+    const int64_t pix = static_cast<int64_t>(py) * width + px;
+    std::copy(accum, accum + D, img + pix * D);
+    alpha_out[pix] = T(1) - trans;
+    last_out[pix] = last;
+  });
 }
 
 // The backward of one tile: gradients of the tile's Gaussians, in list order, into `grads`
 // ([L, 6 + D]: mean2d, conic, opacity, values), which the caller has zeroed.
 template <int kD, typename T>
-void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width,
-                  int height, const T* gimg, const T* galpha, const T* alpha_fwd,
-                  const int* last_fwd, T* accum, T* last_value, T* grads) {
+void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
+                  const T* gimg, const T* galpha, const T* alpha_fwd, const int* last_fwd, T* accum,
+                  T* last_value, T* grads) {
   const int64_t D = kD > 0 ? kD : dynamic_d;
   const int64_t row = 6 + D;
   const PackedGaussian<T>* pg = list.gaussians.data();
   const T* val = list.values.data();
-  for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
-    for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
-      const int64_t pix = static_cast<int64_t>(py) * width + px;
-      const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-      const T final_trans = T(1) - alpha_fwd[pix];
-      const T* gpix = gimg + pix * D;
-      T trans = final_trans;
-      std::fill(accum, accum + D, T(0));
-      std::fill(last_value, last_value + D, T(0));
-      T last_alpha = T(0);
-      for (int j = last_fwd[pix] - 1; j >= 0; --j) {
-        const PackedGaussian<T>& p = pg[j];
-        if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-        T G;
-        bool clamped;
-        const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-        if (alpha == T(0)) continue;
-        trans = trans / (T(1) - alpha);
-        const T w = alpha * trans;
-        T* gb = grads + j * row;
-        const T* v = val + j * D;
-        T g_a = T(0);
-        for (int64_t ch = 0; ch < D; ++ch) {
-          accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
-          last_value[ch] = v[ch];
-          g_a += (v[ch] - accum[ch]) * gpix[ch];
-          gb[6 + ch] += w * gpix[ch];
-        }
-        g_a *= trans;
-        g_a += galpha[pix] * final_trans / (T(1) - alpha);
-        last_alpha = alpha;
-        pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2,
-                           gb + 5);
+  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+    const int64_t pix = static_cast<int64_t>(py) * width + px;
+    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+    const T final_trans = T(1) - alpha_fwd[pix];
+    const T* gpix = gimg + pix * D;
+    T trans = final_trans;
+    std::fill(accum, accum + D, T(0));
+    std::fill(last_value, last_value + D, T(0));
+    T last_alpha = T(0);
+    for (int j = last_fwd[pix] - 1; j >= 0; --j) {
+      const PackedGaussian<T>& p = pg[j];
+      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+      T G;
+      bool clamped;
+      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+      if (alpha == T(0)) continue;
+      trans = trans / (T(1) - alpha);
+      const T w = alpha * trans;
+      T* gb = grads + j * row;
+      const T* v = val + j * D;
+      T g_a = T(0);
+      for (int64_t ch = 0; ch < D; ++ch) {
+        accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
+        last_value[ch] = v[ch];
+        g_a += (v[ch] - accum[ch]) * gpix[ch];
+        gb[6 + ch] += w * gpix[ch];
       }
+      g_a *= trans;
+      g_a += galpha[pix] * final_trans / (T(1) - alpha);
+      last_alpha = alpha;
+      pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
     }
-  }
+  });
 }
 
 }  // namespace
@@ -393,14 +399,12 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
         // Only the Gaussians up to the tile's last contributor have gradients.
         int used = 0;
-        for (int py = ty * kTileSize; py < std::min(height, (ty + 1) * kTileSize); ++py) {
-          for (int px = tx * kTileSize; px < std::min(width, (tx + 1) * kTileSize); ++px) {
-            used = std::max(used, last_fwd[static_cast<int64_t>(py) * width + px]);
-          }
-        }
+        forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+          used = std::max(used, last_fwd[static_cast<int64_t>(py) * width + px]);
+        });
         if (used == 0) continue;
         list.gather(ids + start, std::min(used, stop - start), m2, co, op, skip.data(), val, D);
-        grads.assign(static_cast<std::size_t>(list.size * row), T(0));
+        grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
         if (D == 3) {
           backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
                           accum.data(), last_value.data(), grads.data());
@@ -408,7 +412,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
           backwardTile<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
                           accum.data(), last_value.data(), grads.data());
         }
-        for (int j = 0; j < list.size; ++j) {
+        for (int j = 0; j < list.size(); ++j) {
           T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
           const T* gt = grads.data() + j * row;
           for (int64_t c = 0; c < row; ++c) gb[c] += gt[c];
