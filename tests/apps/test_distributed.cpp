@@ -116,7 +116,9 @@ void expectAGroupOfOneTrainsLikeNoGroup(const std::string& device) {
   ASSERT_EQ(la.size(), lb.size());
   ASSERT_GE(la.size(), 2u);
   for (std::size_t k = 0; k < la.size(); ++k) {
-    if (exact) EXPECT_EQ(la[k], lb[k]) << k;
+    if (exact) {
+      EXPECT_EQ(la[k], lb[k]) << k;
+    }
     EXPECT_NEAR(la[k], lb[k], 1e-5 * lb[k]) << k;
   }
   const auto d = meanDifferences(dir.file("group/model.ply"), dir.file("plain/model.ply"));

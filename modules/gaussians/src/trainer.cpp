@@ -24,15 +24,22 @@
 
 namespace sadsplat {
 namespace gaussians {
-namespace {
+namespace trainer_detail {
 
 // One optimised tensor with its Adam moments (per-row tensors are resized by densification).
+// Not in the anonymous namespace: Trainer::State holds these, and a type with linkage must not
+// hold one without (GCC's -Wsubobject-linkage in unity builds).
 struct Param {
   std::string name;
   at::Tensor value, m, v;
   double lr = 0;
   bool per_gaussian = true;
 };
+
+}  // namespace trainer_detail
+using trainer_detail::Param;
+
+namespace {
 
 double logit(double p) { return std::log(p / (1 - p)); }
 
