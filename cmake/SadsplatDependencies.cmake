@@ -106,8 +106,8 @@ endif()
 # With a CUDA LibTorch they are part of the target. With nvcc but a CPU-only LibTorch they compile
 # into an object library nobody links (INCLUDES: the module include folders the kernels need,
 # since an object library gets none from the target), so a CPU-only build still sees them build.
-# Always (with or without CUDA) the target and the kernels see modules/common/cuda (sadsplat/common/cuda_support.h,
-# internal, not installed).
+# With or without CUDA, the target and the kernels see modules/common/cuda
+# (sadsplat/common/cuda_support.h: internal, not installed).
 function(sadsplat_add_cuda_sources target)
   cmake_parse_arguments(ARG "" "" "SOURCES;INCLUDES" ${ARGN})
   set(support ${PROJECT_SOURCE_DIR}/modules/common/cuda)

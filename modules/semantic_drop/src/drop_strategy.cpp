@@ -104,11 +104,13 @@ std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians:
   if (!(c.lambda_l0 >= 0)) {
     throw Error("<config>", "lambda_l0", "a non-negative weight", std::to_string(c.lambda_l0));
   }
-  if (c.lambda_l0_from < 0 || c.lambda_l0_ramp < 0) {
-    const bool from = c.lambda_l0_from < 0;
-    throw Error("<config>", from ? "lambda_l0_from" : "lambda_l0_ramp",
-                "a non-negative number of iterations",
-                std::to_string(from ? c.lambda_l0_from : c.lambda_l0_ramp));
+  if (c.lambda_l0_from < 0) {
+    throw Error("<config>", "lambda_l0_from", "a non-negative number of iterations",
+                std::to_string(c.lambda_l0_from));
+  }
+  if (c.lambda_l0_ramp < 0) {
+    throw Error("<config>", "lambda_l0_ramp", "a non-negative number of iterations",
+                std::to_string(c.lambda_l0_ramp));
   }
   if (c.drop_interval < 1) {
     throw Error("<config>", "drop_interval", "a positive number of iterations",
