@@ -272,6 +272,12 @@ int main(int argc, char** argv) {
       ->add_option("--lambda-l0-ramp", train_l0_ramp,
                    "the L0 weight rises linearly over this many iterations (0 = at once)")
       ->check(CLI::NonNegativeNumber);
+  double train_l0_importance = -1;
+  train
+      ->add_option("--l0-importance", train_l0_importance,
+                   "weight the L0 loss towards the Gaussians that contribute least to the "
+                   "training views, exponent gamma (not the paper; 0 = the plain mean)")
+      ->check(CLI::NonNegativeNumber);
   int train_recovery = -1;
   train
       ->add_option("--recovery", train_recovery,
@@ -383,11 +389,13 @@ int main(int argc, char** argv) {
   table->add_option("--plots", table_plots,
                     "write the frontier charts (frontier_psnr.png, frontier_miou.png) here (VTK)");
   double table_goal_fewer = 12, table_goal_psnr = 0.3;
-  table->add_option("--goal-fewer", table_goal_fewer,
-                    "charts: the target's times fewer Gaussians (0: no target drawn)")
+  table
+      ->add_option("--goal-fewer", table_goal_fewer,
+                   "charts: the target's times fewer Gaussians (0: no target drawn)")
       ->capture_default_str();
-  table->add_option("--goal-psnr-loss", table_goal_psnr,
-                    "charts: the target's largest PSNR loss in dB")
+  table
+      ->add_option("--goal-psnr-loss", table_goal_psnr,
+                   "charts: the target's largest PSNR loss in dB")
       ->capture_default_str();
 
   auto* demo = app.add_subcommand("demo",
@@ -417,7 +425,7 @@ int main(int argc, char** argv) {
   synth_cmd->add_option("--cache", synth_args.cache, "scene cache file to write");
   synth_cmd->add_flag("--preview", synth_args.preview, "also write OUT/preview.png");
   synth_cmd->add_flag("--colmap-binary", synth_args.colmap_binary,
-                     "with --out: write sparse/0 as a binary COLMAP model (cameras.bin, ...)");
+                      "with --out: write sparse/0 as a binary COLMAP model (cameras.bin, ...)");
 
 #if SADSPLAT_HAVE_VIZ
   auto* view = app.add_subcommand(
@@ -522,6 +530,7 @@ int main(int argc, char** argv) {
       if (train_lambda_l0 >= 0) config.lambda_l0 = train_lambda_l0;
       if (train_l0_from >= 0) config.lambda_l0_from = train_l0_from;
       if (train_l0_ramp >= 0) config.lambda_l0_ramp = train_l0_ramp;
+      if (train_l0_importance >= 0) config.l0_importance = train_l0_importance;
       if (train_recovery >= 0) config.recovery_iterations = train_recovery;
       if (train_recovery_prune >= 0) config.recovery_prune = train_recovery_prune;
       if (train_views_per_step > 0) config.views_per_step = train_views_per_step;
@@ -585,8 +594,8 @@ int main(int argc, char** argv) {
       if (!table_plots.empty()) {
 #if SADSPLAT_HAVE_VIZ
         for (const std::string& path : sadsplat::viz::writeFrontierCharts(
-                 table_plots, sadsplat::eval::frontierPoints(runs, table_baseline),
-                 table_baseline, {table_goal_fewer, table_goal_psnr})) {
+                 table_plots, sadsplat::eval::frontierPoints(runs, table_baseline), table_baseline,
+                 {table_goal_fewer, table_goal_psnr})) {
           std::cout << "wrote " << path << "\n";
         }
 #else

@@ -13,7 +13,8 @@
 #              `full` (same flags: P_base 1 is the default), its runs copied into the pbase folder
 #   l0schedule the 3 seed-0 scenes x full drop with pseudo-labels and the L0 weight off until
 #              iteration N (_fromN), rising over M iterations (_rampM), weight X (_lambdaX)
-# A configuration full_<parts> takes any of the parts pX (P_base), lambdaX, fromN, rampM.
+# A configuration full_<parts> takes any of the parts pX (P_base), lambdaX, fromN, rampM, impG
+# (--l0-importance G: the L0 term weighted towards the Gaussians that contribute least).
 # Env: SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
 # WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup (e.g. a quick CPU check).
 # No run starts after DEADLINE_S and every run stops at it. $OUT gets table_TABLE.tgz (the new
@@ -86,6 +87,7 @@ run_one() {
           lambda*) flags+=(--lambda-l0 "${token#lambda}") ;;
           from*) flags+=(--lambda-l0-from "${token#from}") ;;
           ramp*) flags+=(--lambda-l0-ramp "${token#ramp}") ;;
+          imp*) flags+=(--l0-importance "${token#imp}") ;;
           *) echo "unknown part $token of configuration $config"; return 1 ;;
         esac
       done ;;

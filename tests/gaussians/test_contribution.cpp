@@ -3,6 +3,7 @@
 // the pixels add up to the alpha image's sum.
 #include <gtest/gtest.h>
 
+#include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
 
 namespace sadsplat {
@@ -73,6 +74,39 @@ TEST(Contribution, SumsOverTheViewsAndAppliesTheGate) {
   const at::Tensor gated = gaussians::blendingWeightSums(g, {camera(0)});
   EXPECT_EQ(gated[0].item<double>(), 0.0);
   EXPECT_GT(gated[1].item<double>(), a[1].item<double>());
+}
+
+// The L0 term's weights, by hand: w = (1 + c / median c)^-gamma / mean.
+TEST(InverseContributionWeights, FallWithTheContributionAndAverageOne) {
+  // Sorted [0, 1, 1, 3]: the median (lower middle value) is 1; gamma 1 gives 1, 1/2, 1/2, 1/4
+  // (mean 9/16) before the scaling.
+  const at::Tensor w =
+      gaussians::inverseContributionWeights(at::tensor({0.0f, 1.0f, 3.0f, 1.0f}), 1.0);
+  const float k = 16.0f / 9.0f;
+  EXPECT_TRUE(at::allclose(w, at::tensor({k, k / 2, k / 4, k / 2}), 1e-5, 1e-6)) << w;
+  // A Gaussian that covers nothing gets the largest weight.
+  EXPECT_EQ(w.argmax().item<int64_t>(), 0);
+  // gamma 2 squares the ratios: 1, 1/4, 1/16, 1/4 (mean 25/64).
+  const at::Tensor w2 =
+      gaussians::inverseContributionWeights(at::tensor({0.0f, 1.0f, 3.0f, 1.0f}), 2.0);
+  const float k2 = 64.0f / 25.0f;
+  EXPECT_TRUE(at::allclose(w2, at::tensor({k2, k2 / 4, k2 / 16, k2 / 4}), 1e-5, 1e-6)) << w2;
+}
+
+TEST(InverseContributionWeights, ZeroExponentOrNoContributionGivesOnes) {
+  const at::Tensor c = at::tensor({0.0f, 2.0f, 5.0f});
+  EXPECT_TRUE(at::equal(gaussians::inverseContributionWeights(c, 0.0), at::ones({3})));
+  EXPECT_TRUE(at::equal(gaussians::inverseContributionWeights(at::zeros({4}), 1.0), at::ones({4})));
+  EXPECT_EQ(gaussians::inverseContributionWeights(at::zeros({0}), 1.0).numel(), 0);
+  EXPECT_THROW(gaussians::inverseContributionWeights(c, -1.0), Error);
+}
+
+TEST(InverseContributionWeights, AZeroMedianFallsBackToTheMeanOfThePositiveOnes) {
+  // Median 0; the positive contributions 2 and 4 average 3: 1, 1, 1, 3/5, 3/7 before scaling.
+  const at::Tensor w =
+      gaussians::inverseContributionWeights(at::tensor({0.0f, 0.0f, 2.0f, 0.0f, 4.0f}), 1.0);
+  const at::Tensor raw = at::tensor({1.0f, 1.0f, 0.6f, 1.0f, 3.0f / 7.0f});
+  EXPECT_TRUE(at::allclose(w, raw / raw.mean(), 1e-5, 1e-6)) << w;
 }
 
 }  // namespace

@@ -4,7 +4,9 @@
 #include <ATen/Context.h>
 #include <torch/csrc/autograd/autograd.h>
 
+#include <array>
 #include <iostream>
+#include <utility>
 
 #include "sadsplat/gaussians/rasterizer.h"
 
@@ -100,6 +102,40 @@ TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {
 }
 
 INSTANTIATE_TEST_SUITE_P(FeatureChannels, RasterizerCuda, ::testing::Values(0, 3, 32, 64));
+
+// The SH colours and their backward on CUDA against the CPU, for every degree, with exactly
+// (degree+1)^2 coefficients, with more than the degree uses, and with more than 16. 1000
+// Gaussians: not a multiple of the kernel's block, so the last block is partly empty.
+TEST(RasterizerCudaSh, EveryDegreeAndCoefficientCountMatchesTheCpuReference) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const std::array<double, 3> centre = {0.3, -0.2, -2.0};
+  const std::pair<int, int> cases[] = {{0, 1}, {1, 4}, {1, 16}, {2, 9}, {3, 16}, {3, 20}};
+  for (const auto& [degree, K] : cases) {
+    at::manual_seed(degree * 100 + K);
+    const int n = 1000;
+    const at::Tensor means = at::randn({n, 3});
+    // Around 0.5 - mean: some colour channels fall under 0 and are clamped.
+    const at::Tensor sh = at::randn({n, K, 3}) * 0.4;
+    const at::Tensor w = at::randn({n, 3});
+    const at::Tensor m_cpu = means.clone().requires_grad_(true),
+                     s_cpu = sh.clone().requires_grad_(true);
+    const at::Tensor m_gpu = means.to(at::kCUDA).requires_grad_(true),
+                     s_gpu = sh.to(at::kCUDA).requires_grad_(true);
+    const at::Tensor c_cpu = gaussians::evaluateSh(s_cpu, m_cpu, centre, degree);
+    const at::Tensor c_gpu = gaussians::evaluateSh(s_gpu, m_gpu, centre, degree);
+    EXPECT_LT(relativeError(c_gpu, c_cpu), 1e-5) << "degree " << degree << " K " << K;
+    EXPECT_GT((c_cpu == 0).sum().item<int64_t>(), 0) << "no clamped channel to test";
+    const auto g_cpu = torch::autograd::grad({(c_cpu * w).sum()}, {s_cpu, m_cpu});
+    const auto g_gpu = torch::autograd::grad({(c_gpu * w.to(at::kCUDA)).sum()}, {s_gpu, m_gpu});
+    EXPECT_LT(relativeError(g_gpu[0], g_cpu[0]), 1e-5) << "sh, degree " << degree << " K " << K;
+    EXPECT_LT(relativeError(g_gpu[1], g_cpu[1]), 1e-4) << "means, degree " << degree << " K " << K;
+    // Coefficients above the degree get exactly 0.
+    const int used = (degree + 1) * (degree + 1);
+    if (K > used) {
+      EXPECT_EQ(g_gpu[0].narrow(1, used, K - used).abs().max().item<float>(), 0.f);
+    }
+  }
+}
 
 }  // namespace
 }  // namespace sadsplat

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/gaussians/view_coverage.h"
@@ -171,7 +172,7 @@ class EvenGatesClosed : public gaussians::DropStrategy {
     return (at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 2)
         .to(log_alpha.dtype());
   }
-  at::Tensor regularisation(const at::Tensor&, int) const override { return {}; }
+  at::Tensor regularisation(const at::Tensor&, int, const at::Tensor&) const override { return {}; }
   bool dropNow(int) const override { return false; }
   gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
 };
@@ -256,7 +257,7 @@ class ThirdsGates : public gaussians::DropStrategy {
         at::arange(log_alpha.size(0), log_alpha.options().dtype(at::kLong)) % 3;
     return (third.to(log_alpha.dtype()) * 0.5).to(log_alpha.device());
   }
-  at::Tensor regularisation(const at::Tensor& log_alpha, int) const override {
+  at::Tensor regularisation(const at::Tensor& log_alpha, int, const at::Tensor&) const override {
     return 10 + 0 * log_alpha.sum();
   }
   bool dropNow(int done) const override {
@@ -335,6 +336,100 @@ TEST_F(TrainerTest, RecoveryPruneWorksWithoutADrop) {
   EXPECT_EQ(trainer.numGaussians(), n - n / 2);
   for (int i = 0; i < 2; ++i) trainer.step();
   trainer.checkConsistency();
+}
+
+// Open gates, no drops; regularisation records the L0 weights the trainer passes at each iteration.
+class L0WeightRecorder : public gaussians::DropStrategy {
+ public:
+  at::Tensor trainingGate(const at::Tensor&, int) const override { return {}; }
+  at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
+    return at::ones_like(log_alpha);
+  }
+  at::Tensor regularisation(const at::Tensor&, int, const at::Tensor& l0_weights) const override {
+    seen->push_back(l0_weights.defined() ? l0_weights.cpu().clone() : at::Tensor());
+    return {};
+  }
+  bool dropNow(int) const override { return false; }
+  gaussians::DropDecision decide(const gaussians::DropInputs&, int) const override { return {}; }
+  std::shared_ptr<std::vector<at::Tensor>> seen = std::make_shared<std::vector<at::Tensor>>();
+};
+
+std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene) {
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : scene.views) {
+    if (v.train) cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  return cameras;
+}
+
+TEST_F(TrainerTest, L0WeightsFollowTheContributionsFromTheScheduleStartOnEveryDropInterval) {
+  TrainConfig c = small(8);
+  c.l0_importance = 1.0;
+  c.lambda_l0_from = 3;
+  c.drop_interval = 2;
+  Trainer trainer(scene_, c);
+  auto recorder = std::make_shared<L0WeightRecorder>();
+  trainer.setDropStrategy(recorder);
+  std::vector<at::Tensor> expected(8);
+  for (int it = 0; it < 8; ++it) {
+    if (it == 3 || it == 5 || it == 7) {
+      // What the weights must be: from the contributions of the Gaussians as they are now.
+      expected[it] = gaussians::inverseContributionWeights(
+          gaussians::blendingWeightSums(trainer.parameters(), trainingCameras(scene_)), 1.0);
+    }
+    trainer.step();
+  }
+  const std::vector<at::Tensor>& seen = *recorder->seen;
+  ASSERT_EQ(seen.size(), 8u);
+  for (int it = 0; it < 8; ++it) {
+    ASSERT_TRUE(seen[it].defined()) << it;
+    ASSERT_EQ(seen[it].size(0), trainer.numGaussians());
+    if (it < 3) {
+      EXPECT_TRUE(at::equal(seen[it], at::ones_like(seen[it]))) << "before the schedule: " << it;
+    } else if (expected[it].defined()) {
+      EXPECT_TRUE(at::allclose(seen[it], expected[it], 1e-5, 1e-6)) << "recomputed at " << it;
+      EXPECT_GT((seen[it] - 1).abs().max().item<double>(), 0.1) << it;
+    } else {
+      EXPECT_TRUE(at::equal(seen[it], seen[it - 1])) << "kept between recomputations: " << it;
+    }
+  }
+  EXPECT_FALSE(at::equal(seen[5], seen[3]));
+}
+
+TEST_F(TrainerTest, WithoutL0ImportanceTheL0TermGetsNoWeights) {
+  Trainer trainer(scene_, small(3));
+  auto recorder = std::make_shared<L0WeightRecorder>();
+  trainer.setDropStrategy(recorder);
+  for (int it = 0; it < 3; ++it) trainer.step();
+  ASSERT_EQ(recorder->seen->size(), 3u);
+  for (const at::Tensor& w : *recorder->seen) EXPECT_FALSE(w.defined());
+}
+
+TEST_F(TrainerTest, ResumeBetweenL0WeightUpdatesIsExact) {
+  TrainConfig c = small(9);
+  c.l0_importance = 2.0;
+  c.lambda_l0_from = 2;
+  c.drop_interval = 4;
+  auto run = [&](Trainer& t, int steps) {
+    auto recorder = std::make_shared<L0WeightRecorder>();
+    t.setDropStrategy(recorder);
+    for (int i = 0; i < steps; ++i) t.step();
+    return recorder->seen;
+  };
+  Trainer straight(scene_, c);
+  const auto all = run(straight, 9);
+  test::TempDir dir;
+  {
+    Trainer first(scene_, c);
+    run(first, 4);  // weights computed at 2, next at 6
+    first.saveCheckpoint(dir.file("ckpt.bin"));
+  }
+  Trainer resumed(scene_, c);
+  resumed.loadCheckpoint(dir.file("ckpt.bin"));
+  const auto rest = run(resumed, 5);
+  ASSERT_EQ(rest->size(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(at::equal((*rest)[k], (*all)[4 + k])) << 4 + k;
+  EXPECT_TRUE(at::equal(straight.parameters().means, resumed.parameters().means));
 }
 
 TEST_F(TrainerTest, ResumeAcrossTheRecoveryIsExact) {

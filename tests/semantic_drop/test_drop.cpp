@@ -266,18 +266,40 @@ TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
   c.lambda_l0_ramp = 2;
   const auto drop = makeDropStrategy(c);
   const at::Tensor log_alpha = at::zeros({4});
-  EXPECT_FALSE(drop->regularisation(log_alpha, 9).defined());
+  EXPECT_FALSE(drop->regularisation(log_alpha, 9, {}).defined());
   const double mean_p = probabilityNonZero(log_alpha, HardConcreteParams{}).mean().item<double>();
-  EXPECT_NEAR(drop->regularisation(log_alpha, 10).item<double>(), 0.25 * mean_p, 1e-6);
-  EXPECT_NEAR(drop->regularisation(log_alpha, 11).item<double>(), 0.5 * mean_p, 1e-6);
+  EXPECT_NEAR(drop->regularisation(log_alpha, 10, {}).item<double>(), 0.25 * mean_p, 1e-6);
+  EXPECT_NEAR(drop->regularisation(log_alpha, 11, {}).item<double>(), 0.5 * mean_p, 1e-6);
   // The paper's rule: the full weight from the first iteration.
   c.lambda_l0_from = 0;
   c.lambda_l0_ramp = 0;
-  EXPECT_NEAR(makeDropStrategy(c)->regularisation(log_alpha, 0).item<double>(), 0.5 * mean_p,
+  EXPECT_NEAR(makeDropStrategy(c)->regularisation(log_alpha, 0, {}).item<double>(), 0.5 * mean_p,
               1e-6);
   // Without the structure term there is no L0 term at all.
   c.drop = "semantic";
-  EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100).defined());
+  EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100, {}).defined());
+}
+
+// Per-Gaussian L0 weights (TrainConfig::l0_importance): lambda * mean(w * P_nonzero), by hand.
+TEST(DropStrategy, WeightedRegularisationIsTheMeanOfWeightTimesPNonZero) {
+  gaussians::TrainConfig c;
+  c.drop = "full";
+  c.lambda_l0 = 0.5;
+  const auto drop = makeDropStrategy(c);
+  const at::Tensor log_alpha = at::tensor({-2.0f, 0.0f, 1.0f, 4.0f});
+  const at::Tensor p = probabilityNonZero(log_alpha, HardConcreteParams{});
+  const at::Tensor w = at::tensor({2.0f, 1.0f, 0.5f, 0.5f});
+  double expected = 0;
+  for (int i = 0; i < 4; ++i) expected += w[i].item<double>() * p[i].item<double>() / 4;
+  EXPECT_NEAR(drop->regularisation(log_alpha, 0, w).item<double>(), 0.5 * expected, 1e-6);
+  // Equal weights of 1 are the paper's rule.
+  EXPECT_NEAR(drop->regularisation(log_alpha, 0, at::ones({4})).item<double>(),
+              drop->regularisation(log_alpha, 0, {}).item<double>(), 1e-7);
+  // The gradient pushes hardest on the Gaussian with the largest weight (same log_alpha).
+  const at::Tensor la = at::zeros({2}).requires_grad_(true);
+  drop->regularisation(la, 0, at::tensor({3.0f, 1.0f})).backward();
+  EXPECT_NEAR(la.grad()[0].item<double>(), 3 * la.grad()[1].item<double>(), 1e-7);
+  EXPECT_THROW(drop->regularisation(log_alpha, 0, at::ones({3})), Error);
 }
 
 }  // namespace

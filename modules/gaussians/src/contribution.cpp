@@ -2,6 +2,10 @@
 
 #include <c10/core/GradMode.h>
 
+#include <string>
+
+#include "sadsplat/common/error.h"
+
 namespace sadsplat {
 namespace gaussians {
 
@@ -31,6 +35,22 @@ at::Tensor blendingWeightSums(const GaussianParams& gaussians,
     ones.mutable_grad().zero_();
   }
   return total;
+}
+
+at::Tensor inverseContributionWeights(const at::Tensor& contribution, double gamma) {
+  if (!(gamma >= 0)) {
+    throw Error("<config>", "l0_importance", "a non-negative exponent", std::to_string(gamma));
+  }
+  const int64_t n = contribution.numel();
+  if (n == 0 || gamma == 0) return at::ones_like(contribution);
+  double scale = contribution.median().item<double>();
+  if (!(scale > 0)) {
+    const at::Tensor positive = contribution.masked_select(contribution > 0);
+    if (positive.numel() == 0) return at::ones_like(contribution);
+    scale = positive.mean().item<double>();
+  }
+  const at::Tensor w = (1 + contribution / scale).pow(-gamma);
+  return w / w.mean();
 }
 
 }  // namespace gaussians

@@ -69,23 +69,68 @@ __global__ void projectBackwardKernel(
 
 // ---- spherical harmonics ---------------------------------------------------------------------
 
-__global__ void shForwardKernel(int64_t n, int64_t K, int degree, float3 campos,
-                                const float* __restrict__ sh, const float* __restrict__ means,
-                                float* colors) {
-  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (i >= n) return;
-  const float cam[3] = {campos.x, campos.y, campos.z};
-  shColor(sh + i * K * 3, degree, means + 3 * i, cam, colors + 3 * i);
+// One thread per Gaussian, kShBlock Gaussians per block. A Gaussian's coefficients are one row of
+// 3K consecutive floats (192 bytes at K = 16); read or written a thread per row, a warp's access
+// would touch 32 rows at once. The block's rows go through shared memory instead, copied with
+// consecutive threads on consecutive floats. Shared rows are kShStride (odd) floats apart, so the
+// 32 threads of a warp, each on its own row, hit 32 different banks.
+constexpr int kShBlock = 64;
+constexpr int kShMaxRow = 16 * 3;  // degree 3
+constexpr int kShStride = kShMaxRow + 1;
+
+__device__ __forceinline__ void copyShRowsIn(const float* __restrict__ sh, int64_t first, int rows,
+                                             int row_len, float* s_rows) {
+  const float* src = sh + first * row_len;
+  for (int e = threadIdx.x; e < rows * row_len; e += blockDim.x) {
+    s_rows[(e / row_len) * kShStride + e % row_len] = src[e];
+  }
 }
 
-__global__ void shBackwardKernel(int64_t n, int64_t K, int degree, float3 campos,
-                                 const float* __restrict__ sh, const float* __restrict__ means,
-                                 const float* __restrict__ g_colors, float* g_sh, float* g_means) {
-  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (i >= n) return;
+__global__ void __launch_bounds__(kShBlock)
+    shForwardKernel(int64_t n, int64_t K, int degree, float3 campos, const float* __restrict__ sh,
+                    const float* __restrict__ means, float* colors) {
+  __shared__ float s_sh[kShBlock * kShStride];
+  const int64_t first = static_cast<int64_t>(blockIdx.x) * kShBlock;
+  const int rows = static_cast<int>(min(static_cast<int64_t>(kShBlock), n - first));
+  copyShRowsIn(sh, first, rows, static_cast<int>(3 * K), s_sh);
+  __syncthreads();
+  if (static_cast<int>(threadIdx.x) >= rows) return;
+  const int64_t i = first + threadIdx.x;
   const float cam[3] = {campos.x, campos.y, campos.z};
-  shColorBackward(sh + i * K * 3, degree, means + 3 * i, cam, g_colors + 3 * i, g_sh + i * K * 3,
-                  g_means + 3 * i);
+  shColor(s_sh + threadIdx.x * kShStride, degree, means + 3 * i, cam, colors + 3 * i);
+}
+
+// Writes every coefficient's gradient (0 above the degree), so g_sh needs no zeroing.
+__global__ void __launch_bounds__(kShBlock)
+    shBackwardKernel(int64_t n, int64_t K, int degree, float3 campos, const float* __restrict__ sh,
+                     const float* __restrict__ means, const float* __restrict__ g_colors,
+                     float* g_sh, float* g_means) {
+  __shared__ float s_sh[kShBlock * kShStride];
+  __shared__ float s_g_sh[kShBlock * kShStride];
+  const int64_t first = static_cast<int64_t>(blockIdx.x) * kShBlock;
+  const int rows = static_cast<int>(min(static_cast<int64_t>(kShBlock), n - first));
+  const int row_len = static_cast<int>(3 * K);
+  copyShRowsIn(sh, first, rows, row_len, s_sh);
+  for (int e = threadIdx.x; e < kShBlock * kShStride; e += blockDim.x) s_g_sh[e] = 0.f;
+  __syncthreads();
+  if (static_cast<int>(threadIdx.x) < rows) {
+    const int64_t i = first + threadIdx.x;
+    const float cam[3] = {campos.x, campos.y, campos.z};
+    shColorBackward(s_sh + threadIdx.x * kShStride, degree, means + 3 * i, cam, g_colors + 3 * i,
+                    s_g_sh + threadIdx.x * kShStride, g_means + 3 * i);
+  }
+  __syncthreads();
+  float* dst = g_sh + first * row_len;
+  for (int e = threadIdx.x; e < rows * row_len; e += blockDim.x) {
+    dst[e] = s_g_sh[(e / row_len) * kShStride + e % row_len];
+  }
+}
+
+int shBlocksFor(int64_t n) { return static_cast<int>((n + kShBlock - 1) / kShBlock); }
+
+// The first 16 coefficients of sh (all that degree 3 uses) as [N, K <= 16, 3] contiguous rows.
+at::Tensor shRowsUpToDegree3(const at::Tensor& sh) {
+  return sh.size(1) > kShMaxRow / 3 ? sh.narrow(1, 0, kShMaxRow / 3).contiguous() : sh;
 }
 
 // ---- binning ---------------------------------------------------------------------------------
@@ -520,34 +565,39 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
   return g;
 }
 
-at::Tensor shForwardCuda(const at::Tensor& sh, const at::Tensor& means,
+at::Tensor shForwardCuda(const at::Tensor& sh_all, const at::Tensor& means,
                          const std::array<double, 3>& campos, int degree, void* stream_ptr) {
-  check(sh, "sh");
+  check(sh_all, "sh");
   check(means, "means");
   const int64_t n = means.size(0);
   at::Tensor colors = at::empty({n, 3}, means.options());
   if (n == 0) return colors;
+  const at::Tensor sh = shRowsUpToDegree3(sh_all);
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
-  shForwardKernel<<<blocksFor(n), kThreads1d, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
+  shForwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
       n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
       colors.data_ptr<float>());
   checkLaunch("shForwardKernel");
   return colors;
 }
 
-std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh, const at::Tensor& means,
+std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh_all, const at::Tensor& means,
                                                  const std::array<double, 3>& campos, int degree,
                                                  const at::Tensor& g_colors, void* stream_ptr) {
   check(g_colors, "grad colors");
   const int64_t n = means.size(0);
-  at::Tensor g_sh = at::zeros_like(sh), g_means = at::zeros_like(means);
-  if (n == 0) return {g_sh, g_means};
+  const at::Tensor sh = shRowsUpToDegree3(sh_all);
+  at::Tensor g_sh = at::empty_like(sh), g_means = at::zeros_like(means);
+  if (n == 0) return {at::zeros_like(sh_all), g_means};
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
-  shBackwardKernel<<<blocksFor(n), kThreads1d, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
+  shBackwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
       n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
       g_colors.data_ptr<float>(), g_sh.data_ptr<float>(), g_means.data_ptr<float>());
   checkLaunch("shBackwardKernel");
-  return {g_sh, g_means};
+  if (sh.size(1) == sh_all.size(1)) return {g_sh, g_means};
+  at::Tensor g_sh_all = at::zeros_like(sh_all);  // coefficients above degree 3: no gradient
+  g_sh_all.narrow(1, 0, sh.size(1)).copy_(g_sh);
+  return {g_sh_all, g_means};
 }
 
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,

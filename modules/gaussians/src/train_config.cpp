@@ -131,6 +131,7 @@ std::string TrainConfig::toJson() const {
                       {"lambda_l0", lambda_l0},
                       {"lambda_l0_from", lambda_l0_from},
                       {"lambda_l0_ramp", lambda_l0_ramp},
+                      {"l0_importance", l0_importance},
                       {"lr_log_alpha", lr_log_alpha},
                       {"log_alpha_init", log_alpha_init},
                       {"recovery_iterations", recovery_iterations},
@@ -214,6 +215,7 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   c.lambda_l0 = real(d, "lambda_l0", origin);
   c.lambda_l0_from = integer<int>(d, "lambda_l0_from", origin);
   c.lambda_l0_ramp = integer<int>(d, "lambda_l0_ramp", origin);
+  c.l0_importance = real(d, "l0_importance", origin);
   c.lr_log_alpha = real(d, "lr_log_alpha", origin);
   c.log_alpha_init = real(d, "log_alpha_init", origin);
   c.recovery_iterations = integer<int>(d, "recovery_iterations", origin);

@@ -71,6 +71,7 @@ struct Trainer::State {
   // Parameters: means, sh_dc, sh_rest, opacity, scales, quats, features; decoder W, b.
   std::vector<Param> params;
   at::Tensor confidence;  // [N] last semantic confidence computed by the drop (0 before)
+  at::Tensor l0_weights;  // [N] weight of each Gaussian in the L0 term (TrainConfig::l0_importance)
   std::shared_ptr<const DropStrategy> drop;
   StepProfile::Ptr profile;
   Collective::Ptr collective;
@@ -129,6 +130,7 @@ struct Trainer::State {
       return added > 0 ? at::cat({kept, fill}, 0) : kept;
     };
     confidence = grow(confidence, at::zeros({added}, confidence.options()));
+    l0_weights = grow(l0_weights, at::ones({added}, l0_weights.options()));
     grad_accum = grow(grad_accum, at::zeros({added}, grad_accum.options()));
     denom = grow(denom, at::zeros({added}, denom.options()));
     max_radii = grow(max_radii, at::zeros({added}, max_radii.options()));
@@ -171,9 +173,7 @@ struct Trainer::State {
       la.v.zero_();
     }
     if (config.recovery_prune > 0 && n() > 0) {
-      std::vector<RasterCamera> training;
-      for (int v : train_views) training.push_back(cameras[v]);
-      const at::Tensor score = blendingWeightSums(gaussians(), training);
+      const at::Tensor score = blendingWeightSums(gaussians(), trainingCameras());
       const std::int64_t count =
           static_cast<std::int64_t>(std::floor(config.recovery_prune * static_cast<double>(n())));
       if (count > 0) {
@@ -186,6 +186,28 @@ struct Trainer::State {
       }
     }
     return {closed, pruned};
+  }
+
+  std::vector<RasterCamera> trainingCameras() const {
+    std::vector<RasterCamera> training;
+    for (int v : train_views) training.push_back(cameras[v]);
+    return training;
+  }
+
+  // Whether the L0 term's weights are recomputed before iteration `it`: with l0_importance, when
+  // the L0 schedule starts and every drop interval after (a fixed schedule, so that a resumed run
+  // recomputes them where an uninterrupted one does; between, they follow the Gaussians' rows).
+  bool refreshesL0Weights(int it) const {
+    return gated(it) && config.l0_importance > 0 && it >= config.lambda_l0_from &&
+           (it - config.lambda_l0_from) % config.drop_interval == 0;
+  }
+  // The L0 weights from each Gaussian's contribution to the training views as rendered for
+  // evaluation (opacity x deterministic gate).
+  void refreshL0Weights() {
+    GaussianParams g = gaussians();
+    g.opacity_gate = evaluationGate();
+    l0_weights =
+        inverseContributionWeights(blendingWeightSums(g, trainingCameras()), config.l0_importance);
   }
 
   // Activated opacity times the evaluation gate (when there is one).
@@ -325,6 +347,10 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
     throw Error("<config>", "recovery_iterations", "0 .. iterations - 1",
                 std::to_string(config.recovery_iterations));
   }
+  if (!(config.l0_importance >= 0)) {
+    throw Error("<config>", "l0_importance", "a non-negative exponent",
+                std::to_string(config.l0_importance));
+  }
   if (!(config.recovery_prune >= 0 && config.recovery_prune < 1)) {
     throw Error("<config>", "recovery_prune", "a share in [0, 1)",
                 std::to_string(config.recovery_prune));
@@ -436,6 +462,7 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   s.denom = at::zeros({s.n()}, fopts);
   s.max_radii = at::zeros({s.n()}, fopts);
   s.confidence = at::zeros({s.n()}, fopts);
+  s.l0_weights = at::ones({s.n()}, fopts);
 }
 
 void Trainer::setDropStrategy(std::shared_ptr<const DropStrategy> strategy) {
@@ -516,6 +543,10 @@ StepStats Trainer::step(bool read_losses) {
   settings.background = c.background;
   GaussianParams g = s.gaussians();
   const bool gated = s.gated(it);
+  if (s.refreshesL0Weights(it)) {
+    enterPhase(profile, "L0 weights");
+    s.refreshL0Weights();
+  }
   if (gated) g.opacity_gate = s.drop->trainingGate(s.p("log_alpha").value, it);
   at::Tensor total;
   // Loss values stay on the device until the end of the step: one host synchronisation per step.
@@ -566,7 +597,8 @@ StepStats Trainer::step(bool read_losses) {
   if (batch > 1) total = total / batch;
   if (gated) {
     // Added once over all ranks.
-    const at::Tensor reg = s.drop->regularisation(s.p("log_alpha").value, it);
+    const at::Tensor reg = s.drop->regularisation(
+        s.p("log_alpha").value, it, c.l0_importance > 0 ? s.l0_weights : at::Tensor());
     if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);
   }
   enterPhase(profile, "backward");
@@ -639,11 +671,10 @@ StepStats Trainer::step(bool read_losses) {
       }
       if (c.prune_floaters) {
         // Floaters: seen by too few training views, or far larger than the scene's detail.
-        std::vector<RasterCamera> training;
-        for (int v : s.train_views) training.push_back(s.cameras[v]);
-        const at::Tensor keep = floaterMask(s.p("means").value, s.p("scales").value, training,
-                                            c.floater_min_views, c.floater_max_scale * s.extent)
-                                    .logical_not();
+        const at::Tensor keep =
+            floaterMask(s.p("means").value, s.p("scales").value, s.trainingCameras(),
+                        c.floater_min_views, c.floater_max_scale * s.extent)
+                .logical_not();
         floaters_at_end = s.n() - keep.sum().item<std::int64_t>();
         if (floaters_at_end > 0) s.resize(keep, {});
       }
@@ -740,6 +771,7 @@ void Trainer::saveCheckpoint(const std::string& path) const {
     a.tensors[q.name + ".v"] = q.v;
   }
   a.tensors["confidence"] = s.confidence;
+  a.tensors["l0_weights"] = s.l0_weights;
   a.tensors["grad_accum"] = s.grad_accum;
   a.tensors["denom"] = s.denom;
   a.tensors["max_radii"] = s.max_radii;
@@ -765,6 +797,9 @@ void Trainer::loadCheckpoint(const std::string& path) {
     q.v = a.tensor(q.name + ".v", path).to(s.device).contiguous();
   }
   s.confidence = a.tensor("confidence", path).to(s.device);
+  // Checkpoints written before the importance-weighted L0 have no weights: the plain mean's.
+  s.l0_weights = a.tensors.count("l0_weights") ? a.tensor("l0_weights", path).to(s.device)
+                                               : at::ones_like(s.confidence);
   s.grad_accum = a.tensor("grad_accum", path).to(s.device);
   s.denom = a.tensor("denom", path).to(s.device);
   s.max_radii = a.tensor("max_radii", path).to(s.device);
@@ -789,6 +824,7 @@ void Trainer::checkConsistency() const {
     expect(q.v, q.name + " Adam v");
   }
   expect(s.confidence, "confidence");
+  expect(s.l0_weights, "l0_weights");
   expect(s.grad_accum, "grad_accum");
   expect(s.denom, "denom");
   expect(s.max_radii, "max_radii");

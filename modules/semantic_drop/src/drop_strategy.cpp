@@ -35,12 +35,20 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     return structure_ ? deterministicGate(log_alpha, hc_) : at::Tensor();
   }
 
-  at::Tensor regularisation(const at::Tensor& log_alpha, int iteration) const override {
-    // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0 (or its schedule).
+  at::Tensor regularisation(const at::Tensor& log_alpha, int iteration,
+                            const at::Tensor& l0_weights) const override {
+    // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0 (or its schedule);
+    // with per-Gaussian weights (not the paper) the mean of weight x P_nonzero.
     const double weight =
         scheduledL0Weight(lambda_l0_, lambda_l0_from_, lambda_l0_ramp_, iteration);
     if (!structure_ || weight == 0) return {};
-    return weight * probabilityNonZero(log_alpha, hc_).mean();
+    const at::Tensor p_nonzero = probabilityNonZero(log_alpha, hc_);
+    if (!l0_weights.defined()) return weight * p_nonzero.mean();
+    if (l0_weights.numel() != p_nonzero.numel()) {
+      throw Error("<drop>", "l0_weights", std::to_string(p_nonzero.numel()) + " weights",
+                  std::to_string(l0_weights.numel()));
+    }
+    return weight * (l0_weights.to(p_nonzero.dtype()) * p_nonzero).mean();
   }
 
   bool dropNow(int done) const override {

@@ -3,8 +3,9 @@
 /// \brief How much of a set of views each Gaussian makes: the sum, over the views and their
 /// pixels, of its blending weight alpha_i * T_i (T_i the transmittance in front of it). A Gaussian
 /// that no view sees, or that lies behind opaque ones, scores 0; one that alone covers k pixels
-/// opaquely scores about k. The pruning score of the drop's recovery phase (in the spirit of the
-/// contribution scores of LightGaussian and PUP-3DGS, computed with sadsplat's own rasterizer).
+/// opaquely scores about k. The pruning score of the drop's recovery phase and the weights of the
+/// importance-weighted L0 term (in the spirit of the contribution scores of LightGaussian and
+/// PUP-3DGS, computed with sadsplat's own rasterizer).
 
 #include <ATen/ATen.h>
 
@@ -22,6 +23,15 @@ namespace gaussians {
 /// \return float [N] on the device of the Gaussians, >= 0 (in pixels)
 at::Tensor blendingWeightSums(const GaussianParams& gaussians,
                               const std::vector<RasterCamera>& cameras);
+
+/// \brief Weights that fall with the contribution: w = (1 + c / median(c))^-gamma, scaled to mean
+/// 1. A Gaussian that contributes nothing gets the largest weight, one at the median 2^-gamma of
+/// it; gamma 0 gives all ones. Where the median is 0 (most Gaussians contribute nothing), the mean
+/// of the positive contributions takes its place; all ones when none is positive.
+/// \param[in] contribution [N] >= 0 (blendingWeightSums)
+/// \param[in] gamma >= 0
+/// \return [N], same dtype and device
+at::Tensor inverseContributionWeights(const at::Tensor& contribution, double gamma);
 
 }  // namespace gaussians
 }  // namespace sadsplat

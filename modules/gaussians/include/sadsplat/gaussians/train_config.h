@@ -83,6 +83,13 @@ struct TrainConfig {
   /// constant weight.
   int lambda_l0_from = 0;
   int lambda_l0_ramp = 0;
+  /// Not the paper: exponent gamma of a per-Gaussian weight on the L0 term, so that the
+  /// Gaussians that make least of the training views are pushed shut first. Each P_nonzero in
+  /// L_L0 is weighted by (1 + c / median c)^-gamma, normalised to mean 1
+  /// (gaussians::inverseContributionWeights), c = the Gaussian's summed blending weight over the
+  /// training views (gaussians/contribution.h), recomputed from lambda_l0_from on every
+  /// drop_interval iterations. 0 = the paper's plain mean.
+  double l0_importance = 0.0;
   double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
   /// Not the paper: the last `recovery_iterations` iterations train without gates, L0 term and

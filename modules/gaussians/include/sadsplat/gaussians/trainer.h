@@ -59,7 +59,10 @@ class DropStrategy {
   /// \brief Factor on each Gaussian's opacity when rendering for evaluation (undefined: none).
   virtual at::Tensor evaluationGate(const at::Tensor& log_alpha) const = 0;
   /// \brief Term added to the training loss of (0-based) `iteration` (undefined: none).
-  virtual at::Tensor regularisation(const at::Tensor& log_alpha, int iteration) const = 0;
+  /// \param[in] l0_weights [N] weight of each Gaussian in a sparsity term (undefined: equal;
+  /// TrainConfig::l0_importance)
+  virtual at::Tensor regularisation(const at::Tensor& log_alpha, int iteration,
+                                    const at::Tensor& l0_weights) const = 0;
   /// \brief Whether to drop once `iterations_done` iterations are done.
   virtual bool dropNow(int iterations_done) const = 0;
   /// \brief Which Gaussians to keep, their confidence and the reasons of the removals.
