@@ -13,7 +13,9 @@
 #              `full` (same flags: P_base 1 is the default), its runs copied into the pbase folder
 #   l0schedule the 3 seed-0 scenes x full drop with pseudo-labels and the L0 weight off until
 #              iteration N (_fromN), rising over M iterations (_rampM), weight X (_lambdaX)
-# A configuration full_<parts> takes any of the parts pX (P_base), lambdaX, fromN, rampM, impG
+#   growth     the 3 seed-0 scenes x Net-1 grown to fewer Gaussians (none_gradX, below)
+# none_gradX: Net-1 with densify_grad_threshold X (fewer Gaussians grown; the frontier without a
+# drop). A configuration full_<parts> takes any of the parts pX (P_base), lambdaX, fromN, rampM, impG
 # (--l0-importance G: the L0 term weighted towards the Gaussians that contribute least).
 # Env: SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left; BIN (build-gpu/bin/sadsplat), DEVICE (cuda),
 # WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup (e.g. a quick CPU check).
@@ -22,7 +24,7 @@
 #   tar xzf table_TABLE.tgz -C docs/experiments/TABLE && sadsplat table docs/experiments/TABLE \
 #     --out docs/experiments/TABLE/README.md
 set -uo pipefail
-table="${1:?usage: table_runs.sh ablation|pbase|l0schedule [JOBS] [DEADLINE_S]}"
+table="${1:?usage: table_runs.sh ablation|pbase|l0schedule|growth [JOBS] [DEADLINE_S]}"
 parallel="${2:-4}"; deadline="${3:-540}"
 start=$(date +%s)
 out="${OUT:-/tmp/sadsplat-gpu-out}"
@@ -42,7 +44,9 @@ case "$table" in
             configs=(full_p1 full_p0 full_p2 full_p0.5 full_p1.5) ;;
   l0schedule) scenes=(city_0 country_0 port_0)
             configs=(full_from3500 full_from3500_lambda0.4 full_from2000_ramp1500) ;;
-  *) echo "unknown table $table (ablation, pbase or l0schedule)"; exit 2 ;;
+  growth)   scenes=(city_0 country_0 port_0)
+            configs=(none_grad0.0005 none_grad0.001 none_grad0.002) ;;
+  *) echo "unknown table $table (ablation, pbase, l0schedule or growth)"; exit 2 ;;
 esac
 [ -n "${SCENES:-}" ] && read -r -a scenes <<< "$SCENES"
 [ -n "${CONFIGS:-}" ] && read -r -a configs <<< "$CONFIGS"
@@ -75,6 +79,11 @@ run_one() {
   local cache="$dir/scene.cache" flags=(--drop none)
   case "$config" in
     none) ;;
+    none_grad*)
+      # Net-1 grown to fewer Gaussians: a higher densification gradient threshold.
+      local json="$work/${config}.json"
+      echo "{\"densify_grad_threshold\": ${config#none_grad}}" > "$json"
+      flags+=(--config "$json") ;;
     drop) flags=(--drop full) ;;
     pl) cache="$dir/scene_pl.cache" ;;
     full|full_*)
@@ -117,7 +126,7 @@ for scene in "${scenes[@]}"; do
     for seed in "${seeds[@]}"; do
       [ -f "$done_dir/$scene/${config}_t$seed/metrics.json" ] && continue
       todo+=("$config:$seed")
-      case "$config" in none|drop) ;; *) needs_pl=1 ;; esac
+      case "$config" in none|none_*|drop) ;; *) needs_pl=1 ;; esac
     done
   done
   [ ${#todo[@]} -eq 0 ] && continue

@@ -114,8 +114,8 @@ TEST(RasterizerCudaSh, EveryDegreeAndCoefficientCountMatchesTheCpuReference) {
     at::manual_seed(degree * 100 + K);
     const int n = 1000;
     const at::Tensor means = at::randn({n, 3});
-    // Around 0.5 - mean: some colour channels fall under 0 and are clamped.
-    const at::Tensor sh = at::randn({n, K, 3}) * 0.4;
+    // Wide enough that some colour channels fall under 0 and are clamped (at degree 0 too).
+    const at::Tensor sh = at::randn({n, K, 3}) * 2.0;
     const at::Tensor w = at::randn({n, 3});
     const at::Tensor m_cpu = means.clone().requires_grad_(true),
                      s_cpu = sh.clone().requires_grad_(true);
