@@ -112,7 +112,8 @@ int main(int argc, char** argv) {
           both_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
         }
         if (it == 0) {
-          // Tile hits of the visible Gaussians, from the radii (same formula as the binning).
+          // Tiles of the visible Gaussians' 3-sigma square boxes (an upper bound: the binning cuts
+          // each box to where its alpha can reach 1/255, raster::alphaBox).
           const at::Tensor radii = r.radii.to(at::kCPU).to(at::kFloat);
           const at::Tensor span = (2.0 * radii / 16.0 + 1.0).floor();
           tiles_per_gaussian = (span * span).sum().item<double>() / static_cast<double>(n);

@@ -349,6 +349,67 @@ TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
   EXPECT_EQ(alphaExtent(0, 1.0), 0);
 }
 
+TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
+  // The binning box: every pixel centre of the 3-sigma square where pixelAlpha is non-zero lies
+  // inside the box of half-widths alphaBox; it is never wider than alphaExtent, and for a
+  // Gaussian stretched along one screen axis it is much narrower across that axis.
+  using gaussians::raster::alphaBox;
+  using gaussians::raster::alphaExtent;
+  gaussians::raster::Camera<double> cam{};
+  cam.R[0] = cam.R[4] = cam.R[8] = 1;
+  cam.fx = cam.fy = 60;
+  cam.cx = 40;
+  cam.cy = 30;
+  cam.width = 80;
+  cam.height = 60;
+  cam.near_plane = 0.01;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int narrower = 0, checked = 0, boxes = 0;
+  for (int k = 0; k < 80; ++k) {
+    const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
+    const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
+    // Half of them needle-like: one scale 10-40x the others.
+    const double stretch = k % 2 ? 10 + 30 * (1 + u(rng)) / 2 : 1;
+    const double log_scale[3] = {std::log((0.005 + 0.02 * (1 + u(rng))) * stretch),
+                                 std::log(0.005 + 0.02 * (1 + u(rng))),
+                                 std::log(0.005 + 0.02 * (1 + u(rng)))};
+    gaussians::raster::Projected<double> p;
+    if (!gaussians::raster::projectGaussian(mean, quat, log_scale, cam, &p)) continue;
+    for (double opacity : {1.0 / 300, 1.0 / 255, 0.0045, 0.05, 0.5, 0.99, 1.0}) {
+      const int extent = alphaExtent(p.radius, opacity);
+      int rx = -1, ry = -1;
+      alphaBox(p.radius, opacity, p.conic, &rx, &ry);
+      EXPECT_LE(rx, extent);
+      EXPECT_LE(ry, extent);
+      EXPECT_EQ(rx <= 0, extent <= 0);
+      if (extent > 0) {
+        ++boxes;
+        narrower += rx * ry * 2 <= extent * extent;
+      }
+      for (int py = -p.radius - 2; py <= p.radius + 2; ++py) {
+        for (int px = -p.radius - 2; px <= p.radius + 2; ++px) {
+          const double x = std::floor(p.mean2d[0]) + px + 0.5,
+                       y = std::floor(p.mean2d[1]) + py + 0.5;
+          double G = 0;
+          bool clamped = false;
+          if (gaussians::raster::pixelAlpha(p.mean2d, p.conic, opacity, x, y, &G, &clamped) == 0) {
+            continue;
+          }
+          const double dx = std::abs(x - p.mean2d[0]), dy = std::abs(y - p.mean2d[1]);
+          if (dx > p.radius || dy > p.radius) continue;  // cut at 3 sigma by design (above)
+          ++checked;
+          EXPECT_LE(dx, rx) << "Gaussian " << k << " opacity " << opacity;
+          EXPECT_LE(dy, ry) << "Gaussian " << k << " opacity " << opacity;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 5000);
+  // Needles that lie across the screen's axes get at most half the square's area.
+  EXPECT_GT(narrower, boxes / 5) << narrower << " of " << boxes;
+}
+
 // Without features and depth (what training renders for a view with no semantic loss) the colour,
 // alpha and every colour gradient are those of the full render; features get no gradient.
 TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {

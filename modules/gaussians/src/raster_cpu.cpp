@@ -130,17 +130,18 @@ namespace {
 
 // Per-tile lists sorted by (depth, id): the same order the CUDA backend's stable sort gives.
 template <typename T>
-Binning binGaussians(const T* means2d, const int* radii, const T* opacities, const T* depths,
-                     int64_t n, int width, int height) {
+Binning binGaussians(const T* means2d, const T* conics, const int* radii, const T* opacities,
+                     const T* depths, int64_t n, int width, int height) {
   const ScopedPhase phase("binning");
   const auto [tiles_x, tiles_y] = tileGrid(width, height);
   const int num_tiles = tiles_x * tiles_y;
   std::vector<std::vector<int>> lists(num_tiles);
   for (int64_t i = 0; i < n; ++i) {
-    const int extent = alphaExtent(radii[i], opacities[i]);
-    if (extent <= 0) continue;
+    int rx, ry;
+    alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+    if (rx <= 0) continue;
     int x0, y0, x1, y1;
-    tileRect(means2d + 2 * i, extent, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {
       for (int tx = x0; tx < x1; ++tx) lists[ty * tiles_x + tx].push_back(static_cast<int>(i));
     }
@@ -332,7 +333,7 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const T* op = opacities.data_ptr<T>();
     const T* val = values.data_ptr<T>();
     out.binning =
-        binGaussians(m2, radii.data_ptr<int>(), op, depths.data_ptr<T>(), n, width, height);
+        binGaussians(m2, co, radii.data_ptr<int>(), op, depths.data_ptr<T>(), n, width, height);
     const int* ranges = out.binning.tile_ranges.data_ptr<int>();
     const int* ids = out.binning.gaussian_ids.data_ptr<int>();
     T* img = out.image.data_ptr<T>();

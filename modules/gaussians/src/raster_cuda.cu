@@ -136,15 +136,17 @@ at::Tensor shRowsUpToDegree3(const at::Tensor& sh) {
 // ---- binning ---------------------------------------------------------------------------------
 
 __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
-                                 const int* __restrict__ radii, const float* __restrict__ opacities,
-                                 int tiles_x, int tiles_y, int64_t* counts) {
+                                 const float* __restrict__ conics, const int* __restrict__ radii,
+                                 const float* __restrict__ opacities, int tiles_x, int tiles_y,
+                                 int64_t* counts) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   int64_t count = 0;
-  const int extent = alphaExtent(radii[i], opacities[i]);
-  if (extent > 0) {
+  int rx, ry;
+  alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+  if (rx > 0) {
     int x0, y0, x1, y1;
-    tileRect(means2d + 2 * i, extent, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     count = static_cast<int64_t>(max(0, x1 - x0)) * max(0, y1 - y0);
   }
   counts[i] = count;
@@ -152,17 +154,19 @@ __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
 
 // Key = tile id (high 32 bits) | depth's float bits (positive floats sort like their bits).
 __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
-                                const int* __restrict__ radii, const float* __restrict__ opacities,
+                                const float* __restrict__ conics, const int* __restrict__ radii,
+                                const float* __restrict__ opacities,
                                 const float* __restrict__ depths,
                                 const int64_t* __restrict__ offsets, int tiles_x, int tiles_y,
                                 int64_t* keys, int* values) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
-  const int extent = alphaExtent(radii[i], opacities[i]);
-  if (extent <= 0) return;
+  int rx, ry;
+  alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+  if (rx <= 0) return;
   int64_t out = i == 0 ? 0 : offsets[i - 1];
   int x0, y0, x1, y1;
-  tileRect(means2d + 2 * i, extent, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+  tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
   const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
   for (int ty = y0; ty < y1; ++ty) {
     for (int tx = x0; tx < x1; ++tx) {
@@ -215,7 +219,7 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
   return {sorted_keys, sorted_values};
 }
 
-Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
+Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const at::Tensor& radii,
                      const at::Tensor& opacities, const at::Tensor& depths, int width, int height,
                      cudaStream_t stream) {
   const int64_t n = means2d.size(0);
@@ -230,8 +234,8 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
   }
   at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
   countTilesKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
-      n, means2d.data_ptr<float>(), radii.data_ptr<int>(), opacities.data_ptr<float>(), tiles_x,
-      tiles_y, counts.data_ptr<int64_t>());
+      n, means2d.data_ptr<float>(), conics.data_ptr<float>(), radii.data_ptr<int>(),
+      opacities.data_ptr<float>(), tiles_x, tiles_y, counts.data_ptr<int64_t>());
   checkLaunch("countTilesKernel");
   const at::Tensor offsets = counts.cumsum(0);
   const int64_t m = offsets[n - 1].item<int64_t>();
@@ -239,8 +243,9 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& radii,
   at::Tensor values = at::empty({m}, opts.dtype(at::kInt));
   if (m > 0) {
     writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
-        n, means2d.data_ptr<float>(), radii.data_ptr<int>(), opacities.data_ptr<float>(),
-        depths.data_ptr<float>(), offsets.data_ptr<int64_t>(), tiles_x, tiles_y,
+        n, means2d.data_ptr<float>(), conics.data_ptr<float>(), radii.data_ptr<int>(),
+        opacities.data_ptr<float>(), depths.data_ptr<float>(), offsets.data_ptr<int64_t>(),
+        tiles_x, tiles_y,
         keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     const ScopedPhase sort_phase("sort");
@@ -615,7 +620,8 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
   out.image = at::zeros({height, width, D}, values.options());
   out.alpha = at::zeros({height, width}, values.options());
   out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
-  out.binning = binGaussians(means2d, radii, opacities, depths, width, height, stream);
+  out.binning =
+      binGaussians(means2d, conics, radii, opacities, depths, width, height, stream);
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
 #define SADSPLAT_LAUNCH_FORWARD(CH)                                                         \

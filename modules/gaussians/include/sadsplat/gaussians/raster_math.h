@@ -351,16 +351,16 @@ SADSPLAT_HD T gaussianPower(const T conic[3], T dx, T dy) {
   return T(-0.5) * (conic[0] * dx * dx + conic[2] * dy * dy) - conic[1] * dx * dy;
 }
 
-/// Tiles touched by a Gaussian's box of half-width `radius` (its alphaExtent): [x0, x1) x [y0, y1),
+/// Tiles touched by a Gaussian's box of half-widths (rx, ry) (its alphaBox): [x0, x1) x [y0, y1),
 /// clamped to the grid.
 template <typename T>
-SADSPLAT_HD void tileRect(const T mean2d[2], int radius, int tiles_x, int tiles_y, int* x0, int* y0,
-                          int* x1, int* y1) {
+SADSPLAT_HD void tileRect(const T mean2d[2], int rx, int ry, int tiles_x, int tiles_y, int* x0,
+                          int* y0, int* x1, int* y1) {
   const T size = T(kTileSize);
-  *x0 = mmax(0, static_cast<int>(floorOf((mean2d[0] - radius) / size)));
-  *y0 = mmax(0, static_cast<int>(floorOf((mean2d[1] - radius) / size)));
-  *x1 = mmin(tiles_x, static_cast<int>(floorOf((mean2d[0] + radius) / size)) + 1);
-  *y1 = mmin(tiles_y, static_cast<int>(floorOf((mean2d[1] + radius) / size)) + 1);
+  *x0 = mmax(0, static_cast<int>(floorOf((mean2d[0] - rx) / size)));
+  *y0 = mmax(0, static_cast<int>(floorOf((mean2d[1] - ry) / size)));
+  *x1 = mmin(tiles_x, static_cast<int>(floorOf((mean2d[0] + rx) / size)) + 1);
+  *y1 = mmin(tiles_y, static_cast<int>(floorOf((mean2d[1] + ry) / size)) + 1);
 }
 
 /// The screen radius that holds every pixel where a Gaussian of this opacity reaches kMinAlpha,
@@ -377,6 +377,26 @@ SADSPLAT_HD int alphaExtent(int radius, T opacity) {
   const T k = msqrt(T(2) * mlog(q)) / T(3);
   if (!(k < T(1))) return radius;
   return static_cast<int>(mceil(k * T(radius)));
+}
+
+/// The binning box, half-widths (*rx, *ry): alphaExtent's square cut to the axis-aligned box of the
+/// ellipse where alpha can reach kMinAlpha. opacity * exp(-d^T C d / 2) >= 1/255 (C the conic)
+/// needs d^T C d <= 2 ln(255 opacity) = k^2, and that ellipse spans k sqrt(S_xx) across and
+/// k sqrt(S_yy) down, S = C^-1 (S_xx = C_yy / det C). An elongated Gaussian's square box
+/// (3 sigma of its long axis both ways) holds many tiles its ellipse never reaches; renders are
+/// unchanged (a pixel outside the box has alpha < kMinAlpha, which pixelAlpha skips).
+template <typename T>
+SADSPLAT_HD void alphaBox(int radius, T opacity, const T conic[3], int* rx, int* ry) {
+  const int extent = alphaExtent(radius, opacity);
+  *rx = *ry = extent;
+  if (extent <= 0) return;
+  const T det = conic[0] * conic[2] - conic[1] * conic[1];
+  if (!(det > T(0))) return;
+  // The same 1 % margin on the opacity as alphaExtent.
+  const T k2 = T(2) * mlog(opacity * T(1.01 / kMinAlpha));
+  const T sx = msqrt(k2 * conic[2] / det), sy = msqrt(k2 * conic[0] / det);
+  if (sx < T(extent)) *rx = static_cast<int>(mceil(sx));
+  if (sy < T(extent)) *ry = static_cast<int>(mceil(sy));
 }
 
 /// Alpha of a Gaussian at a pixel centre (px, py), or 0 when it is skipped (power > 0 or alpha
