@@ -198,8 +198,8 @@ struct Trainer::State {
   // the L0 schedule starts and every drop interval after (a fixed schedule, so that a resumed run
   // recomputes them where an uninterrupted one does; between, they follow the Gaussians' rows).
   bool refreshesL0Weights(int it) const {
-    return gated(it) && config.l0_importance > 0 && it >= config.lambda_l0_from &&
-           (it - config.lambda_l0_from) % config.drop_interval == 0;
+    return gated(it) && config.l0_importance > 0 && config.drop_interval > 0 &&
+           it >= config.lambda_l0_from && (it - config.lambda_l0_from) % config.drop_interval == 0;
   }
   // The L0 weights from each Gaussian's contribution to the training views as rendered for
   // evaluation (opacity x deterministic gate).
