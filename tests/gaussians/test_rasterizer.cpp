@@ -8,6 +8,8 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
@@ -289,11 +291,8 @@ TEST(Rasterizer, TiledRenderEqualsABruteForceComposite) {
   EXPECT_GT(out[1].max().item<double>(), 0.5);  // the scene does cover the image
 }
 
-TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
-  // The binning radius: every pixel centre of the 3-sigma box where pixelAlpha is non-zero lies
-  // inside the box of half-width alphaExtent; faint Gaussians get less than their 3-sigma radius,
-  // Gaussians that cannot reach 1/255 get none, opaque ones keep the 3-sigma radius.
-  using gaussians::raster::alphaExtent;
+// 80x60 pixels, focal length 60, at the origin looking along +z: the binning tests' camera.
+gaussians::raster::Camera<double> binningTestCamera() {
   gaussians::raster::Camera<double> cam{};
   cam.R[0] = cam.R[4] = cam.R[8] = 1;
   cam.fx = cam.fy = 60;
@@ -302,6 +301,37 @@ TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
   cam.width = 80;
   cam.height = 60;
   cam.near_plane = 0.01;
+  return cam;
+}
+
+// |offset| (x, y) from the projected mean of every pixel centre around it (the 3-sigma box and 2
+// pixels more) where pixelAlpha is non-zero, cut at the 3-sigma box: past it an opaque Gaussian
+// can still reach 1/255 (out to ~3.3 sigma), and the rasterizer cuts it there by design (as the
+// reference 3DGS rasterizer does).
+std::vector<std::pair<double, double>> reachablePixelOffsets(
+    const gaussians::raster::Projected<double>& p, double opacity) {
+  std::vector<std::pair<double, double>> offsets;
+  for (int py = -p.radius - 2; py <= p.radius + 2; ++py) {
+    for (int px = -p.radius - 2; px <= p.radius + 2; ++px) {
+      const double x = std::floor(p.mean2d[0]) + px + 0.5, y = std::floor(p.mean2d[1]) + py + 0.5;
+      double G = 0;
+      bool clamped = false;
+      if (gaussians::raster::pixelAlpha(p.mean2d, p.conic, opacity, x, y, &G, &clamped) == 0) {
+        continue;
+      }
+      const double dx = std::abs(x - p.mean2d[0]), dy = std::abs(y - p.mean2d[1]);
+      if (dx <= p.radius && dy <= p.radius) offsets.emplace_back(dx, dy);
+    }
+  }
+  return offsets;
+}
+
+TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
+  // The binning radius: every pixel centre of the 3-sigma box where pixelAlpha is non-zero lies
+  // inside the box of half-width alphaExtent; faint Gaussians get less than their 3-sigma radius,
+  // Gaussians that cannot reach 1/255 get none, opaque ones keep the 3-sigma radius.
+  using gaussians::raster::alphaExtent;
+  const gaussians::raster::Camera<double> cam = binningTestCamera();
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   int shrunk = 0, checked = 0;
@@ -323,23 +353,10 @@ TEST(Rasterizer, AlphaExtentHoldsEveryPixelAGaussianCanReach) {
         EXPECT_EQ(extent, 0);
       }
       shrunk += extent < p.radius;
-      for (int py = -p.radius - 2; py <= p.radius + 2; ++py) {
-        for (int px = -p.radius - 2; px <= p.radius + 2; ++px) {
-          const double x = std::floor(p.mean2d[0]) + px + 0.5,
-                       y = std::floor(p.mean2d[1]) + py + 0.5;
-          double G = 0;
-          bool clamped = false;
-          if (gaussians::raster::pixelAlpha(p.mean2d, p.conic, opacity, x, y, &G, &clamped) == 0) {
-            continue;
-          }
-          const double dx = std::abs(x - p.mean2d[0]), dy = std::abs(y - p.mean2d[1]);
-          // Past the 3-sigma box an opaque Gaussian can still reach 1/255 (out to ~3.3 sigma);
-          // the rasterizer cuts it there by design (as the reference 3DGS rasterizer does).
-          if (dx > p.radius || dy > p.radius) continue;
-          ++checked;
-          EXPECT_LE(dx, extent) << "Gaussian " << k << " opacity " << opacity;
-          EXPECT_LE(dy, extent) << "Gaussian " << k << " opacity " << opacity;
-        }
+      for (const auto& [dx, dy] : reachablePixelOffsets(p, opacity)) {
+        ++checked;
+        EXPECT_LE(dx, extent) << "Gaussian " << k << " opacity " << opacity;
+        EXPECT_LE(dy, extent) << "Gaussian " << k << " opacity " << opacity;
       }
     }
   }
@@ -355,14 +372,7 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
   // Gaussian stretched along one screen axis it is much narrower across that axis.
   using gaussians::raster::alphaBox;
   using gaussians::raster::alphaExtent;
-  gaussians::raster::Camera<double> cam{};
-  cam.R[0] = cam.R[4] = cam.R[8] = 1;
-  cam.fx = cam.fy = 60;
-  cam.cx = 40;
-  cam.cy = 30;
-  cam.width = 80;
-  cam.height = 60;
-  cam.near_plane = 0.01;
+  const gaussians::raster::Camera<double> cam = binningTestCamera();
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
   int narrower = 0, checked = 0, boxes = 0;
@@ -387,21 +397,10 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
         ++boxes;
         narrower += rx * ry * 2 <= extent * extent;
       }
-      for (int py = -p.radius - 2; py <= p.radius + 2; ++py) {
-        for (int px = -p.radius - 2; px <= p.radius + 2; ++px) {
-          const double x = std::floor(p.mean2d[0]) + px + 0.5,
-                       y = std::floor(p.mean2d[1]) + py + 0.5;
-          double G = 0;
-          bool clamped = false;
-          if (gaussians::raster::pixelAlpha(p.mean2d, p.conic, opacity, x, y, &G, &clamped) == 0) {
-            continue;
-          }
-          const double dx = std::abs(x - p.mean2d[0]), dy = std::abs(y - p.mean2d[1]);
-          if (dx > p.radius || dy > p.radius) continue;  // cut at 3 sigma by design (above)
-          ++checked;
-          EXPECT_LE(dx, rx) << "Gaussian " << k << " opacity " << opacity;
-          EXPECT_LE(dy, ry) << "Gaussian " << k << " opacity " << opacity;
-        }
+      for (const auto& [dx, dy] : reachablePixelOffsets(p, opacity)) {
+        ++checked;
+        EXPECT_LE(dx, rx) << "Gaussian " << k << " opacity " << opacity;
+        EXPECT_LE(dy, ry) << "Gaussian " << k << " opacity " << opacity;
       }
     }
   }
