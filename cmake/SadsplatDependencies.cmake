@@ -10,6 +10,17 @@ find_package(Boost REQUIRED)
 find_package(Threads REQUIRED)
 # zlib: the gzip layer of .spz files.
 find_package(ZLIB REQUIRED)
+# Optional codecs of the web splat formats: zstd (SPZ version 4) and WebP (PlayCanvas' SOG).
+find_path(SADSPLAT_ZSTD_INCLUDE_DIR zstd.h)
+find_library(SADSPLAT_ZSTD_LIBRARY NAMES zstd)
+if(NOT SADSPLAT_ZSTD_INCLUDE_DIR)
+  set(SADSPLAT_ZSTD_LIBRARY "")
+endif()
+find_path(SADSPLAT_WEBP_INCLUDE_DIR webp/decode.h)
+find_library(SADSPLAT_WEBP_LIBRARY NAMES webp)
+if(NOT SADSPLAT_WEBP_INCLUDE_DIR)
+  set(SADSPLAT_WEBP_LIBRARY "")
+endif()
 
 # --- LibTorch and PCL (non-I/O) as the imported targets sadsplat::torch / sadsplat::pcl ---------
 # The same file defines them for a project that uses the installed package (sadsplatConfig.cmake).

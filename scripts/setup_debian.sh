@@ -6,6 +6,8 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libpcl-dev libflann-dev libeigen3-dev libvtk9-dev mpi-default-dev
   libtorch-dev libopencv-dev libgtest-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
+  # SPZ version 4 (zstd) and PlayCanvas' SOG (WebP images) in the web splat formats.
+  libzstd-dev libwebp-dev
   libopen3d-dev python3 python3-open3d
   # gloo's headers: LibTorch's c10d Gloo process group (data-parallel training, --nproc).
   libgloo-dev

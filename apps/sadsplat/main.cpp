@@ -52,18 +52,6 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// `convert`: Gaussian clouds between .ply and .pcd, semantic clouds between .ply and .pcd.
-void convertCloud(const std::string& in, const std::string& out, int spz_version) {
-  using namespace sadsplat::io;
-  if (cloudKind(in) == CloudKind::kSemantic) {
-    writeSemanticCloud(out, readSemanticCloud(in));
-  } else if (lowerExtension(out) == ".spz") {
-    writeSpz(out, readGaussians(in), sadsplat::kMaxShDegree, spz_version);
-  } else {
-    writeGaussians(out, readGaussians(in));
-  }
-}
-
 // `extract`: the points of one class (or of all others) of a Gaussian or a semantic cloud,
 // read and written with the given functions.
 template <typename PointT, typename Read, typename Write>
@@ -193,15 +181,19 @@ int main(int argc, char** argv) {
   import->add_option("--max-width", import_options.max_width, "cap on image width (0 = none)");
 
   auto* convert = app.add_subcommand(
-      "convert", "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz, semantic clouds .ply/.pcd");
+      "convert",
+      "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz (also read: .sog, .compressed.ply), "
+      "semantic clouds .ply/.pcd");
   std::string convert_in, convert_out;
-  convert->add_option("IN", convert_in, "input .ply, .pcd, .splat or .spz")->required();
+  convert->add_option("IN", convert_in, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")
+      ->required();
   convert->add_option("OUT", convert_out, "output .ply, .pcd, .splat or .spz")->required();
   int convert_spz_version = 3;
   convert
       ->add_option("--spz-version", convert_spz_version,
-                   ".spz: 3 (precise rotations) or 2 (what older web viewers read)")
-      ->check(CLI::IsMember({2, 3}))
+                   ".spz: 3 (gzip, every SPZ reader), 4 (zstd, the current version) or 2 (what "
+                   "older web viewers read)")
+      ->check(CLI::IsMember({2, 3, 4}))
       ->capture_default_str();
 
   auto* extract = app.add_subcommand("extract", "Write the Gaussians of one class");
@@ -473,7 +465,10 @@ int main(int argc, char** argv) {
       std::cout << "imported " << scene.views.size() << " views, " << scene.points.size()
                 << " points into " << import_out << " in " << secondsSince(start) << " s\n";
     } else if (*convert) {
-      convertCloud(convert_in, convert_out, convert_spz_version);
+      sadsplat::io::ConvertOptions options;
+      options.spz_version = convert_spz_version;
+      const std::string note = sadsplat::io::convertCloudFile(convert_in, convert_out, options);
+      if (!note.empty()) std::cerr << "sadsplat: note: " << note << "\n";
     } else if (*extract) {
       if (sadsplat::io::isDirectory(extract_in)) {
         // A run directory: its model and its class list.
@@ -508,7 +503,9 @@ int main(int argc, char** argv) {
                                         sadsplat::io::writeSemanticCloud);
       } else {
         extractClass<sadsplat::GaussianPoint>(extract_in, extract_out, class_id, extract_negative,
-                                              sadsplat::io::readGaussians,
+                                              [](const std::string& path) {
+                                                return sadsplat::io::readGaussians(path);
+                                              },
                                               sadsplat::io::writeGaussians);
       }
     } else if (*synth_cmd) {

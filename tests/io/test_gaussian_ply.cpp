@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "test_support/test_support.h"
 
@@ -177,7 +178,22 @@ TEST(GaussianPly, ErrorsNameTheFileAndTheProblem) {
 
   auto cloud = test::randomGaussians(2, 6);
   cloud[1].scale[1] = std::numeric_limits<float>::quiet_NaN();
+  // The writer refuses what the reader would refuse, naming the Gaussian and the field.
+  try {
+    writeGaussianPly(dir.file("nan.ply"), cloud);
+    ADD_FAILURE() << "a NaN was written";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "Gaussian 1 scale_1");
+  }
+  EXPECT_FALSE(io::pathExists(dir.file("nan.ply")));
+  // A NaN in a file: vertex 1's scale_1 (float 56 of 97 per record) patched in.
+  cloud[1].scale[1] = 0.5f;
   writeGaussianPly(dir.file("nan.ply"), cloud);
+  std::string bytes = test::readFile(dir.file("nan.ply"));
+  const std::size_t data = bytes.find("end_header\n") + 11;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&bytes[data + (97 + 56) * 4], &nan, 4);
+  test::writeFile(dir.file("nan.ply"), bytes);
   expectReadError(dir.file("nan.ply"), "vertex 1 property scale_1: expected a finite number");
 
   std::string odd = "ply\nformat ascii 1.0\nelement vertex 0\n";

@@ -1,5 +1,7 @@
 #include "sadsplat/io/cloud_files.h"
 
+#include <cctype>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -14,15 +16,22 @@ namespace {
 [[noreturn]] void unknownExtension(const std::string& path, const std::string& kind) {
   throw Error(path, "file name",
               "a " + kind + " file ending in .ply or .pcd" +
-                  (kind == "Gaussian cloud" ? std::string(" (or .splat, .spz)") : std::string()),
+                  (kind == "Gaussian cloud" ? std::string(" (or .splat, .spz, .sog)")
+                                            : std::string()),
               lowerExtension(path).empty() ? "no extension" : lowerExtension(path));
+}
+
+bool isCompressedPlyName(const std::string& path) {
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return endsWith(lower, ".compressed.ply");
 }
 
 }  // namespace
 
 CloudKind cloudKind(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".splat" || ext == ".spz") {
+  if (ext == ".splat" || ext == ".spz" || ext == ".sog") {
     requireRegularFile(path);
     return CloudKind::kGaussians;
   }
@@ -43,17 +52,46 @@ CloudKind cloudKind(const std::string& path) {
   unknownExtension(path, "point cloud");
 }
 
-pcl::PointCloud<GaussianPoint> readGaussians(const std::string& path) {
+pcl::PointCloud<GaussianPoint> readGaussians(const std::string& path,
+                                             GaussianReadReport* report) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".ply") return readGaussianPly(path);
-  if (ext == ".pcd") return loadGaussianPcd(path);
-  if (ext == ".splat") return readSplat(path);
-  if (ext == ".spz") return readSpz(path);
-  unknownExtension(path, "Gaussian cloud");
+  pcl::PointCloud<GaussianPoint> cloud;
+  std::size_t clamped = 0;
+  if (ext == ".ply" && isCompressedPly(path)) {
+    CompressedPlyInfo info;
+    cloud = readCompressedPly(path, &info);
+    clamped = info.clamped_opacities;
+  } else if (ext == ".ply") {
+    PlyFileInfo info;
+    cloud = readGaussianPly(path, &info);
+    clamped = info.clamped_opacities;
+  } else if (ext == ".pcd") {
+    cloud = loadGaussianPcd(path);
+  } else if (ext == ".splat") {
+    cloud = readSplat(path);
+  } else if (ext == ".spz") {
+    SpzFileInfo info;
+    cloud = readSpz(path, &info);
+    clamped = info.clamped_opacities;
+  } else if (ext == ".sog") {
+    SogFileInfo info;
+    cloud = readSog(path, &info);
+    clamped = info.clamped_opacities;
+  } else {
+    unknownExtension(path, "Gaussian cloud");
+  }
+  if (report != nullptr) report->clamped_opacities = clamped;
+  return cloud;
 }
 
 void writeGaussians(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud) {
   const std::string ext = lowerExtension(path);
+  if (ext == ".sog" || isCompressedPlyName(path)) {
+    throw Error(path, "file name",
+                "an output sadsplat writes: .ply, .pcd, .splat or .spz (PlayCanvas' .sog and "
+                ".compressed.ply are read only: write .ply and convert it with splat-transform)",
+                "not supported: writing " + std::string(ext == ".sog" ? ".sog" : ".compressed.ply"));
+  }
   if (ext == ".ply") {
     writeGaussianPly(path, cloud);
   } else if (ext == ".pcd") {
@@ -65,6 +103,34 @@ void writeGaussians(const std::string& path, const pcl::PointCloud<GaussianPoint
   } else {
     unknownExtension(path, "Gaussian cloud");
   }
+}
+
+std::string convertCloudFile(const std::string& in, const std::string& out,
+                             const ConvertOptions& options) {
+  if (cloudKind(in) == CloudKind::kSemantic) {
+    writeSemanticCloud(out, readSemanticCloud(in));
+    return "";
+  }
+  GaussianReadReport report;
+  SpzWriteOptions spz;
+  spz.version = options.spz_version;
+  pcl::PointCloud<GaussianPoint> cloud;
+  if (lowerExtension(in) == ".spz") {
+    SpzFileInfo info;
+    cloud = readSpz(in, &info);
+    report.clamped_opacities = info.clamped_opacities;
+    spz.antialiased = info.antialiased;
+  } else {
+    cloud = readGaussians(in, &report);
+  }
+  if (lowerExtension(out) == ".spz") {
+    writeSpz(out, cloud, spz);
+  } else {
+    writeGaussians(out, cloud);
+  }
+  if (report.clamped_opacities == 0) return "";
+  return std::to_string(report.clamped_opacities) + " infinite opacities of " + in +
+         " clamped to +-" + std::to_string(static_cast<int>(kMaxOpacityLogit));
 }
 
 pcl::PointCloud<pcl::PointXYZRGBL> readSemanticCloud(const std::string& path) {

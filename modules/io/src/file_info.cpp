@@ -1,6 +1,7 @@
 #include "sadsplat/io/file_info.h"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <iomanip>
 #include <limits>
@@ -14,6 +15,7 @@
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/splat_formats.h"
 
 namespace sadsplat {
 namespace io {
@@ -25,14 +27,20 @@ void describeBounds(std::ostream& out, const Range& points, GetXyz xyz) {
                  std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[1], -lo[2]};
   bool any = false;
+  std::size_t invalid = 0;
   for (const auto& p : points) {
     const auto v = xyz(p);
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+      ++invalid;  // NaN: PCL's invalid point (readers refuse infinite coordinates)
+      continue;
+    }
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], v[k]);
       hi[k] = std::max(hi[k], v[k]);
     }
     any = true;
   }
+  if (invalid > 0) out << "invalid points (NaN coordinates): " << invalid << "\n";
   if (!any) {
     out << "bounding box: (empty)\n";
     return;
@@ -57,6 +65,13 @@ void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& 
   out << "labelled gaussians: " << labelled;
   if (labelled) out << " (class ids up to " << max_label << ")";
   out << "\n";
+}
+
+void describeClamped(std::ostream& out, std::size_t clamped) {
+  if (clamped > 0) {
+    out << "opacities clamped: " << clamped << " infinite logits read as +-" << kMaxOpacityLogit
+        << "\n";
+  }
 }
 
 void describeSemantic(std::ostream& out, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud) {
@@ -134,16 +149,30 @@ std::string describeFile(const std::string& path) {
   std::ostringstream out;
   if (!pathExists(path)) throw Error(path, "file", "an existing file or directory", "missing");
   if (isDirectory(path)) {
+    const std::string ext = lowerExtension(path);
+    if (ext == ".ply" || ext == ".pcd" || ext == ".splat" || ext == ".spz" || ext == ".sog") {
+      throw Error(path, "file", "a " + ext + " file", "a directory");
+    }
     out << path << ": scene directory\n";
     describeScene(out, importScene(path));
-  } else if (isSceneCache(path)) {
-    out << path << ": scene cache (version " << kSceneCacheVersion << ")\n";
+    return out.str();
+  }
+  requireRegularFile(path);  // a FIFO or device would block the reads below
+  const std::string ext = lowerExtension(path);
+  if (isSceneCache(path)) {
+    out << path << ": scene cache (version " << sceneCacheVersion(path) << ")\n";
     describeScene(out, readSceneCache(path));
-  } else if ((lowerExtension(path) == ".ply" || lowerExtension(path) == ".pcd") &&
-             cloudKind(path) == CloudKind::kSemantic) {
+  } else if ((ext == ".ply" || ext == ".pcd") && cloudKind(path) == CloudKind::kSemantic) {
     out << path << ": semantic point cloud (x y z colour label)\n";
     describeSemantic(out, readSemanticCloud(path));
-  } else if (lowerExtension(path) == ".ply") {
+  } else if (ext == ".ply" && isCompressedPly(path)) {
+    CompressedPlyInfo info;
+    const auto cloud = readCompressedPly(path, &info);
+    out << path << ": PlayCanvas compressed PLY (" << info.chunks << " chunks of 256)\n"
+        << "SH degree: " << info.sh_degree << "\n";
+    describeClamped(out, info.clamped_opacities);
+    describeGaussians(out, cloud);
+  } else if (ext == ".ply") {
     PlyFileInfo info;
     const auto cloud = readGaussianPly(path, &info);
     out << path << ": 3DGS PLY (" << info.format << ")\n"
@@ -155,17 +184,36 @@ std::string describeFile(const std::string& path) {
       for (const auto& n : info.ignored_properties) out << " " << n;
       out << "\n";
     }
+    describeClamped(out, info.clamped_opacities);
     describeGaussians(out, cloud);
-  } else if (lowerExtension(path) == ".splat" || lowerExtension(path) == ".spz") {
-    out << path << ": " << (lowerExtension(path) == ".spz" ? "SPZ" : ".splat")
-        << " web-viewer splats (no semantic fields)\n";
-    describeGaussians(out, readGaussians(path));
-  } else if (lowerExtension(path) == ".pcd") {
+  } else if (ext == ".spz") {
+    SpzFileInfo info;
+    const auto cloud = readSpz(path, &info);
+    out << path << ": SPZ version " << info.version << " (RUB axes on disk, read as RDF)\n"
+        << "SH degree: " << info.sh_degree
+        << (info.sh_degree > kMaxShDegree ? " (band 4 not read)" : "") << "\n"
+        << "position step: 1/" << (1u << info.fractional_bits) << "\n"
+        << "antialiased: " << (info.antialiased ? "yes" : "no") << "\n";
+    if (info.extensions) out << "extensions: present (skipped)\n";
+    describeClamped(out, info.clamped_opacities);
+    describeGaussians(out, cloud);
+  } else if (ext == ".sog") {
+    SogFileInfo info;
+    const auto cloud = readSog(path, &info);
+    out << path << ": PlayCanvas SOG version " << info.version << "\n"
+        << "SH degree: " << info.sh_bands << "\n";
+    describeClamped(out, info.clamped_opacities);
+    describeGaussians(out, cloud);
+  } else if (ext == ".splat") {
+    out << path << ": .splat web-viewer splats (no semantic fields)\n";
+    describeGaussians(out, readSplat(path));
+  } else if (ext == ".pcd") {
     out << path << ": PCD of GaussianPoint\n";
     describeGaussians(out, loadGaussianPcd(path));
   } else {
     throw Error(path, "file type",
-                "a .ply, .pcd, .splat or .spz file, a scene cache or a scene directory");
+                "a .ply, .pcd, .splat, .spz or .sog file, a scene cache or a scene directory",
+                ext.empty() ? "no extension" : ext);
   }
   return out.str();
 }

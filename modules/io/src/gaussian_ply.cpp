@@ -8,6 +8,7 @@
 #include "ply_codec.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/gaussian_checks.h"
 
 namespace sadsplat {
 namespace io {
@@ -165,9 +166,12 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
           decoder.next(p.type, "vertex " + std::to_string(v) + " property " + p.name);
       const Target& t = targets[i];
       if (t.kind == Target::kSkip) continue;
-      if (!std::isfinite(value)) {
-        throw Error(path, "vertex " + std::to_string(v) + " property " + p.name, "a finite number",
-                    std::to_string(value));
+      // Checked as the float it becomes: a double of 1e300 or an ascii 1e39 is infinite then.
+      // An infinite opacity is left to checkReadGaussians, which clamps it.
+      const bool opacity = t.kind == Target::kFloat && t.float_offset == offsetof(GaussianPoint, opacity);
+      if (std::isnan(value) || (!opacity && !std::isfinite(static_cast<float>(value)))) {
+        throw Error(path, "vertex " + std::to_string(v) + " property " + p.name,
+                    "a finite number within float range", std::to_string(value));
       }
       if (t.kind == Target::kLabel) {
         if (value == -1.0) {  // an `int label` (Open3D's type) marks "no class" with -1
@@ -186,9 +190,15 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
     }
     decoder.endItem();
   }
+  // Elements after the vertices (a camera record, faces) are not used, but a header that
+  // declares more of them than the file holds is a truncated or corrupt file.
+  for (std::size_t e = vertex_index + 1; e < header.elements.size(); ++e) {
+    skipElement(path, decoder, header.elements[e], header.format);
+  }
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;
+  found.clamped_opacities = checkReadGaussians(path, cloud).clamped_opacities;
   if (info != nullptr) *info = found;
   return cloud;
 }
@@ -198,6 +208,7 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
   if (options.sh_degree < 0 || options.sh_degree > kMaxShDegree) {
     throw Error(path, "sh_degree option", "0..3", std::to_string(options.sh_degree));
   }
+  checkWritableGaussians(path, cloud);
   const int rest = shCoefficientsForDegree(options.sh_degree) - 1;
 
   std::ostringstream header;

@@ -7,6 +7,7 @@
 
 #include "pcd_codec.h"
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/gaussian_checks.h"
 
 namespace sadsplat {
 namespace io {
@@ -142,8 +143,18 @@ pcl::PointCloud<PointT> loadTable(const std::string& path, const pcd::Table& t,
           continue;
         }
         double v = pcd::loadValue(src, *m.from);
-        if (!std::isfinite(v)) {
-          if (finite_only || m.to.type != 'F') {
+        // A float field is checked as the float it becomes (an 8-byte 1e300 is +inf then);
+        // infinite opacities of Gaussians are left to checkReadGaussians, which clamps them.
+        if (m.to.type == 'F' && m.to.size == 4 && std::isfinite(v)) {
+          const float f = static_cast<float>(v);
+          if (!std::isfinite(f)) {
+            throw Error(path, "point " + std::to_string(i) + " field " + m.from->name,
+                        "a finite number within float range", std::to_string(v));
+          }
+        }
+        if (!std::isfinite(v) && !(std::isinf(v) && m.to.name == "opacity")) {
+          // NaN marks an invalid point in a semantic cloud (PCL's convention); infinity never.
+          if (finite_only || m.to.type != 'F' || std::isinf(v)) {
             throw Error(path, "point " + std::to_string(i) + " field " + m.from->name,
                         "a finite number", std::to_string(v));
           }
@@ -182,6 +193,7 @@ std::vector<std::string> pcdFieldNames(const std::string& path) {
 }
 
 void savePcd(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud) {
+  checkWritableGaussians(path, cloud);
   saveTable(path, cloud);
 }
 
@@ -190,8 +202,10 @@ void savePcd(const std::string& path, const pcl::PointCloud<pcl::PointXYZRGBL>& 
 }
 
 pcl::PointCloud<GaussianPoint> loadGaussianPcd(const std::string& path) {
-  return loadTable<GaussianPoint>(path, pcd::read(path),
-                                  {"x", "y", "z", "f_dc", "opacity", "scale", "rot"}, true);
+  auto cloud = loadTable<GaussianPoint>(path, pcd::read(path),
+                                        {"x", "y", "z", "f_dc", "opacity", "scale", "rot"}, true);
+  checkReadGaussians(path, cloud);
+  return cloud;
 }
 
 pcl::PointCloud<pcl::PointXYZRGBL> loadSemanticPcd(const std::string& path) {

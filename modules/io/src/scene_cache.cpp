@@ -6,6 +6,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
 
 namespace sadsplat {
 namespace io {
@@ -121,14 +122,26 @@ Image8 readImage(ByteReader& r, int w, int h, int channels, const char* field) {
 
 }  // namespace
 
-std::uint64_t fnv1a64(const void* data, std::size_t size) {
+namespace {
+
+std::uint64_t fnv1aWithBasis(const void* data, std::size_t size, std::uint64_t basis) {
   const auto* p = static_cast<const unsigned char*>(data);
-  std::uint64_t hash = 1469598103934665603ull;
+  std::uint64_t hash = basis;
   for (std::size_t i = 0; i < size; ++i) {
     hash ^= p[i];
     hash *= 1099511628211ull;
   }
   return hash;
+}
+
+// Version 1 files were written with an offset basis one digit short of FNV-1a-64's
+// (1469598103934665603 instead of 14695981039346656037); they stay readable.
+constexpr std::uint64_t kVersion1Basis = 1469598103934665603ull;
+
+}  // namespace
+
+std::uint64_t fnv1a64(const void* data, std::size_t size) {
+  return fnv1aWithBasis(data, size, 14695981039346656037ull);
 }
 
 void writeSceneCache(const std::string& path, const Scene& scene) {
@@ -211,9 +224,20 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
 }
 
 bool isSceneCache(const std::string& path) {
+  if (!isRegularFile(path)) return false;  // a FIFO would block the read below
   std::ifstream in(path, std::ios::binary);
   char magic[8] = {};
   return in.read(magic, 8) && std::memcmp(magic, kMagic, 8) == 0;
+}
+
+std::uint32_t sceneCacheVersion(const std::string& path) {
+  const std::string head = readFileStart(path, 12);
+  if (head.size() < 12 || std::memcmp(head.data(), kMagic, 8) != 0) {
+    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"");
+  }
+  std::uint32_t version;
+  std::memcpy(&version, head.data() + 8, 4);
+  return version;
 }
 
 Scene readSceneCache(const std::string& path) {
@@ -224,8 +248,9 @@ Scene readSceneCache(const std::string& path) {
   }
   head.getBytes(8, "magic");
   const auto version = head.get<std::uint32_t>("version");
-  if (version != kSceneCacheVersion) {
-    throw Error(path, "version", std::to_string(kSceneCacheVersion) + " (re-import the scene)",
+  if (version != kSceneCacheVersion && version != 1) {
+    throw Error(path, "version",
+                "1 or " + std::to_string(kSceneCacheVersion) + " (re-import the scene)",
                 std::to_string(version));
   }
   head.get<std::uint32_t>("flags");
@@ -236,7 +261,9 @@ Scene readSceneCache(const std::string& path) {
                 std::to_string(bytes.size() - kHeaderSize) + " (file truncated or padded)");
   }
   const char* body = bytes.data() + kHeaderSize;
-  if (fnv1a64(body, payload_size) != checksum) {
+  const std::uint64_t hash = version == 1 ? fnv1aWithBasis(body, payload_size, kVersion1Basis)
+                                          : fnv1a64(body, payload_size);
+  if (hash != checksum) {
     throw Error(path, "checksum", "the FNV-1a hash stored in the header", "a mismatch (corrupt)");
   }
 

@@ -83,6 +83,12 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
       const double v = decoder.next(p.type, what);
       if (p.name == "x" || p.name == "y" || p.name == "z") {
         const float f = static_cast<float>(v);
+        // NaN marks an invalid point (PCL's convention for organised clouds); an infinite
+        // coordinate, or one beyond float range, is a broken file.
+        if (std::isinf(f)) {
+          throw Error(path, what, "a finite coordinate (or NaN for an invalid point)",
+                      std::to_string(v));
+        }
         (p.name == "x" ? point.x : p.name == "y" ? point.y : point.z) = f;
         if (!std::isfinite(f)) cloud.is_dense = false;
       } else if (p.name == "red" || p.name == "green" || p.name == "blue") {

@@ -33,6 +33,7 @@ struct PlyFileInfo {
   bool has_semantic = false;                    ///< any feature_*/log_alpha/confidence/label
   int feature_dim = 0;                          ///< number of feature_* properties
   std::vector<std::string> ignored_properties;  ///< vertex properties sadsplat does not know
+  std::size_t clamped_opacities = 0;  ///< infinite opacities clamped (gaussian_checks.h)
 };
 
 /// \brief Writes a cloud as a binary little-endian 3DGS PLY (atomically).
@@ -44,7 +45,8 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
 /// without normals and semantic properties; unknown properties and elements are skipped).
 ///
 /// Properties a file lacks take GaussianPoint's defaults. Required: x y z f_dc_0..2 opacity
-/// scale_0..2 rot_0..3. Every value must be finite.
+/// scale_0..2 rot_0..3. Every value must be finite as a float and plausible (gaussian_checks.h);
+/// an infinite opacity is clamped and counted. Elements after the vertices must be complete.
 /// \param[in] path the file
 /// \param[out] info if not null, what the file contained
 /// \throws sadsplat::Error naming the file, the element/property/vertex and the expectation

@@ -11,8 +11,9 @@
 namespace sadsplat {
 namespace io {
 
-/// \brief Format version written by writeSceneCache and the only one readSceneCache accepts.
-constexpr std::uint32_t kSceneCacheVersion = 1;
+/// \brief Format version written by writeSceneCache. readSceneCache also accepts version 1, the
+/// same layout whose checksum used a wrong FNV offset basis (see docs/formats.md).
+constexpr std::uint32_t kSceneCacheVersion = 2;
 
 /// \brief Writes `scene` to `path` (atomically).
 void writeSceneCache(const std::string& path, const Scene& scene);
@@ -22,10 +23,15 @@ void writeSceneCache(const std::string& path, const Scene& scene);
 /// mismatch, non-finite camera values or label ids outside the class list
 Scene readSceneCache(const std::string& path);
 
-/// \brief Whether `path` starts with the scene cache magic (cheap: reads 8 bytes).
+/// \brief The format version in a scene cache's header.
+/// \throws sadsplat::Error when `path` is not a scene cache
+std::uint32_t sceneCacheVersion(const std::string& path);
+
+/// \brief Whether `path` is a regular file starting with the scene cache magic (reads 8 bytes).
 bool isSceneCache(const std::string& path);
 
-/// \brief FNV-1a 64-bit hash, the cache's checksum.
+/// \brief FNV-1a 64-bit hash (offset basis 14695981039346656037, prime 1099511628211), the
+/// checksum of version 2 caches.
 std::uint64_t fnv1a64(const void* data, std::size_t size);
 
 }  // namespace io

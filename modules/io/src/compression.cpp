@@ -1,0 +1,153 @@
+#include "compression.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <functional>
+
+#if SADSPLAT_HAVE_ZSTD
+#include <zstd.h>
+#endif
+
+#include "sadsplat/common/error.h"
+
+namespace sadsplat {
+namespace io {
+namespace compression {
+namespace {
+
+// Runs inflate on a zlib stream set up by the caller, appending to `out` and refusing to produce
+// more than `limit` bytes.
+void inflateBounded(const std::string& path, const std::string& field, z_stream& s,
+                    const std::function<std::size_t(const std::vector<std::uint8_t>&)>& limit_of,
+                    std::vector<std::uint8_t>& out) {
+  std::uint8_t buffer[65536];
+  int rc = Z_OK;
+  while (rc != Z_STREAM_END) {
+    s.next_out = buffer;
+    s.avail_out = sizeof(buffer);
+    rc = inflate(&s, Z_NO_FLUSH);
+    if (rc != Z_OK && rc != Z_STREAM_END) {
+      inflateEnd(&s);
+      throw Error(path, field, "a valid compressed stream", "corrupt or truncated data");
+    }
+    const std::size_t produced = sizeof(buffer) - s.avail_out;
+    const std::size_t limit = limit_of(out);
+    if (out.size() + produced > limit) {
+      inflateEnd(&s);
+      throw Error(path, field,
+                  "at most " + std::to_string(limit) + " bytes uncompressed (what the header's "
+                  "count needs)",
+                  "more (a count that does not match the data, or a compression bomb)");
+    }
+    out.insert(out.end(), buffer, buffer + produced);
+    if (produced == 0 && s.avail_in == 0 && rc != Z_STREAM_END) {
+      inflateEnd(&s);
+      throw Error(path, field, "a complete compressed stream", "truncated data");
+    }
+  }
+  inflateEnd(&s);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data,
+                               std::size_t size) {
+  z_stream s{};
+  if (deflateInit2(&s, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 9, Z_DEFAULT_STRATEGY) !=
+      Z_OK) {
+    throw Error(path, "gzip", "zlib to initialise", "an initialisation failure");
+  }
+  std::vector<std::uint8_t> out(deflateBound(&s, size) + 64);
+  s.next_in = const_cast<Bytef*>(data);
+  s.avail_in = static_cast<uInt>(size);
+  s.next_out = out.data();
+  s.avail_out = static_cast<uInt>(out.size());
+  const int rc = deflate(&s, Z_FINISH);
+  deflateEnd(&s);
+  if (rc != Z_STREAM_END) throw Error(path, "gzip", "the data compressed", "a zlib error");
+  out.resize(out.size() - s.avail_out);
+  return out;
+}
+
+std::vector<std::uint8_t> gunzip(
+    const std::string& path, const std::uint8_t* data, std::size_t size,
+    const std::function<std::size_t(const std::vector<std::uint8_t>&)>& limit_of) {
+  z_stream s{};
+  if (inflateInit2(&s, 16 + MAX_WBITS) != Z_OK) {
+    throw Error(path, "gzip", "zlib to initialise", "an initialisation failure");
+  }
+  s.next_in = const_cast<Bytef*>(data);
+  s.avail_in = static_cast<uInt>(size);
+  std::vector<std::uint8_t> out;
+  inflateBounded(path, "gzip data", s, limit_of, out);
+  return out;
+}
+
+std::vector<std::uint8_t> inflateRaw(const std::string& path, const std::string& field,
+                                     const std::uint8_t* data, std::size_t size,
+                                     std::size_t expected) {
+  z_stream s{};
+  if (inflateInit2(&s, -MAX_WBITS) != Z_OK) {
+    throw Error(path, field, "zlib to initialise", "an initialisation failure");
+  }
+  s.next_in = const_cast<Bytef*>(data);
+  s.avail_in = static_cast<uInt>(size);
+  std::vector<std::uint8_t> out;
+  out.reserve(expected);
+  inflateBounded(
+      path, field, s, [expected](const std::vector<std::uint8_t>&) { return expected; }, out);
+  if (out.size() != expected) {
+    throw Error(path, field, std::to_string(expected) + " bytes uncompressed",
+                std::to_string(out.size()));
+  }
+  return out;
+}
+
+#if SADSPLAT_HAVE_ZSTD
+
+bool haveZstd() { return true; }
+
+std::vector<std::uint8_t> zstdCompress(const std::string& path, const std::uint8_t* data,
+                                       std::size_t size) {
+  std::vector<std::uint8_t> out(ZSTD_compressBound(size));
+  const std::size_t n = ZSTD_compress(out.data(), out.size(), data, size, 12);
+  if (ZSTD_isError(n)) throw Error(path, "zstd", "the data compressed", ZSTD_getErrorName(n));
+  out.resize(n);
+  return out;
+}
+
+void zstdDecompress(const std::string& path, const std::string& field, const std::uint8_t* data,
+                    std::size_t size, std::uint8_t* out, std::size_t expected) {
+  // ZSTD_decompress writes at most `expected` bytes: the header's count bounds the output.
+  const std::size_t n = ZSTD_decompress(out, expected, data, size);
+  if (ZSTD_isError(n)) {
+    throw Error(path, field, "a valid zstd frame of " + std::to_string(expected) + " bytes",
+                ZSTD_getErrorName(n));
+  }
+  if (n != expected) {
+    throw Error(path, field, std::to_string(expected) + " bytes uncompressed", std::to_string(n));
+  }
+}
+
+#else
+
+bool haveZstd() { return false; }
+
+std::vector<std::uint8_t> zstdCompress(const std::string& path, const std::uint8_t*,
+                                       std::size_t) {
+  throw Error(path, "SPZ version 4", "a build with libzstd (Debian: libzstd-dev)",
+              "not supported: built without zstd");
+}
+
+void zstdDecompress(const std::string& path, const std::string&, const std::uint8_t*,
+                    std::size_t, std::uint8_t*, std::size_t) {
+  throw Error(path, "SPZ version 4", "a build with libzstd (Debian: libzstd-dev)",
+              "not supported: built without zstd");
+}
+
+#endif
+
+}  // namespace compression
+}  // namespace io
+}  // namespace sadsplat
