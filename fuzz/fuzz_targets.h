@@ -28,13 +28,14 @@
 namespace sadsplat {
 namespace fuzz {
 
-// Fuzz target: the 3DGS PLY reader (ascii and binary), and the semantic PLY reader on the same
-// input.
+// Fuzz target: the 3DGS PLY reader (ascii and binary), and the semantic and PlayCanvas
+// compressed PLY readers on the same input.
 inline void fuzz_gaussian_ply(const std::uint8_t* data, std::size_t size) {
   const std::string path = fuzz::inputFile("input.ply");
   fuzz::writeInput(path, data, size);
   fuzz::expectOnlySadsplatErrors([&] { io::readGaussianPly(path); });
   fuzz::expectOnlySadsplatErrors([&] { io::readSemanticPly(path); });
+  fuzz::expectOnlySadsplatErrors([&] { io::readCompressedPly(path); });
 }
 
 // Fuzz target: the PCD codec (ascii, binary, binary_compressed), as Gaussians and as a semantic
@@ -46,8 +47,8 @@ inline void fuzz_pcd(const std::uint8_t* data, std::size_t size) {
   fuzz::expectOnlySadsplatErrors([&] { io::loadSemanticPcd(path); });
 }
 
-// Fuzz target: the .splat and .spz readers. Inputs that start with gzip's magic go to .spz;
-// the others are also tried as .splat.
+// Fuzz target: the web splat readers: every input is tried as .spz (versions 2-4), .splat and
+// .sog (a ZIP of WebP images).
 inline void fuzz_splat_formats(const std::uint8_t* data, std::size_t size) {
   const std::string spz = fuzz::inputFile("input.spz");
   fuzz::writeInput(spz, data, size);
@@ -55,6 +56,9 @@ inline void fuzz_splat_formats(const std::uint8_t* data, std::size_t size) {
   const std::string splat = fuzz::inputFile("input.splat");
   fuzz::writeInput(splat, data, size);
   fuzz::expectOnlySadsplatErrors([&] { io::readSplat(splat); });
+  const std::string sog = fuzz::inputFile("input.sog");
+  fuzz::writeInput(sog, data, size);
+  fuzz::expectOnlySadsplatErrors([&] { io::readSog(sog); });
 }
 
 // Fuzz target: the scene cache, structure-aware: the input is the payload (chunks, including

@@ -9,6 +9,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/gaussian_checks.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "test_support/test_support.h"
 
@@ -335,6 +336,70 @@ TEST(GaussianPly, Open3dTensorReaderKeepsTheProperties) {
   EXPECT_FLOAT_EQ(opacity, cloud[2].opacity);
   EXPECT_FLOAT_EQ(feature, cloud[4].feature[31]);
   EXPECT_FLOAT_EQ(rest, cloud[0].f_rest[44]);
+}
+
+// An ascii 3DGS PLY of one Gaussian whose values are given as text (x y z f_dc_0..2 opacity
+// scale_0..2 rot_0..3), with `extra_header` lines after the vertex element.
+std::string asciiPly(const std::string& values, const std::string& extra_header = "") {
+  std::string text = "ply\nformat ascii 1.0\nelement vertex 1\n";
+  for (const char* n : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0",
+                        "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
+    text += std::string("property float ") + n + "\n";
+  }
+  return text + extra_header + "end_header\n" + values + "\n";
+}
+
+// Values are checked as the floats they become and against the plausible ranges
+// (gaussian_checks.h): nothing reads as a silent +inf or an absurd coordinate.
+TEST(GaussianPly, ValuesBeyondFloatRangeOrPlausibilityAreErrors) {
+  test::TempDir dir;
+  const auto check = [&](const std::string& name, const std::string& values,
+                         const std::string& needle) {
+    test::writeFile(dir.file(name), asciiPly(values));
+    expectReadError(dir.file(name), needle);
+  };
+  check("big.ply", "1e39 0 0 0 0 0 0 0 0 0 1 0 0 0", "vertex 0 property x: expected a finite number within float range");
+  check("far.ply", "-3.4e38 0 0 0 0 0 0 0 0 0 1 0 0 0", "Gaussian 0 x: expected a coordinate within +-1e7");
+  check("scale.ply", "0 0 0 0 0 0 0 1e30 0 0 1 0 0 0", "Gaussian 0 scale_0: expected a log-scale within +-50");
+  // A binary double of 1e300 is +inf as a float.
+  std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty double x\n";
+  for (const char* n : {"y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1",
+                        "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"}) {
+    header += std::string("property float ") + n + "\n";
+  }
+  std::string bytes = header + "end_header\n";
+  const double huge = 1e300;
+  bytes.append(reinterpret_cast<const char*>(&huge), 8);
+  bytes.append(13 * 4, '\0');
+  test::writeFile(dir.file("double.ply"), bytes);
+  expectReadError(dir.file("double.ply"), "property x: expected a finite number within float range");
+}
+
+// What 3DGS decoders make of an alpha byte of 255 (+inf) reads as an opaque Gaussian, counted.
+TEST(GaussianPly, InfiniteOpacityIsClampedAndCounted) {
+  test::TempDir dir;
+  test::writeFile(dir.file("inf.ply"), asciiPly("1 2 3 0 0 0 inf 0 0 0 1 0 0 0"));
+  PlyFileInfo info;
+  const auto cloud = readGaussianPly(dir.file("inf.ply"), &info);
+  EXPECT_EQ(info.clamped_opacities, 1u);
+  EXPECT_EQ(cloud[0].opacity, io::kMaxOpacityLogit);
+  test::writeFile(dir.file("ninf.ply"), asciiPly("1 2 3 0 0 0 -inf 0 0 0 1 0 0 0"));
+  EXPECT_EQ(readGaussianPly(dir.file("ninf.ply"))[0].opacity, -io::kMaxOpacityLogit);
+  test::writeFile(dir.file("nan.ply"), asciiPly("1 2 3 0 0 0 nan 0 0 0 1 0 0 0"));
+  expectReadError(dir.file("nan.ply"), "opacity");
+}
+
+// An element declared after the vertices (10^9 camera records) without its bytes is a
+// truncated file, not a complete one.
+TEST(GaussianPly, TrailingElementsMustBeComplete) {
+  test::TempDir dir;
+  test::writeFile(dir.file("cam.ply"), asciiPly("1 2 3 0 0 0 0 0 0 0 1 0 0 0",
+                                                "element camera 1000000000\nproperty float fx\n"));
+  expectReadError(dir.file("cam.ply"), "element camera");
+  test::writeFile(dir.file("cam1.ply"), asciiPly("1 2 3 0 0 0 0 0 0 0 1 0 0 0",
+                                                 "element camera 1\nproperty float fx\n") +
+                                            "500\n");
+  EXPECT_EQ(readGaussianPly(dir.file("cam1.ply")).size(), 1u);
 }
 
 }  // namespace

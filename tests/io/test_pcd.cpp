@@ -187,5 +187,29 @@ TEST(Pcd, AFifoIsAnErrorNotABlockingRead) {
   expectPcdError(dir.file("pipe.pcd"), "a regular file");
 }
 
+TEST(Pcd, EightByteFloatsBeyondFloatRangeAreErrors) {
+  test::TempDir dir;
+  const auto semanticError = [&](const std::string& path) -> std::string {
+    try {
+      io::loadSemanticPcd(path);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  std::string header =
+      "FIELDS x y z rgb label\nSIZE 8 4 4 4 4\nTYPE F F F F U\nCOUNT 1 1 1 1 1\nWIDTH 1\n"
+      "HEIGHT 1\nPOINTS 1\nDATA ascii\n";
+  test::writeFile(dir.file("big.pcd"), header + "1e300 0 0 0 1\n");
+  EXPECT_NE(semanticError(dir.file("big.pcd")).find("point 0 field x: expected a finite number "
+                                                    "within float range"),
+            std::string::npos);
+  test::writeFile(dir.file("inf.pcd"), header + "inf 0 0 0 1\n");
+  EXPECT_NE(semanticError(dir.file("inf.pcd")).find("point 0 field x"), std::string::npos);
+  test::writeFile(dir.file("nan.pcd"), header + "nan 0 0 0 1\n");
+  const auto cloud = io::loadSemanticPcd(dir.file("nan.pcd"));  // NaN: PCL's invalid point
+  EXPECT_FALSE(cloud.is_dense);
+}
+
 }  // namespace
 }  // namespace sadsplat

@@ -181,5 +181,24 @@ TEST(SceneCache, ChecksSemanticValidityOfWellFormedFiles) {
   expectCacheError(dir.file("chunk.cache"), "truncated or corrupt");
 }
 
+// The checksum is FNV-1a-64 as published (test vectors of the reference implementation); the
+// committed fixture is a version-1 file (its checksum used a wrong offset basis) and still reads.
+TEST(SceneCache, ChecksumIsFnv1a64AndVersion1FilesStillRead) {
+  EXPECT_EQ(io::fnv1a64("", 0), 0xcbf29ce484222325ull);
+  EXPECT_EQ(io::fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(io::fnv1a64("foobar", 6), 0x85944171f73967e8ull);
+  const std::string v1 = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  EXPECT_EQ(io::sceneCacheVersion(v1), 1u);
+  const io::Scene scene = io::readSceneCache(v1);
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("v2.cache"), scene);
+  EXPECT_EQ(io::sceneCacheVersion(dir.file("v2.cache")), 2u);
+  const std::string bytes = test::readFile(dir.file("v2.cache"));
+  std::uint64_t stored;
+  std::memcpy(&stored, bytes.data() + 24, 8);
+  EXPECT_EQ(stored, io::fnv1a64(bytes.data() + 32, bytes.size() - 32));
+  EXPECT_EQ(io::readSceneCache(dir.file("v2.cache")).views.size(), scene.views.size());
+}
+
 }  // namespace
 }  // namespace sadsplat

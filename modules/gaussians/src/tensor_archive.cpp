@@ -96,7 +96,8 @@ TensorArchive readTensorArchive(const std::string& path) {
   char magic[8];
   r.read(magic, 8, "magic");
   if (std::memcmp(magic, kMagic, 8) != 0) {
-    throw Error(path, "magic", "a sadsplat checkpoint starting with \"SADSCKPT\"");
+    throw Error(path, "magic", "a sadsplat checkpoint starting with \"SADSCKPT\"",
+                "other bytes");
   }
   const auto version = r.get<std::uint32_t>("version");
   if (version != 1) throw Error(path, "version", "1", std::to_string(version));
@@ -104,7 +105,10 @@ TensorArchive readTensorArchive(const std::string& path) {
   TensorArchive archive;
   for (std::uint64_t e = 0; e < count; ++e) {
     const auto len = r.get<std::uint32_t>("name length");
-    if (len > 4096) throw Error(path, "entry " + std::to_string(e), "a name under 4096 bytes");
+    if (len > 4096) {
+      throw Error(path, "entry " + std::to_string(e), "a name under 4096 bytes",
+                  std::to_string(len) + " bytes");
+    }
     std::string name(len, '\0');
     r.read(name.data(), len, "name");
     const auto kind = r.get<std::uint8_t>(name + " kind");
@@ -117,7 +121,10 @@ TensorArchive readTensorArchive(const std::string& path) {
     }
     const auto dtype = r.get<std::uint8_t>(name + " dtype");
     const auto ndim = r.get<std::uint32_t>(name + " ndim");
-    if (dtype > 2 || ndim > 8) throw Error(path, name, "dtype 0..2 and at most 8 dimensions");
+    if (dtype > 2 || ndim > 8) {
+      throw Error(path, name, "dtype 0..2 and at most 8 dimensions",
+                  "dtype " + std::to_string(dtype) + ", " + std::to_string(ndim) + " dimensions");
+    }
     std::vector<int64_t> sizes(ndim);
     // The sizes must fit the bytes left before anything is allocated.
     const std::size_t element = dtype == 2 ? 8 : 4;
@@ -131,7 +138,9 @@ TensorArchive readTensorArchive(const std::string& path) {
       if (dim != 0 && bytes_needed > r.remaining() / dim) {
         throw Error(path, name + " sizes",
                     "a tensor that fits the " + std::to_string(r.remaining()) +
-                        " bytes left (checkpoint truncated or corrupt)");
+                        " bytes left (checkpoint truncated or corrupt)",
+                    "a size of " + std::to_string(s) + " in dimension " +
+                        std::to_string(&s - sizes.data()));
       }
       bytes_needed *= dim;
     }

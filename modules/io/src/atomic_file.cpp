@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -15,13 +16,34 @@
 
 namespace sadsplat {
 namespace io {
+namespace {
+
+// "<path>.tmp-<pid>" beside the output; when that name would pass NAME_MAX (255 bytes on the
+// usual file systems) a short hidden name in the same directory, so that every output name the
+// file system accepts can also be written atomically.
+std::string temporaryPathFor(const std::string& path) {
+  const std::string suffix = ".tmp-" + std::to_string(::getpid());
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  constexpr std::size_t kNameMax = 255;
+  if (name.size() + suffix.size() <= kNameMax) return path + suffix;
+  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a of the name: distinct per output
+  for (const char c : name) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ull;
+  }
+  return dir + ".sadsplat-" + std::to_string(hash) + suffix;
+}
+
+}  // namespace
 
 void writeViaTemporaryPath(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write) {
   // An output path names what the user wants; its missing parent directories are made here, so
   // every writer accepts a nested path that does not exist yet (`--out out/a/b/model.ply`).
   makeParentDirectory(path);
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const std::string tmp = temporaryPathFor(path);
   try {
     try {
       write(tmp);

@@ -101,7 +101,8 @@ template <typename T>
 T parseField(std::istringstream& in, const TextLines& lines, const char* field) {
   T v{};
   if (!(in >> v)) {
-    throw Error(lines.path(), lines.where() + " " + field, std::string("a value for ") + field);
+    throw Error(lines.path(), lines.where() + " " + field, std::string("a value for ") + field,
+                "the end of the line or a non-number");
   }
   return v;
 }
@@ -109,7 +110,8 @@ T parseField(std::istringstream& in, const TextLines& lines, const char* field) 
 double parseDouble(std::istringstream& in, const TextLines& lines, const char* field) {
   std::string token;
   if (!(in >> token)) {
-    throw Error(lines.path(), lines.where() + " " + field, std::string("a value for ") + field);
+    throw Error(lines.path(), lines.where() + " " + field, std::string("a value for ") + field,
+                "the end of the line or a non-number");
   }
   char* end = nullptr;
   const double v = std::strtod(token.c_str(), &end);
@@ -200,7 +202,9 @@ std::vector<ColmapPoint3D> readPointsText(const std::string& path) {
       const auto idx = parseField<std::uint32_t>(in, lines, "TRACK point2D_idx");
       p.track.emplace_back(image_id, idx);
     }
-    if (!in.eof()) throw Error(path, lines.where() + " TRACK", "pairs of integers");
+    if (!in.eof()) {
+      throw Error(path, lines.where() + " TRACK", "pairs of integers", "an odd count or a word");
+    }
     points.push_back(std::move(p));
   }
   return points;

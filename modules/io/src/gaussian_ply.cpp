@@ -46,7 +46,7 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
     if (header.elements[i].name == "vertex") vertex_index = i;
   }
   if (vertex_index == header.elements.size()) {
-    throw Error(path, "header", "an \"element vertex\" line");
+    throw Error(path, "header", "an \"element vertex\" line", "none");
   }
   const PlyElement& vertex = header.elements[vertex_index];
 
@@ -99,7 +99,8 @@ pcl::PointCloud<GaussianPoint> readGaussianPly(const std::string& path, PlyFileI
     } else if ((k = indexedName(n, "feature_")) >= 0) {
       if (k >= kFeatureDim) {
         throw Error(path, "vertex property " + n,
-                    "at most " + std::to_string(kFeatureDim) + " feature_* properties");
+                    "at most " + std::to_string(kFeatureDim) + " feature_* properties",
+                    "feature_" + std::to_string(k));
       }
       t.float_offset = SADSPLAT_FIELD_OFFSET(feature) + sizeof(float) * k;
       found.feature_dim = std::max(found.feature_dim, k + 1);

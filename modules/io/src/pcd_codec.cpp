@@ -108,7 +108,9 @@ Header parseHeader(const std::string& path, const std::string& bytes) {
   h.data_offset = pos;
 
   if (names.empty()) throw Error(path, "FIELDS", "at least one field name", "none");
-  if (names.size() > kMaxFields) throw Error(path, "FIELDS", "at most 4096 fields");
+  if (names.size() > kMaxFields) {
+    throw Error(path, "FIELDS", "at most 4096 fields", std::to_string(names.size()));
+  }
   if (sizes.size() != names.size()) {
     throw Error(path, "SIZE", std::to_string(names.size()) + " values (one per field)",
                 std::to_string(sizes.size()));
@@ -122,7 +124,8 @@ Header parseHeader(const std::string& path, const std::string& bytes) {
                 std::to_string(counts.size()));
   }
   if (!have_width || !have_height) {
-    throw Error(path, "WIDTH/HEIGHT", "both present, below 2^32");
+    throw Error(path, "WIDTH/HEIGHT", "both present, below 2^32",
+                have_width ? "no HEIGHT" : "no WIDTH");
   }
   std::set<std::string> seen;
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -106,7 +106,8 @@ inline std::size_t minItemBytes(const PlyElement& element, PlyFormat format) {
 
 inline PlyHeader parseHeader(const std::string& path, const std::string& bytes) {
   if (bytes.compare(0, 4, "ply\n") != 0 && bytes.compare(0, 5, "ply\r\n") != 0) {
-    throw Error(path, "magic", "a PLY file starting with \"ply\"");
+    throw Error(path, "magic", "a PLY file starting with \"ply\"",
+                bytes.empty() ? "an empty file" : "other bytes");
   }
   PlyHeader header;
   std::size_t pos = 0;
@@ -178,7 +179,7 @@ inline PlyHeader parseHeader(const std::string& path, const std::string& bytes) 
       throw Error(path, where, "a PLY header keyword", keyword);
     }
   }
-  if (!have_format) throw Error(path, "header", "a \"format\" line");
+  if (!have_format) throw Error(path, "header", "a \"format\" line", "none");
   header.data_offset = pos;
   return header;
 }

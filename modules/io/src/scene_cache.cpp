@@ -167,7 +167,8 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
         (!v.labels.empty() && v.labels.pixels.size() != pixels)) {
       throw Error(path, "view " + v.name,
                   "images of the camera's size " + std::to_string(v.camera.width) + "x" +
-                      std::to_string(v.camera.height));
+                      std::to_string(v.camera.height),
+                  "an image with another pixel count");
     }
     ByteWriter c;
     c.putString(v.name);
@@ -233,7 +234,8 @@ bool isSceneCache(const std::string& path) {
 std::uint32_t sceneCacheVersion(const std::string& path) {
   const std::string head = readFileStart(path, 12);
   if (head.size() < 12 || std::memcmp(head.data(), kMagic, 8) != 0) {
-    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"");
+    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"",
+                "other bytes");
   }
   std::uint32_t version;
   std::memcpy(&version, head.data() + 8, 4);
@@ -244,7 +246,8 @@ Scene readSceneCache(const std::string& path) {
   const std::string bytes = readWholeFile(path);
   ByteReader head(path, bytes.data(), bytes.size(), "header");
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
-    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"");
+    throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"",
+                "other bytes");
   }
   head.getBytes(8, "magic");
   const auto version = head.get<std::uint32_t>("version");
@@ -325,7 +328,9 @@ Scene readSceneCache(const std::string& path) {
       v.mask = readImage(c, w, h, 1, "mask");
       if (has_labels) {
         v.labels = readImage(c, w, h, 1, "labels");
-        if (!have_classes) throw Error(path, "chunk order", "CLAS before VIEW");
+        if (!have_classes) {
+          throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
+        }
         for (std::size_t i = 0; i < v.labels.pixels.size(); ++i) {
           const auto l = v.labels.pixels[i];
           if (l != kIgnoreLabel && l >= scene.classes.size()) {
@@ -346,7 +351,9 @@ Scene readSceneCache(const std::string& path) {
       for (auto& p : scene.points) {
         for (float& x : p.xyz) {
           x = c.get<float>("point xyz");
-          if (!std::isfinite(x)) throw Error(path, "point xyz", "finite coordinates");
+          if (!std::isfinite(x)) {
+            throw Error(path, "point xyz", "finite coordinates", std::to_string(x));
+          }
         }
         for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
       }

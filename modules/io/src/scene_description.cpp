@@ -43,7 +43,8 @@ std::vector<std::string> stringList(const nlohmann::json& doc, const std::string
 std::vector<ClassInfo> readClassesJson(const std::string& path) {
   const nlohmann::json doc = parseJsonFile(path);
   if (!doc.is_object() || !doc.contains("classes") || !doc.at("classes").is_array()) {
-    throw Error(path, "classes", "an object with a \"classes\" array");
+    throw Error(path, "classes", "an object with a \"classes\" array",
+                doc.is_object() ? "no \"classes\" array" : doc.type_name());
   }
   const auto& list = doc.at("classes");
   if (list.empty() || list.size() > 255) {
@@ -58,14 +59,16 @@ std::vector<ClassInfo> readClassesJson(const std::string& path) {
     ClassInfo c;
     if (!item.contains("name") || !item.at("name").is_string() ||
         item.at("name").get<std::string>().empty()) {
-      throw Error(path, where + ".name", "a non-empty string");
+      throw Error(path, where + ".name", "a non-empty string",
+                  item.contains("name") ? item.at("name").dump().substr(0, 40) : "missing");
     }
     c.name = item.at("name").get<std::string>();
     if (!names.insert(c.name).second) {
       throw Error(path, where + ".name", "a unique class name", c.name + " (a duplicate)");
     }
     if (!item.contains("color") || !item.at("color").is_array() || item.at("color").size() != 3) {
-      throw Error(path, where + ".color", "[r, g, b] with integers 0..255");
+      throw Error(path, where + ".color", "[r, g, b] with integers 0..255",
+                  item.contains("color") ? item.at("color").dump().substr(0, 40) : "missing");
     }
     for (int k = 0; k < 3; ++k) {
       const auto& v = item.at("color")[k];
@@ -76,7 +79,9 @@ std::vector<ClassInfo> readClassesJson(const std::string& path) {
     }
     c.prompt = c.name;
     if (item.contains("prompt")) {
-      if (!item.at("prompt").is_string()) throw Error(path, where + ".prompt", "a string");
+      if (!item.at("prompt").is_string()) {
+        throw Error(path, where + ".prompt", "a string", item.at("prompt").type_name());
+      }
       c.prompt = item.at("prompt").get<std::string>();
     }
     classes.push_back(c);

@@ -57,7 +57,7 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
   const std::string bytes = readWholeFile(path);
   const ply::PlyHeader header = ply::parseHeader(path, bytes);
   const ply::PlyElement* vertex = findVertex(header);
-  if (vertex == nullptr) throw Error(path, "header", "an \"element vertex\" line");
+  if (vertex == nullptr) throw Error(path, "header", "an \"element vertex\" line", "none");
   for (const char* required : {"x", "y", "z", "red", "green", "blue", "label"}) {
     if (!hasProperty(*vertex, required)) {
       throw Error(path, std::string("vertex property ") + required,
@@ -108,6 +108,12 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
       }
     }
     decoder.endItem();
+  }
+  // Elements after the vertices are not used, but must be as complete as the header says.
+  bool after = false;
+  for (const auto& e : header.elements) {
+    if (after) ply::skipElement(path, decoder, e, header.format);
+    after = after || &e == vertex;
   }
   return cloud;
 }

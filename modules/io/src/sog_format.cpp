@@ -83,6 +83,14 @@ Image decodeWebp(const std::string& path, const ZipArchive& zip, const std::stri
     throw Error(path, "ZIP entry " + name, "a WebP image", "other bytes");
   }
   const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+  // An image is a texture of the Gaussians (padded to a convenient width) or a palette of at most
+  // 65536 entries: anything far larger is refused before its pixels are allocated.
+  const std::size_t max_pixels = 4 * min_pixels + (std::size_t{1} << 20);
+  if (pixels > max_pixels) {
+    throw Error(path, "ZIP entry " + name,
+                "an image of at most " + std::to_string(max_pixels) + " pixels",
+                std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
   if (pixels < min_pixels) {
     throw Error(path, "ZIP entry " + name,
                 "at least " + std::to_string(min_pixels) + " pixels (one per Gaussian)",

@@ -2,7 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
@@ -40,7 +42,7 @@ TrainLogWriter::TrainLogWriter(const std::string& path, int resume_iteration) : 
   }
   writeFileAtomically(path, [&](std::ostream& out) { out << kept; });
   out_.open(path, std::ios::app);
-  if (!out_) throw Error(path, "open for appending", "a writable file");
+  if (!out_) throw Error(path, "open for appending", "a writable file", std::strerror(errno));
 }
 
 void TrainLogWriter::append(const TrainLogRecord& r) {

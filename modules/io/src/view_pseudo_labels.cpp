@@ -62,7 +62,10 @@ void ViewPseudoLabels::validate(const std::string& origin, std::size_t pixels) c
       kept.size() != static_cast<std::size_t>(num_targets)) {
     throw Error(origin, "pseudo-labels tables",
                 "num_targets x num_classes scores, num_targets x feature_dim features, "
-                "num_targets kept flags");
+                "num_targets kept flags",
+                std::to_string(scores.size()) + " scores, " + std::to_string(features.size()) +
+                    " features, " + std::to_string(kept.size()) + " flags for " +
+                    std::to_string(num_targets) + " targets");
   }
   for (std::size_t i = 0; i < region.size(); ++i) {
     if (region[i] < -1 || region[i] >= num_targets) {
@@ -77,7 +80,9 @@ void ViewPseudoLabels::validate(const std::string& origin, std::size_t pixels) c
     }
   }
   for (float f : features) {
-    if (!std::isfinite(f)) throw Error(origin, "pseudo-labels features", "finite values");
+    if (!std::isfinite(f)) {
+      throw Error(origin, "pseudo-labels features", "finite values", std::to_string(f));
+    }
   }
 }
 
