@@ -172,10 +172,18 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
       0)
       << out;
   EXPECT_EQ(io::readSemanticCloud(dir.file("road_sem.pcd")).size(), roads);
+  // A value outside an option's choices is a usage error (exit 2) naming the flag.
   EXPECT_EQ(test::runCommand(
                 kCli + " train " + kScene + " --out " + dir.file("r2") + " --device tpu", &out),
+            2);
+  EXPECT_NE(out.find("--device"), std::string::npos) << out;
+  // The same value in a --config file is an error naming the file and the key (exit 1).
+  test::writeFile(dir.file("tpu.json"), "{\"device\": \"tpu\"}");
+  EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r3") +
+                                 " --config " + dir.file("tpu.json"),
+                             &out),
             1);
-  EXPECT_NE(out.find("device"), std::string::npos) << out;
+  EXPECT_NE(out.find("device: expected cpu,cuda, got tpu"), std::string::npos) << out;
 }
 
 // A run trained on a relative scene path is evaluated from another working directory (run.json

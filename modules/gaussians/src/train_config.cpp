@@ -1,13 +1,21 @@
 #include "sadsplat/gaussians/train_config.h"
 
+#include "sadsplat/gaussians/train_options.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <sstream>
+#include <type_traits>
+#include <variant>
+#include <vector>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/gaussian_point.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -85,57 +93,223 @@ TrainConfig TrainConfig::forGlobalBatch(int views) const {
   return c;
 }
 
+namespace {
+
+using C = TrainConfig;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The table: one row per TrainConfig field. Ranges are what the trainer can run with, not
+// recommendations; the defaults are the field initialisers in train_config.h.
+const std::vector<TrainOption> kOptions = {
+    {"iterations", &C::iterations, "training iterations (paper: 7000)", "--iterations", 1, kInf},
+    {"feature_dim", &C::feature_dim, "semantic feature channels per Gaussian (paper: 32)",
+     nullptr, 0, kFeatureDim},
+    {"max_sh_degree", &C::max_sh_degree, "highest spherical-harmonics degree", nullptr, 0, 3},
+    {"sh_increase_interval", &C::sh_increase_interval,
+     "iterations between raising the SH degree by one", nullptr, 1, kInf},
+    {"lambda_ssim", &C::lambda_ssim, "weight of D-SSIM in the RGB loss (paper: 0.2)", nullptr, 0,
+     1},
+    {"fused_ssim", &C::fused_ssim, "CUDA: the SSIM loss in fused kernels (false: reference)"},
+    {"fused_semantic_loss", &C::fused_semantic_loss,
+     "CUDA: the semantic loss in fused kernels (false: reference)"},
+    {"lambda_rgb", &C::lambda_rgb, "weight of the RGB loss", nullptr, 0, kInf},
+    {"lambda_semantic", &C::lambda_semantic, "weight of the semantic loss on labelled views",
+     nullptr, 0, kInf},
+    {"semantic_interval", &C::semantic_interval,
+     "every this many iterations a labelled view is rendered as well (0: never)", nullptr, 0,
+     kInf},
+    {"views_per_step", &C::views_per_step,
+     "training views per step and rank; the loss is their mean", "--views-per-step", 1, 1024},
+    {"use_pseudo_labels", &C::use_pseudo_labels,
+     "supervise unlabelled training views with the scene's kept pseudo-labels"},
+    {"lambda_pseudo", &C::lambda_pseudo, "weight of the semantic loss on pseudo-labelled views",
+     nullptr, 0, kInf},
+    {"pseudo_labels_train_decoder", &C::pseudo_labels_train_decoder,
+     "whether pseudo-labels also train the decoder (paper: yes)"},
+    {"lr_position_init", &C::lr_position_init, "position learning rate at the start (x extent)",
+     nullptr, 0, kInf},
+    {"lr_position_final", &C::lr_position_final, "position learning rate at the end (x extent)",
+     nullptr, 0, kInf},
+    {"lr_sh_dc", &C::lr_sh_dc, "learning rate of the SH DC coefficients", nullptr, 0, kInf},
+    {"lr_sh_rest", &C::lr_sh_rest, "learning rate of the higher SH coefficients", nullptr, 0,
+     kInf},
+    {"lr_opacity", &C::lr_opacity, "learning rate of the opacity logits", nullptr, 0, kInf},
+    {"lr_scaling", &C::lr_scaling, "learning rate of the log-scales", nullptr, 0, kInf},
+    {"lr_rotation", &C::lr_rotation, "learning rate of the quaternions", nullptr, 0, kInf},
+    {"lr_feature", &C::lr_feature, "learning rate of the semantic features", nullptr, 0, kInf},
+    {"lr_decoder", &C::lr_decoder, "learning rate of the feature decoder", nullptr, 0, kInf},
+    {"densify_from", &C::densify_from, "first densification iteration", nullptr, 0, kInf},
+    {"densify_until", &C::densify_until, "last densification iteration (-1: half the iterations)",
+     nullptr, -1, kInf},
+    {"densify_interval", &C::densify_interval, "iterations between densifications", nullptr, 1,
+     kInf},
+    {"densify_grad_threshold", &C::densify_grad_threshold,
+     "NDC-space positional gradient that triggers densification (3DGS)", nullptr, 0, kInf},
+    {"percent_dense", &C::percent_dense, "clone / split boundary as a share of the extent",
+     nullptr, 0, kInf},
+    {"min_opacity", &C::min_opacity, "Gaussians below this opacity are pruned", nullptr, 0, 1},
+    {"opacity_reset_interval", &C::opacity_reset_interval,
+     "iterations between opacity resets (0: never)", nullptr, 0, kInf},
+    {"max_screen_radius", &C::max_screen_radius,
+     "prune Gaussians wider than this many pixels after the first reset (0: off)", nullptr, 0,
+     kInf},
+    {"checkpoint_interval", &C::checkpoint_interval, "iterations between checkpoints (0: none)",
+     nullptr, 0, kInf},
+    {"seed", &C::seed, "random seed", "--seed"},
+    {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
+    {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
+    {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1,
+     kInf},
+    {"prune_floaters", &C::prune_floaters,
+     "after the last iteration remove Gaussians seen by fewer than floater_min_views training "
+     "views or larger than floater_max_scale x the scene extent",
+     "--prune-floaters"},
+    {"floater_min_views", &C::floater_min_views, "see prune_floaters", nullptr, 0, kInf},
+    {"floater_max_scale", &C::floater_max_scale, "see prune_floaters", nullptr, 0, kInf},
+    {"drop", &C::drop, "the semantic-aware drop", "--drop", -kInf, kInf,
+     "none|semantic|structure|full"},
+    {"p_base", &C::p_base, "base drop rate P_base (paper: 1.0)", "--p-base", 0, kInf},
+    {"drop_interval", &C::drop_interval, "iterations between drops (paper: 500)", nullptr, 1,
+     kInf},
+    {"lambda_l0", &C::lambda_l0, "weight of the L0 sparsity loss", "--lambda-l0", 0, kInf},
+    {"lambda_l0_from", &C::lambda_l0_from,
+     "the L0 loss starts at this iteration (not the paper; 0: from the start)",
+     "--lambda-l0-from", 0, kInf},
+    {"lambda_l0_ramp", &C::lambda_l0_ramp,
+     "the L0 weight rises linearly over this many iterations (0: at once)", "--lambda-l0-ramp",
+     0, kInf},
+    {"l0_importance", &C::l0_importance,
+     "weight the L0 loss towards the Gaussians that contribute least, exponent gamma (not the "
+     "paper; 0: the plain mean)",
+     "--l0-importance", 0, kInf},
+    {"lr_log_alpha", &C::lr_log_alpha, "learning rate of the Hard Concrete gates", nullptr, 0,
+     kInf},
+    {"log_alpha_init", &C::log_alpha_init, "initial gate log-alpha (3: P(open) = 0.99)"},
+    {"recovery_iterations", &C::recovery_iterations,
+     "the last N iterations train without gates, L0 and drops (not the paper; 0: off)",
+     "--recovery", 0, kInf},
+    {"recovery_prune", &C::recovery_prune,
+     "at the start of the recovery also remove this share of the least contributing Gaussians",
+     "--recovery-prune", 0, 0.999},
+};
+
+std::string numberText(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+bool isChoice(const char* choices, const std::string& value) {
+  std::stringstream list(choices);
+  for (std::string c; std::getline(list, c, '|');) {
+    if (c == value) return true;
+  }
+  return false;
+}
+
+std::string choiceText(const char* choices) {
+  std::string text = choices;
+  std::replace(text.begin(), text.end(), '|', ',');
+  return text;
+}
+
+// Sets the option from a JSON value, with the reader's type and integer checks.
+void setFromJson(const TrainOption& o, const nlohmann::json& value, TrainConfig& c,
+                 const std::string& origin) {
+  nlohmann::json d = {{o.key, value}};
+  std::visit(
+      [&](auto member) {
+        using T = std::decay_t<decltype(c.*member)>;
+        if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::uint64_t>) {
+          c.*member = integer<T>(d, o.key, origin);
+        } else if constexpr (std::is_same_v<T, double>) {
+          c.*member = real(d, o.key, origin);
+        } else if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::string>) {
+          c.*member = value.get<T>();
+        } else {  // the background colour
+          if (!value.is_array() || value.size() != 3) {
+            throw Error(origin, o.key, "an array of 3 numbers (RGB)",
+                        value.is_array() ? std::to_string(value.size()) + " elements"
+                                         : value.type_name());
+          }
+          for (int k = 0; k < 3; ++k) {
+            if (!value[k].is_number()) {
+              throw Error(origin, o.key, "an array of 3 numbers (RGB)", value[k].type_name());
+            }
+            (c.*member)[k] = static_cast<float>(value[k].get<double>());
+          }
+        }
+      },
+      o.member);
+}
+
+nlohmann::json toJsonValue(const TrainOption& o, const TrainConfig& c) {
+  return std::visit(
+      [&](auto member) -> nlohmann::json {
+        using T = std::decay_t<decltype(c.*member)>;
+        if constexpr (std::is_same_v<T, std::array<float, 3>>) {
+          return {(c.*member)[0], (c.*member)[1], (c.*member)[2]};
+        } else {
+          return c.*member;
+        }
+      },
+      o.member);
+}
+
+}  // namespace
+
+const std::vector<TrainOption>& trainOptions() { return kOptions; }
+
+std::string optionText(const TrainOption& option, const TrainConfig& config) {
+  const nlohmann::json v = toJsonValue(option, config);
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+void setOptionFromText(const TrainOption& option, const std::string& text, TrainConfig& config,
+                       const std::string& origin) {
+  nlohmann::json value;
+  if (std::holds_alternative<std::string TrainConfig::*>(option.member)) {
+    value = text;
+  } else {
+    value = nlohmann::json::parse(text, nullptr, false);
+    if (value.is_discarded() || value.is_string()) {
+      throw Error(origin, option.flag ? option.flag : option.key,
+                  std::holds_alternative<bool TrainConfig::*>(option.member) ? "true or false"
+                                                                             : "a number",
+                  text);
+    }
+  }
+  const nlohmann::json reference = toJsonValue(option, TrainConfig{});
+  if (value.type() != reference.type() && !(value.is_number() && reference.is_number())) {
+    throw Error(origin, option.flag ? option.flag : option.key,
+                std::string("a ") + reference.type_name(), value.type_name());
+  }
+  setFromJson(option, value, config, origin);
+}
+
+void TrainConfig::check(const std::string& origin) const {
+  for (const TrainOption& o : kOptions) {
+    const nlohmann::json v = toJsonValue(o, *this);
+    if (v.is_number() && !(v.get<double>() >= o.min && v.get<double>() <= o.max)) {
+      const std::string range =
+          o.max == kInf ? ">= " + numberText(o.min)
+                        : o.min == -kInf ? "<= " + numberText(o.max)
+                                         : numberText(o.min) + " .. " + numberText(o.max);
+      throw Error(origin, o.key, range, v.dump());
+    }
+    if (v.is_string() && o.choices != nullptr && !isChoice(o.choices, v.get<std::string>())) {
+      throw Error(origin, o.key, choiceText(o.choices), v.get<std::string>());
+    }
+  }
+  if (recovery_iterations >= iterations) {
+    throw Error(origin, "recovery_iterations", "0 .. iterations - 1",
+                std::to_string(recovery_iterations));
+  }
+}
+
 std::string TrainConfig::toJson() const {
-  nlohmann::json j = {{"iterations", iterations},
-                      {"feature_dim", feature_dim},
-                      {"max_sh_degree", max_sh_degree},
-                      {"sh_increase_interval", sh_increase_interval},
-                      {"lambda_ssim", lambda_ssim},
-                      {"fused_ssim", fused_ssim},
-                      {"fused_semantic_loss", fused_semantic_loss},
-                      {"lambda_rgb", lambda_rgb},
-                      {"lambda_semantic", lambda_semantic},
-                      {"semantic_interval", semantic_interval},
-                      {"views_per_step", views_per_step},
-                      {"prune_floaters", prune_floaters},
-                      {"floater_min_views", floater_min_views},
-                      {"floater_max_scale", floater_max_scale},
-                      {"use_pseudo_labels", use_pseudo_labels},
-                      {"lambda_pseudo", lambda_pseudo},
-                      {"pseudo_labels_train_decoder", pseudo_labels_train_decoder},
-                      {"lr_position_init", lr_position_init},
-                      {"lr_position_final", lr_position_final},
-                      {"lr_sh_dc", lr_sh_dc},
-                      {"lr_sh_rest", lr_sh_rest},
-                      {"lr_opacity", lr_opacity},
-                      {"lr_scaling", lr_scaling},
-                      {"lr_rotation", lr_rotation},
-                      {"lr_feature", lr_feature},
-                      {"lr_decoder", lr_decoder},
-                      {"densify_from", densify_from},
-                      {"densify_until", densify_until},
-                      {"densify_interval", densify_interval},
-                      {"densify_grad_threshold", densify_grad_threshold},
-                      {"percent_dense", percent_dense},
-                      {"min_opacity", min_opacity},
-                      {"opacity_reset_interval", opacity_reset_interval},
-                      {"max_screen_radius", max_screen_radius},
-                      {"checkpoint_interval", checkpoint_interval},
-                      {"seed", seed},
-                      {"background", {background[0], background[1], background[2]}},
-                      {"device", device},
-                      {"max_gaussians", max_gaussians},
-                      {"drop", drop},
-                      {"p_base", p_base},
-                      {"drop_interval", drop_interval},
-                      {"lambda_l0", lambda_l0},
-                      {"lambda_l0_from", lambda_l0_from},
-                      {"lambda_l0_ramp", lambda_l0_ramp},
-                      {"l0_importance", l0_importance},
-                      {"lr_log_alpha", lr_log_alpha},
-                      {"log_alpha_init", log_alpha_init},
-                      {"recovery_iterations", recovery_iterations},
-                      {"recovery_prune", recovery_prune}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const TrainOption& o : kOptions) j[o.key] = toJsonValue(o, *this);
   return j.dump(2) + "\n";
 }
 
@@ -148,78 +322,22 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   }
   if (!j.is_object()) throw Error(origin, "top level", "a JSON object", j.type_name());
   TrainConfig c;
-  nlohmann::json defaults = nlohmann::json::parse(c.toJson());
+  const nlohmann::json defaults = nlohmann::json::parse(c.toJson());
   for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!defaults.contains(it.key()))
+    const auto option = std::find_if(kOptions.begin(), kOptions.end(), [&](const TrainOption& o) {
+      return it.key() == o.key;
+    });
+    if (option == kOptions.end()) {
       throw Error(origin, it.key(), "a known configuration key", "unknown");
-    if (it.value().type() != defaults[it.key()].type() &&
-        !(it.value().is_number() && defaults[it.key()].is_number())) {
-      throw Error(origin, it.key(), std::string("a ") + defaults[it.key()].type_name(),
+    }
+    const nlohmann::json& reference = defaults[it.key()];
+    if (it.value().type() != reference.type() &&
+        !(it.value().is_number() && reference.is_number())) {
+      throw Error(origin, it.key(), std::string("a ") + reference.type_name(),
                   it.value().type_name());
     }
-    defaults[it.key()] = it.value();
+    setFromJson(*option, it.value(), c, origin);
   }
-  const auto& d = defaults;
-  c.iterations = integer<int>(d, "iterations", origin);
-  c.feature_dim = integer<int>(d, "feature_dim", origin);
-  c.max_sh_degree = integer<int>(d, "max_sh_degree", origin);
-  c.sh_increase_interval = integer<int>(d, "sh_increase_interval", origin);
-  c.lambda_ssim = real(d, "lambda_ssim", origin);
-  c.fused_ssim = d["fused_ssim"].get<bool>();
-  c.fused_semantic_loss = d["fused_semantic_loss"].get<bool>();
-  c.lambda_rgb = real(d, "lambda_rgb", origin);
-  c.lambda_semantic = real(d, "lambda_semantic", origin);
-  c.semantic_interval = integer<int>(d, "semantic_interval", origin);
-  c.views_per_step = integer<int>(d, "views_per_step", origin);
-  c.prune_floaters = d["prune_floaters"].get<bool>();
-  c.floater_min_views = integer<int>(d, "floater_min_views", origin);
-  c.floater_max_scale = real(d, "floater_max_scale", origin);
-  c.use_pseudo_labels = d["use_pseudo_labels"];
-  c.lambda_pseudo = real(d, "lambda_pseudo", origin);
-  c.pseudo_labels_train_decoder = d["pseudo_labels_train_decoder"];
-  c.lr_position_init = real(d, "lr_position_init", origin);
-  c.lr_position_final = real(d, "lr_position_final", origin);
-  c.lr_sh_dc = real(d, "lr_sh_dc", origin);
-  c.lr_sh_rest = real(d, "lr_sh_rest", origin);
-  c.lr_opacity = real(d, "lr_opacity", origin);
-  c.lr_scaling = real(d, "lr_scaling", origin);
-  c.lr_rotation = real(d, "lr_rotation", origin);
-  c.lr_feature = real(d, "lr_feature", origin);
-  c.lr_decoder = real(d, "lr_decoder", origin);
-  c.densify_from = integer<int>(d, "densify_from", origin);
-  c.densify_until = integer<int>(d, "densify_until", origin);
-  c.densify_interval = integer<int>(d, "densify_interval", origin);
-  c.densify_grad_threshold = real(d, "densify_grad_threshold", origin);
-  c.percent_dense = real(d, "percent_dense", origin);
-  c.min_opacity = real(d, "min_opacity", origin);
-  c.opacity_reset_interval = integer<int>(d, "opacity_reset_interval", origin);
-  c.max_screen_radius = integer<int>(d, "max_screen_radius", origin);
-  c.checkpoint_interval = integer<int>(d, "checkpoint_interval", origin);
-  c.seed = integer<std::uint64_t>(d, "seed", origin);
-  const nlohmann::json& background = d["background"];
-  if (background.size() != 3) {
-    throw Error(origin, "background", "an array of 3 numbers (RGB)",
-                std::to_string(background.size()) + " elements");
-  }
-  for (int k = 0; k < 3; ++k) {
-    if (!background[k].is_number()) {
-      throw Error(origin, "background", "an array of 3 numbers (RGB)", background[k].type_name());
-    }
-    c.background[k] = static_cast<float>(background[k].get<double>());
-  }
-  c.device = d["device"];
-  c.max_gaussians = integer<int>(d, "max_gaussians", origin);
-  c.drop = d["drop"];
-  c.p_base = real(d, "p_base", origin);
-  c.drop_interval = integer<int>(d, "drop_interval", origin);
-  c.lambda_l0 = real(d, "lambda_l0", origin);
-  c.lambda_l0_from = integer<int>(d, "lambda_l0_from", origin);
-  c.lambda_l0_ramp = integer<int>(d, "lambda_l0_ramp", origin);
-  c.l0_importance = real(d, "l0_importance", origin);
-  c.lr_log_alpha = real(d, "lr_log_alpha", origin);
-  c.log_alpha_init = real(d, "log_alpha_init", origin);
-  c.recovery_iterations = integer<int>(d, "recovery_iterations", origin);
-  c.recovery_prune = real(d, "recovery_prune", origin);
   return c;
 }
 

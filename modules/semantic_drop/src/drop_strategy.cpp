@@ -107,23 +107,7 @@ double scheduledL0Weight(double lambda, int from, int ramp, int iteration) {
 
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
                                                                 const HardConcreteParams& hc) {
-  if (c.p_base < 0)
-    throw Error("<config>", "p_base", "a non-negative base drop rate", std::to_string(c.p_base));
-  if (!(c.lambda_l0 >= 0)) {
-    throw Error("<config>", "lambda_l0", "a non-negative weight", std::to_string(c.lambda_l0));
-  }
-  if (c.lambda_l0_from < 0) {
-    throw Error("<config>", "lambda_l0_from", "a non-negative number of iterations",
-                std::to_string(c.lambda_l0_from));
-  }
-  if (c.lambda_l0_ramp < 0) {
-    throw Error("<config>", "lambda_l0_ramp", "a non-negative number of iterations",
-                std::to_string(c.lambda_l0_ramp));
-  }
-  if (c.drop_interval < 1) {
-    throw Error("<config>", "drop_interval", "a positive number of iterations",
-                std::to_string(c.drop_interval));
-  }
+  c.check();  // ranges and choices of every option, the drop's included
   if (c.drop == "none") return nullptr;
   if (c.drop == "semantic") return std::make_shared<SemanticDropStrategy>(c, true, false, hc);
   if (c.drop == "structure") return std::make_shared<SemanticDropStrategy>(c, false, true, hc);

@@ -10,7 +10,8 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief Every training parameter, with the defaults of the paper / 3DGS.
+/// \brief Every training parameter, with the defaults of the paper / 3DGS. Each field is listed
+/// once more, in the option table (train_options.h), which gives its key, help and range.
 struct TrainConfig {
   int iterations = 7000;  ///< paper: 7000
   int feature_dim = 32;   ///< paper: semantic dimension 32
@@ -111,9 +112,15 @@ struct TrainConfig {
   /// \throws sadsplat::Error when views < 1
   TrainConfig forGlobalBatch(int views) const;
 
-  /// \brief The configuration as JSON text.
+  /// \brief Checks every option against its range in the option table (train_options.h) and
+  /// the rules between options (recovery_iterations below iterations).
+  /// \throws sadsplat::Error naming `origin` and the first option that is out of range
+  void check(const std::string& origin = "<config>") const;
+
+  /// \brief The configuration as JSON text (every key of the option table).
   std::string toJson() const;
-  /// \brief Reads a JSON object; keys not given keep their defaults; unknown keys are errors.
+  /// \brief Reads a JSON object; keys not given keep their defaults; unknown keys and values of
+  /// the wrong type are errors (ranges are check()'s).
   /// \throws sadsplat::Error naming `origin` and the key
   static TrainConfig fromJson(const std::string& text, const std::string& origin);
 };

@@ -1,0 +1,33 @@
+// `sadsplat eval RUN`: a training run's metrics on its test views.
+#include <iostream>
+
+#include "commands.h"
+#include "sadsplat/pipeline/runs.h"
+
+namespace sadsplat {
+namespace cli {
+namespace {
+
+class EvalCommand : public Command {
+ public:
+  CLI::App* add(CLI::App& app) override {
+    CLI::App* c = app.add_subcommand("eval", "Evaluate a training run on its test views");
+    c->add_option("RUN", run_, "run directory")->required();
+    c->add_option("--scene", scene_, "scene to evaluate on (default: the run's)");
+    return c;
+  }
+  int run(const Invocation&) override {
+    std::cout << pipeline::evalRun(run_, scene_);
+    return 0;
+  }
+
+ private:
+  std::string run_, scene_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> makeEvalCommand() { return std::make_unique<EvalCommand>(); }
+
+}  // namespace cli
+}  // namespace sadsplat

@@ -1,0 +1,95 @@
+// `sadsplat extract MODEL --class NAME --out FILE`: the Gaussians (or points) of one class.
+#include <iostream>
+
+#include "commands.h"
+#include "sadsplat/common/error.h"
+#include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/io/cloud_files.h"
+#include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/scene_cache.h"
+#include "sadsplat/io/scene_import.h"
+#include "sadsplat/semantic_drop/class_extraction.h"
+
+namespace sadsplat {
+namespace cli {
+namespace {
+
+// The points of one class (or of all others) of a cloud, read and written with the given
+// functions.
+template <typename PointT, typename Read, typename Write>
+void extractClass(const std::string& in, const std::string& out, std::uint32_t class_id,
+                  bool negative, Read read, Write write) {
+  const auto cloud = std::make_shared<pcl::PointCloud<PointT>>(read(in));
+  semantic_drop::ClassExtraction<PointT> filter;
+  filter.setClassId(class_id);
+  filter.setNegative(negative);
+  filter.setInputCloud(cloud);
+  pcl::PointCloud<PointT> kept;
+  filter.filter(kept);
+  write(out, kept);
+  std::cout << "kept " << kept.size() << " of " << cloud->size() << " points\n";
+}
+
+class ExtractCommand : public Command {
+ public:
+  CLI::App* add(CLI::App& app) override {
+    CLI::App* c = app.add_subcommand("extract", "Write the Gaussians of one class");
+    c->add_option("MODEL", in_, "input .ply / .pcd, or a run directory")->required();
+    c->add_option("--class", class_, "class name (or id)")->required();
+    c->add_option("--classes", classes_, "classes.json or scene cache naming classes");
+    c->add_option("--out", out_, "output .ply or .pcd")->required();
+    c->add_flag("--negative", negative_, "keep every class except this one");
+    return c;
+  }
+
+  int run(const Invocation&) override {
+    std::string in = in_, classes = classes_;
+    if (io::isDirectory(in)) {  // a run directory: its model and its class list
+      if (classes.empty()) classes = in + "/classes.json";
+      in += "/model.ply";
+    }
+    const std::uint32_t id = classId(classes);
+    if (io::cloudKind(in) == io::CloudKind::kSemantic) {
+      extractClass<pcl::PointXYZRGBL>(in, out_, id, negative_, io::readSemanticCloud,
+                                      io::writeSemanticCloud);
+    } else {
+      extractClass<GaussianPoint>(
+          in, out_, id, negative_, [](const std::string& p) { return io::readGaussians(p); },
+          io::writeGaussians);
+    }
+    return 0;
+  }
+
+ private:
+  std::uint32_t classId(const std::string& classes) const {
+    if (classes.empty()) {
+      std::size_t used = 0;
+      unsigned long id = 0;
+      try {
+        id = std::stoul(class_, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != class_.size() || id >= kUnlabelled) {
+        throw Error("<command line>", "--class", "a class id, or --classes FILE to use names",
+                    class_);
+      }
+      return static_cast<std::uint32_t>(id);
+    }
+    const auto list = io::isSceneCache(classes) ? io::readSceneCache(classes).classes
+                                                : io::readClassesJson(classes);
+    semantic_drop::ClassExtraction<GaussianPoint> by_name;
+    by_name.setClassName(class_, list);
+    return by_name.getClassId();
+  }
+
+  std::string in_, out_, class_, classes_;
+  bool negative_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> makeExtractCommand() { return std::make_unique<ExtractCommand>(); }
+
+}  // namespace cli
+}  // namespace sadsplat
