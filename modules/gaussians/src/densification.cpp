@@ -1,0 +1,171 @@
+#include "sadsplat/gaussians/densification.h"
+
+#include <cmath>
+#include <tuple>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/densification_stats.h"
+#include "sadsplat/gaussians/trainer.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace {
+
+double logit(double p) { return std::log(p / (1 - p)); }
+
+class DefaultDensification : public DensificationStrategy {
+ public:
+  DefaultDensification(const TrainConfig& config, double extent)
+      : config_(config), extent_(extent) {}
+
+  void initialise(std::int64_t rows, const at::TensorOptions& options) override {
+    grad_accum_ = at::zeros({rows}, options);
+    denom_ = at::zeros({rows}, options);
+    max_radii_ = at::zeros({rows}, options);
+  }
+
+  std::vector<at::Tensor*> stepPostBackward(const std::vector<RenderResult>& renders,
+                                            const std::vector<RasterCamera>& cameras, int batch,
+                                            Collective* collective) override {
+    // NDC-space screen gradient of visible Gaussians (3DGS), per view, so a batch's mean loss is
+    // scaled back by the batch size (3DGS's per-view gradient).
+    step_grad_ = collective ? at::zeros_like(grad_accum_) : grad_accum_;
+    step_denom_ = collective ? at::zeros_like(denom_) : denom_;
+    for (std::size_t k = 0; k < renders.size(); ++k) {
+      const RenderResult& r = renders[k];
+      if (!r.means2d.grad().defined()) continue;
+      accumulateScreenGradients(r.means2d.grad(), r.radii, cameras[k].width * 0.5 * batch,
+                                cameras[k].height * 0.5 * batch, step_grad_, step_denom_,
+                                max_radii_);
+    }
+    if (!collective) return {};
+    return {&step_grad_, &step_denom_};  // they travel with the gradients
+  }
+
+  void reduced(Collective& collective) override {
+    collective.max(max_radii_);  // the maxima need their own reduction
+    grad_accum_ += step_grad_;
+    denom_ += step_denom_;
+  }
+
+  void stepPostUpdate(int done, ParameterStore& params,
+                      const std::function<at::Tensor()>& effective_opacity,
+                      const Resize& resize) override {
+    const TrainConfig& c = config_;
+    if (done > c.densify_until) return;
+    if (done > c.densify_from && done % c.densify_interval == 0) {
+      densifyAndPrune(params, effective_opacity, done > c.opacity_reset_interval, done, resize);
+    }
+    if (c.opacity_reset_interval > 0 && done % c.opacity_reset_interval == 0) {
+      Parameter& o = params["opacity"];
+      o.value.clamp_max_(logit(0.01));
+      o.m.zero_();
+      o.v.zero_();
+    }
+  }
+
+  void resized(const RowChange& change) override {
+    grad_accum_ = change.apply(grad_accum_, 0);
+    denom_ = change.apply(denom_, 0);
+    max_radii_ = change.apply(max_radii_, 0);
+  }
+
+  void save(TensorArchive& a) const override {
+    a.tensors["grad_accum"] = grad_accum_;
+    a.tensors["denom"] = denom_;
+    a.tensors["max_radii"] = max_radii_;
+  }
+
+  void load(const TensorArchive& a, const std::string& path, const at::Device& device) override {
+    grad_accum_ = a.tensor("grad_accum", path).to(device);
+    denom_ = a.tensor("denom", path).to(device);
+    max_radii_ = a.tensor("max_radii", path).to(device);
+  }
+
+  void checkRows(std::int64_t rows) const override {
+    for (const auto& [t, name] : {std::make_pair(&grad_accum_, "grad_accum"),
+                                  std::make_pair(&denom_, "denom"),
+                                  std::make_pair(&max_radii_, "max_radii")}) {
+      if (!t->defined() || t->size(0) != rows) {
+        throw Error("<trainer>", name, std::to_string(rows) + " rows",
+                    t->defined() ? std::to_string(t->size(0)) : "undefined");
+      }
+    }
+  }
+
+ private:
+  void densifyAndPrune(ParameterStore& params,
+                       const std::function<at::Tensor()>& effective_opacity, bool prune_big,
+                       int iteration, const Resize& resize) {
+    const TrainConfig& c = config_;
+    const at::Tensor avg = grad_accum_ / denom_.clamp_min(1);
+    const at::Tensor scales = params["scales"].value.detach().exp();
+    const at::Tensor max_scale = std::get<0>(scales.max(1));
+    const at::Tensor big_grad = avg >= c.densify_grad_threshold;
+    const double dense = c.percent_dense * extent_;
+    const bool room = params.rows() < c.max_gaussians;
+    const at::Tensor clone = room ? big_grad & (max_scale <= dense) : at::zeros_like(big_grad);
+    const at::Tensor split = room ? big_grad & (max_scale > dense) : at::zeros_like(big_grad);
+
+    std::map<std::string, at::Tensor> extra;
+    const at::Tensor clone_idx = clone.nonzero().squeeze(1);
+    const at::Tensor split_idx = split.nonzero().squeeze(1);
+    // Split: two samples from each large Gaussian, scales divided by 1.6 (3DGS).
+    at::Tensor split_means;
+    {
+      const at::Tensor s = scales.index_select(0, split_idx).repeat({2, 1});
+      at::Generator gen = seededGenerator(c.seed, 7, static_cast<std::uint64_t>(iteration));
+      const at::Tensor noise =
+          at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(grad_accum_.device()) * s;
+      const at::Tensor q = params["quats"].value.detach().index_select(0, split_idx).repeat({2, 1});
+      const at::Tensor qn = q / q.norm(2, 1, true);
+      const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2),
+                       z = qn.select(1, 3);
+      const at::Tensor R =
+          at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                     2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                     2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+                    1)
+              .view({-1, 3, 3});
+      split_means = at::bmm(R, noise.unsqueeze(2)).squeeze(2) +
+                    params["means"].value.detach().index_select(0, split_idx).repeat({2, 1});
+    }
+    for (const Parameter& q : params.all()) {
+      if (!q.per_gaussian) continue;
+      const at::Tensor src = q.value.detach();
+      const at::Tensor cloned = src.index_select(0, clone_idx);
+      std::vector<int64_t> reps(static_cast<std::size_t>(src.dim()), 1);
+      reps[0] = 2;
+      at::Tensor splitted = src.index_select(0, split_idx).repeat(reps);
+      if (q.name == "means") splitted = split_means;
+      if (q.name == "scales") splitted = splitted - std::log(1.6);
+      extra[q.name] = at::cat({cloned, splitted}, 0);
+    }
+    // Originals of split Gaussians go; so do transparent (and, later, huge) ones. Transparent
+    // means the opacity a Gaussian renders with at evaluation: times its deterministic gate.
+    at::Tensor keep = split.logical_not();
+    at::Tensor remove = effective_opacity() < c.min_opacity;
+    if (prune_big) {
+      remove = remove | (max_radii_ > c.max_screen_radius) | (max_scale > 0.1 * extent_);
+    }
+    keep = keep & remove.logical_not();
+    resize(keep, extra);
+    grad_accum_.zero_();  // the statistics start again with the new rows
+    denom_.zero_();
+    max_radii_.zero_();
+  }
+
+  TrainConfig config_;
+  double extent_;
+  at::Tensor grad_accum_, denom_, max_radii_;
+  at::Tensor step_grad_, step_denom_;  // a step's sums, apart while they are all-reduced
+};
+
+}  // namespace
+
+DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent) {
+  return std::make_shared<DefaultDensification>(config, extent);
+}
+
+}  // namespace gaussians
+}  // namespace sadsplat

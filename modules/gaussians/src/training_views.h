@@ -1,0 +1,58 @@
+#pragma once
+// The scene's views as the trainer uses them: images, masks, semantic supervision and the drop's
+// confidence maps on the device, and the cameras.
+
+#include <ATen/ATen.h>
+
+#include <vector>
+
+#include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/gaussians/train_config.h"
+#include "sadsplat/io/scene.h"
+
+namespace sadsplat {
+namespace gaussians {
+
+// What a view trains besides the picture: the features (it has a semantic loss) and the decoder
+// (the loss also trains it).
+struct ViewRole {
+  bool semantic = false;
+  bool decoder_learns = false;
+};
+
+struct TrainingViews {
+  std::vector<RasterCamera> cameras;        // every view of the scene
+  std::vector<at::Tensor> images;           // [H, W, 3] float in [0, 1] (training views only)
+  std::vector<at::Tensor> masks;            // [H, W] float, 1 = valid pixel
+  std::vector<at::Tensor> labels;           // [H, W] int64, -1 = not supervised (or undefined)
+  std::vector<double> semantic_weight;      // lambda_semantic (ground truth) or lambda_pseudo
+  std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (or undefined)
+  int pseudo_labelled_views = 0;
+  std::vector<int> train_views, labelled_views;
+
+  std::vector<RasterCamera> trainingCameras() const;
+  ViewRole role(int v, const TrainConfig& config) const;
+};
+
+// The views one rank renders in one step, and what the whole group's views train.
+struct StepViews {
+  std::vector<int> views;
+  bool features_anywhere = false;  // some rank's views train the features (groups only)
+  bool decoder_anywhere = false;   // some rank's views train the decoder (groups only)
+};
+
+// Iteration `it`'s views: the next training view of a seeded shuffle, and every
+// semantic_interval iterations the next labelled view. Data-parallel ranks split one global
+// batch of views_per_step x ranks draws: this rank's draws are numbered
+// rank * views_per_step + b, so N ranks draw what one process with N times the views would.
+// `in_group`: also say what the whole group's views train (a group of one included).
+StepViews drawStepViews(const TrainingViews& views, const TrainConfig& config, int it, int rank,
+                        int ranks, bool in_group);
+
+/// Loads the views of `scene` onto `device`.
+/// \throws sadsplat::Error when the scene has no training view
+TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& config,
+                                const at::Device& device);
+
+}  // namespace gaussians
+}  // namespace sadsplat
