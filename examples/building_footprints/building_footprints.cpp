@@ -4,7 +4,7 @@
 //                       [GROUND_CLASS]
 //
 // 1. read the semantic Gaussians (sadsplat::io::readGaussians),
-// 2. keep one class (sadsplat::semantic_drop::ClassExtraction, a pcl::FilterIndices),
+// 2. keep one class (sadsplat::filters::ClassExtraction, a pcl::FilterIndices),
 // 3. remove outliers (pcl::StatisticalOutlierRemoval on the centres),
 // 4. split into objects (pcl::EuclideanClusterExtraction),
 // 5. write OUT_DIR/object_<id>.pcd (the object's Gaussians, every field) and OUT_DIR/objects.csv:
@@ -29,7 +29,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/scene.h"
-#include "sadsplat/semantic_drop/class_extraction.h"
+#include "sadsplat/filters/class_extraction.h"
 #if WITH_OPEN3D
 #include "sadsplat/interop/open3d_conversion.h"
 #endif
@@ -41,7 +41,7 @@ using Gaussians = pcl::PointCloud<sadsplat::GaussianPoint>;
 bool groundPlane(const std::shared_ptr<Gaussians>& all, const std::string& ground_class,
                  const std::vector<sadsplat::ClassInfo>& classes, Eigen::Vector4d* plane) {
 #if WITH_OPEN3D
-  sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> by_class;
+  sadsplat::filters::ClassExtraction<sadsplat::GaussianPoint> by_class;
   by_class.setClassName(ground_class, classes);
   by_class.setInputCloud(all);
   Gaussians ground;
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   try {
     // 1-2: the Gaussians of one class.
     auto all = std::make_shared<Gaussians>(sadsplat::io::readGaussians(model));
-    sadsplat::semantic_drop::ClassExtraction<sadsplat::GaussianPoint> by_class;
+    sadsplat::filters::ClassExtraction<sadsplat::GaussianPoint> by_class;
     const auto classes = sadsplat::io::readClassesJson(classes_json);
     by_class.setClassName(class_name, classes);
     by_class.setInputCloud(all);

@@ -26,7 +26,8 @@ cmake --install "$build" --prefix "$tmp/prefix" >/dev/null
 test -x "$tmp/prefix/bin/sadsplat"
 test -f "$tmp/prefix/lib/cmake/sadsplat/sadsplatConfig.cmake"
 test -f "$tmp/prefix/lib/cmake/sadsplat/sadsplatConfigVersion.cmake"
-test -f "$tmp/prefix/include/sadsplat/semantic_drop/class_extraction.h"
+test -f "$tmp/prefix/include/sadsplat/filters/class_extraction.h"
+test -f "$tmp/prefix/include/sadsplat/semantic_drop/class_extraction.h"  # the forwarding header
 
 "$tmp/prefix/bin/sadsplat" train "$src/data/tiny_scene.cache" --iterations 60 --out "$tmp/run" >/dev/null
 
@@ -34,6 +35,10 @@ run_example() {  # PREFIX NAME
   cmake -S "$src/examples/building_footprints" -B "$tmp/ex_$2" "${generator[@]}" \
     -DCMAKE_PREFIX_PATH="$1" >"$tmp/configure_$2.log" 2>&1 || { cat "$tmp/configure_$2.log"; exit 1; }
   cmake --build "$tmp/ex_$2" >"$tmp/build_$2.log" 2>&1 || { cat "$tmp/build_$2.log"; exit 1; }
+  # The example extracts a class through the torch-free filters layer: no LibTorch is linked.
+  if ldd "$tmp/ex_$2/building_footprints" | grep -i -e torch -e libc10; then
+    echo "building_footprints links LibTorch"; exit 1
+  fi
   "$tmp/ex_$2/building_footprints" "$tmp/run/model.ply" "$tmp/run/classes.json" building \
     "$tmp/objects_$2" 0.5 5
   # At least one object; its PCD holds as many Gaussians as the table says.

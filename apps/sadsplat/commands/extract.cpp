@@ -8,7 +8,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
-#include "sadsplat/semantic_drop/class_extraction.h"
+#include "sadsplat/filters/class_extraction.h"
 
 namespace sadsplat {
 namespace cli {
@@ -20,7 +20,7 @@ template <typename PointT, typename Read, typename Write>
 void extractClass(const std::string& in, const std::string& out, std::uint32_t class_id,
                   bool negative, Read read, Write write) {
   const auto cloud = std::make_shared<pcl::PointCloud<PointT>>(read(in));
-  semantic_drop::ClassExtraction<PointT> filter;
+  filters::ClassExtraction<PointT> filter;
   filter.setClassId(class_id);
   filter.setNegative(negative);
   filter.setInputCloud(cloud);
@@ -78,7 +78,7 @@ class ExtractCommand : public Command {
     }
     const auto list = io::isSceneCache(classes) ? io::readSceneCache(classes).classes
                                                 : io::readClassesJson(classes);
-    semantic_drop::ClassExtraction<GaussianPoint> by_name;
+    filters::ClassExtraction<GaussianPoint> by_name;
     by_name.setClassName(class_, list);
     return by_name.getClassId();
   }

@@ -61,16 +61,9 @@ class FusedCounterGate : public torch::autograd::Function<FusedCounterGate> {
 };
 #endif
 
-double logitOfThreshold(const HardConcreteParams& p) {
-  const double t = -p.l / (p.r - p.l);
-  return std::log(t / (1 - t));
-}
+using filters::logitOfThreshold;
 
 }  // namespace
-
-double probabilityNonZero(double log_alpha, const HardConcreteParams& p) {
-  return 1.0 / (1.0 + std::exp(-(log_alpha - p.beta * logitOfThreshold(p))));
-}
 
 at::Tensor probabilityNonZero(const at::Tensor& log_alpha, const HardConcreteParams& p) {
   return at::sigmoid(log_alpha - p.beta * logitOfThreshold(p));
@@ -108,13 +101,6 @@ at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed,
 
 at::Tensor deterministicGate(const at::Tensor& log_alpha, const HardConcreteParams& p) {
   return (at::sigmoid(log_alpha) * (p.r - p.l) + p.l).clamp(0, 1);
-}
-
-double dropProbability(double p_base, double confidence, double log_alpha, bool use_confidence,
-                       bool use_structure, const HardConcreteParams& p) {
-  const double semantic = use_confidence ? 1.0 - std::clamp(confidence, 0.0, 1.0) : 1.0;
-  const double learned = use_structure ? 1.0 - probabilityNonZero(log_alpha, p) : 1.0;
-  return std::clamp(p_base * semantic * learned, 0.0, 1.0);
 }
 
 }  // namespace semantic_drop

@@ -1,8 +1,8 @@
 #pragma once
 /// \file hard_concrete.h
 /// \brief The Hard Concrete gate of the learnable structure drop (paper, "Learnable Structure
-/// Drop Module"; Louizos et al. 2018), as scalar functions (for PCL filters) and tensor
-/// functions (for training).
+/// Drop Module"; Louizos et al. 2018) as tensor functions for training; the scalar functions
+/// of the PCL filters are in sadsplat/filters/hard_concrete_math.h.
 ///
 /// A gate z in [0, 1] per Gaussian: u ~ U(0, 1), s = sigmoid((log u - log(1 - u) + log_alpha) /
 /// beta), z = clamp(s (r - l) + l, 0, 1), with (l, r) = (-0.1, 1.1). Its probability of being
@@ -15,18 +15,15 @@
 
 #include <cstdint>
 
+#include "sadsplat/filters/hard_concrete_math.h"
+
 namespace sadsplat {
 namespace semantic_drop {
 
-/// \brief Parameters of the gate; defaults from Louizos et al.
-struct HardConcreteParams {
-  double beta = 2.0 / 3.0;  ///< temperature
-  double l = -0.1;          ///< stretch interval lower bound
-  double r = 1.1;           ///< stretch interval upper bound
-};
-
-/// \brief P(z > 0) for one log_alpha.
-double probabilityNonZero(double log_alpha, const HardConcreteParams& p = {});
+// The scalar math lives in the torch-free filters layer.
+using filters::dropProbability;
+using filters::HardConcreteParams;
+using filters::probabilityNonZero;
 /// \brief P(z > 0) for a tensor of log_alphas (differentiable).
 at::Tensor probabilityNonZero(const at::Tensor& log_alpha, const HardConcreteParams& p = {});
 /// \brief A sample of gates for `log_alpha` (differentiable in log_alpha) from `uniform` noise
@@ -44,11 +41,6 @@ at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed,
 bool counterGateIsFused(const at::Tensor& log_alpha);
 /// \brief The deterministic gate used at evaluation: clamp(sigmoid(log_alpha) (r - l) + l, 0, 1).
 at::Tensor deterministicGate(const at::Tensor& log_alpha, const HardConcreteParams& p = {});
-
-/// \brief P_drop = clamp(p_base (1 - confidence) (1 - P_nonzero), 0, 1) (paper, drop rule); a mode
-/// without the semantic term uses confidence = 0, one without the structure term P_learned = 1.
-double dropProbability(double p_base, double confidence, double log_alpha, bool use_confidence,
-                       bool use_structure, const HardConcreteParams& p = {});
 
 }  // namespace semantic_drop
 }  // namespace sadsplat

@@ -3,10 +3,10 @@
 // GaussianPoint and pcl::PointXYZRGBL, included by users who define PCL_NO_PRECOMPILE.
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/semantic_drop/class_extraction.h"
+#include "sadsplat/filters/class_extraction.h"
 
 namespace sadsplat {
-namespace semantic_drop {
+namespace filters {
 
 template <typename PointT>
 void ClassExtraction<PointT>::setClassName(const std::string& name,
@@ -35,5 +35,5 @@ void ClassExtraction<PointT>::applyFilter(pcl::Indices& indices) {
   }
 }
 
-}  // namespace semantic_drop
+}  // namespace filters
 }  // namespace sadsplat

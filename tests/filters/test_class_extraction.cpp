@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/semantic_drop/class_extraction.h"
+#include "sadsplat/filters/class_extraction.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -10,7 +10,7 @@ namespace {
 
 TEST(ClassExtraction, KeepsOneClassAndNegativeGivesTheComplement) {
   auto cloud = std::make_shared<pcl::PointCloud<GaussianPoint>>(test::randomGaussians(200, 41, 3));
-  semantic_drop::ClassExtraction<GaussianPoint> filter(true);
+  filters::ClassExtraction<GaussianPoint> filter(true);
   filter.setInputCloud(cloud);
   filter.setClassId(2);
   pcl::Indices kept, rest;
@@ -41,7 +41,7 @@ TEST(ClassExtraction, RespectsSetIndicesAndWorksOnPlainLabelledClouds) {
     p.label = l;
     cloud->push_back(p);
   }
-  semantic_drop::ClassExtraction<pcl::PointXYZRGBL> filter;
+  filters::ClassExtraction<pcl::PointXYZRGBL> filter;
   filter.setInputCloud(cloud);
   filter.setIndices(std::make_shared<pcl::Indices>(pcl::Indices{0, 1, 2}));
   filter.setClassId(1);
@@ -52,7 +52,7 @@ TEST(ClassExtraction, RespectsSetIndicesAndWorksOnPlainLabelledClouds) {
 
 TEST(ClassExtraction, SelectsByNameOrSaysWhichNamesExist) {
   const std::vector<ClassInfo> classes = {{"road", {0, 0, 0}, ""}, {"tree", {0, 0, 0}, ""}};
-  semantic_drop::ClassExtraction<GaussianPoint> filter;
+  filters::ClassExtraction<GaussianPoint> filter;
   filter.setClassName("tree", classes);
   EXPECT_EQ(filter.getClassId(), 1u);
   try {

@@ -4,10 +4,10 @@
 
 #include <random>
 
-#include "sadsplat/semantic_drop/drop_filters.h"
+#include "sadsplat/filters/drop_filters.h"
 
 namespace sadsplat {
-namespace semantic_drop {
+namespace filters {
 
 template <typename PointT>
 void DropFilter<PointT>::applyFilter(pcl::Indices& indices) {
@@ -27,5 +27,5 @@ void DropFilter<PointT>::applyFilter(pcl::Indices& indices) {
   }
 }
 
-}  // namespace semantic_drop
+}  // namespace filters
 }  // namespace sadsplat
