@@ -22,11 +22,13 @@ cp scripts/gpu/build.sh /tmp/ab-base/scripts/gpu/build.sh
 export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=build-gpu/bin/sadsplat
 kind=${scene%_*}; seed=${scene##*_}
+# The baseline writes the scene cache: a newer tree reads older cache versions, not the reverse.
+maker=/tmp/ab-base/$bin
 cache=/tmp/ab-train/${scene}.cache; mkdir -p /tmp/ab-train
-[ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 \
+[ -f "$cache" ] || "$maker" synth --kind "$kind" --seed "$seed" --width 800 --height 450 \
   --cache "$cache" > "$logs/synth.log" 2>&1
 if [ "${PL:-1}" = 1 ]; then
-  [ -f "${cache%.cache}_pl.cache" ] || "$bin" pseudo-labels "$cache" --out "${cache%.cache}_pl.cache" \
+  [ -f "${cache%.cache}_pl.cache" ] || "$maker" pseudo-labels "$cache" --out "${cache%.cache}_pl.cache" \
     > "$logs/pseudo_labels.log" 2>&1
   cache="${cache%.cache}_pl.cache"
 fi
