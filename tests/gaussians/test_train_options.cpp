@@ -4,7 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fstream>
 #include <set>
+#include <string>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/train_options.h"
@@ -79,6 +81,17 @@ TEST(TrainOptions, CheckNamesTheFirstOptionOutOfRange) {
   c = TrainConfig{};
   c.feature_dim = 33;
   EXPECT_EQ(fieldOf(c), "feature_dim");
+}
+
+// docs/GUIDE.md's table of training options names every key of the table (and no other).
+TEST(TrainOptions, TheGuideListsEveryKey) {
+  std::ifstream in(std::string(SADSPLAT_TEST_DATA_DIR) + "/../docs/GUIDE.md");
+  ASSERT_TRUE(in) << "docs/GUIDE.md";
+  std::set<std::string> listed;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("| `", 0) == 0) listed.insert(line.substr(3, line.find('`', 3) - 3));
+  }
+  for (const TrainOption& o : trainOptions()) EXPECT_EQ(listed.count(o.key), 1u) << o.key;
 }
 
 TEST(TrainOptions, TextValuesAreTypeChecked) {
