@@ -47,7 +47,9 @@ int readInt(const char* name, const char* text, int low, int high) {
 // A port the kernel reports free right now (bind to port 0).
 int freePort() {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) throw Error("<distributed>", "socket", "a TCP socket for the rendezvous port");
+  if (fd < 0)
+    throw Error("<distributed>", "socket", "a TCP socket for the rendezvous port",
+                std::strerror(errno));
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
@@ -56,7 +58,9 @@ int freePort() {
   const bool ok = ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
                   ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len) == 0;
   ::close(fd);
-  if (!ok) throw Error("<distributed>", "rendezvous port", "a free port on 127.0.0.1");
+  if (!ok)
+    throw Error("<distributed>", "rendezvous port", "a free port on 127.0.0.1",
+                std::strerror(errno));
   return ntohs(addr.sin_port);
 }
 

@@ -128,7 +128,8 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
 #endif
   }
   if (result.views.empty()) {
-    throw Error(scene.source, "test views", "at least one test view with a label map");
+    throw Error(scene.source, "test views", "at least one test view with a label map",
+                "none (no test view has a label map)");
   }
   result.psnr = psnr_sum / result.views.size();
   result.ssim = ssim_sum / result.views.size();

@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -23,7 +25,8 @@ namespace {
 std::vector<std::string> subdirectories(const std::string& dir) {
   std::vector<std::string> names;
   DIR* d = ::opendir(dir.c_str());
-  if (d == nullptr) throw Error(dir, "folder", "a readable experiment results folder");
+  if (d == nullptr)
+    throw Error(dir, "folder", "a readable experiment results folder", std::strerror(errno));
   while (const dirent* e = ::readdir(d)) {
     const std::string name = e->d_name;
     if (name != "." && name != ".." && io::isDirectory(dir + "/" + name)) names.push_back(name);
@@ -34,7 +37,9 @@ std::vector<std::string> subdirectories(const std::string& dir) {
 }
 
 double number(const nlohmann::json& j, const char* key, const std::string& file) {
-  if (!j.contains(key) || !j[key].is_number()) throw Error(file, key, "a number");
+  if (!j.contains(key) || !j[key].is_number())
+    throw Error(file, key, "a number",
+                j.contains(key) ? j[key].dump().substr(0, 40) : std::string("missing"));
   return j[key].get<double>();
 }
 
@@ -96,7 +101,8 @@ std::vector<ExperimentRun> readExperimentRuns(const std::string& results_dir) {
   for (const std::string& scene : subdirectories(results_dir)) {
     const std::size_t kind_end = scene.find_last_of('_');
     if (kind_end == std::string::npos || kind_end == 0) {
-      throw Error(results_dir + "/" + scene, "folder name", "<kind>_<scene seed>, e.g. city_0");
+      throw Error(results_dir + "/" + scene, "folder name", "<kind>_<scene seed>, e.g. city_0",
+                  scene);
     }
     for (const std::string& run : subdirectories(results_dir + "/" + scene)) {
       const std::string file = results_dir + "/" + scene + "/" + run + "/metrics.json";
@@ -107,7 +113,7 @@ std::vector<ExperimentRun> readExperimentRuns(const std::string& results_dir) {
           seed_at == std::string::npos ? -1 : std::strtol(run.c_str() + seed_at + 2, &end, 10);
       if (seed < 0 || seed_at == 0 || end == nullptr || *end != '\0') {
         throw Error(results_dir + "/" + scene + "/" + run, "folder name",
-                    "<configuration>_t<training seed>, e.g. full_t0");
+                    "<configuration>_t<training seed>, e.g. full_t0", run);
       }
       nlohmann::json j;
       try {

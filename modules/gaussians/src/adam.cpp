@@ -27,7 +27,8 @@ namespace {
 void expectLike(const at::Tensor& t, const at::Tensor& value, const char* name) {
   if (!t.defined() || !t.sizes().equals(value.sizes()) || t.scalar_type() != value.scalar_type() ||
       t.device() != value.device() || !t.is_contiguous()) {
-    throw Error("<adam>", name, "a contiguous tensor shaped, typed and placed like the value");
+    throw Error("<adam>", name, "a contiguous tensor shaped, typed and placed like the value",
+                "another shape, type, device or layout");
   }
 }
 
@@ -49,7 +50,8 @@ adam::Coefficients<T> coefficients(double lr, std::int64_t step, const AdamSetti
 void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
               std::int64_t step, const AdamSettings& settings) {
   if (!value.defined() || !value.is_contiguous()) {
-    throw Error("<adam>", "value", "a defined, contiguous tensor");
+    throw Error("<adam>", "value", "a defined, contiguous tensor",
+                value.defined() ? "a non-contiguous tensor" : "an undefined tensor");
   }
   if (step < 1) throw Error("<adam>", "step", ">= 1", std::to_string(step));
   expectLike(m, value, "m");

@@ -14,8 +14,7 @@ namespace gaussians {
 #if SADSPLAT_HAVE_CUDA
 namespace densification_stats {
 void accumulateCuda(const at::Tensor& grad, const at::Tensor& radii, float scale_x, float scale_y,
-                    at::Tensor& grad_accum, at::Tensor& denom, at::Tensor& max_radii,
-                    void* stream);
+                    at::Tensor& grad_accum, at::Tensor& denom, at::Tensor& max_radii, void* stream);
 }  // namespace densification_stats
 #endif
 
@@ -26,7 +25,8 @@ void expectStatistic(const at::Tensor& t, const char* name, std::int64_t n,
   if (!t.defined() || t.dim() != 1 || t.size(0) != n || t.scalar_type() != at::kFloat ||
       t.device() != grad.device() || !t.is_contiguous()) {
     throw Error("<densification statistics>", name,
-                "a contiguous float32 [" + std::to_string(n) + "] tensor on the gradient's device");
+                "a contiguous float32 [" + std::to_string(n) + "] tensor on the gradient's device",
+                "another shape, type, device or layout");
   }
 }
 
@@ -41,8 +41,8 @@ void accumulateScreenGradientsReference(const at::Tensor& means2d_grad, const at
   const at::Tensor visible = radii > 0;
   grad_accum += at::where(visible, norm, at::zeros_like(norm));
   denom += visible.to(denom.scalar_type());
-  max_radii.copy_(at::where(visible, at::max(max_radii, radii.to(max_radii.scalar_type())),
-                            max_radii));
+  max_radii.copy_(
+      at::where(visible, at::max(max_radii, radii.to(max_radii.scalar_type())), max_radii));
 }
 
 void accumulateScreenGradients(const at::Tensor& means2d_grad, const at::Tensor& radii,
@@ -52,7 +52,9 @@ void accumulateScreenGradients(const at::Tensor& means2d_grad, const at::Tensor&
   if (means2d_grad.dim() != 2 || means2d_grad.size(1) != 2 || radii.dim() != 1 ||
       radii.size(0) != n || radii.device() != means2d_grad.device()) {
     throw Error("<densification statistics>", "means2d gradient / radii",
-                "[N, 2] and [N] on one device");
+                "[N, 2] and [N] on one device",
+                "means2d " + std::to_string(means2d_grad.dim()) + "-d, radii " +
+                    std::to_string(radii.dim()) + "-d");
   }
   expectStatistic(grad_accum, "grad_accum", n, means2d_grad);
   expectStatistic(denom, "denom", n, means2d_grad);

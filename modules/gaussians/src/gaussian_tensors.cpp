@@ -52,7 +52,8 @@ GaussianTensors GaussianTensors::to(const at::Device& device) const {
 }
 
 void GaussianTensors::validate() const {
-  if (!means.defined()) throw Error("<GaussianTensors>", "means", "a defined [N, 3] tensor");
+  if (!means.defined())
+    throw Error("<GaussianTensors>", "means", "a defined [N, 3] tensor", "an undefined tensor");
   const int64_t n = means.size(0);
   const at::Device d = means.device();
   const auto f = at::kFloat;

@@ -11,8 +11,8 @@
 #include <c10/cuda/CUDAGuard.h>
 #endif
 
-#include "sadsplat/common/cuda_support.h"
 #include "raster_backend.h"
+#include "sadsplat/common/cuda_support.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
@@ -327,7 +327,8 @@ std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at:
 RenderResult render(const GaussianParams& g, const RasterCamera& camera,
                     const RenderSettings& settings) {
   validateCamera(camera);
-  if (!g.means.defined()) throw Error("<render>", "means", "a defined [N, 3] tensor");
+  if (!g.means.defined())
+    throw Error("<render>", "means", "a defined [N, 3] tensor", "an undefined tensor");
   const int64_t n = g.means.size(0);
   if (g.means.scalar_type() != at::kFloat && g.means.scalar_type() != at::kDouble) {
     throw Error("<render>", "means", "float32 or float64", c10::toString(g.means.scalar_type()));

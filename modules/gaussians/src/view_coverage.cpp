@@ -27,7 +27,7 @@ double sceneExtent(const std::vector<RasterCamera>& cameras) {
 
 at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras) {
   if (means.dim() != 2 || means.size(1) != 3) {
-    throw Error("<view coverage>", "means", "an [N, 3] tensor");
+    throw Error("<view coverage>", "means", "an [N, 3] tensor", std::to_string(means.dim()) + "-d");
   }
   const at::Tensor m = means.detach().to(at::kDouble);
   at::Tensor counts = at::zeros({means.size(0)}, means.options().dtype(at::kInt));

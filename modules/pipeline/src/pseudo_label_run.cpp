@@ -95,7 +95,8 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
   const bool input_is_cache = !io::isDirectory(o.scene);
   const std::string out = o.out.empty() ? (input_is_cache ? o.scene : "") : o.out;
   if (out.empty()) {
-    throw Error(o.scene, "--out", "a scene cache file to write (the input is a scene directory)");
+    throw Error(o.scene, "--out", "a scene cache file to write (the input is a scene directory)",
+                "no --out");
   }
   io::Scene scene = loadScene(o.scene, o.scale);
   pseudo_labels::TargetScorer::Ptr scorer;
@@ -103,7 +104,8 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
     scorer = pseudo_labels::makeBuiltinScorer(o.builtin);
   } else if (o.backend == "torchscript") {
     if (o.sam_model.empty() || o.clip_model.empty()) {
-      throw Error("<command line>", "--backend torchscript", "--sam FILE and --clip FILE");
+      throw Error("<command line>", "--backend torchscript", "--sam FILE and --clip FILE",
+                  "--sam and --clip not both given");
     }
     scorer = pseudo_labels::makeTorchScriptScorer(o.sam_model, o.clip_model);
   } else {

@@ -286,10 +286,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   << " left\n";
     }
     if (stats.recovery_started && o.progress) {
-      *o.progress << "\n[recovery] iteration " << it << ": gates folded into the opacities; removed "
-                  << stats.recovery_closed_gates << " Gaussians with a closed gate and "
-                  << stats.recovery_pruned << " least contributing ones, " << stats.num_gaussians
-                  << " left; " << config.recovery_iterations
+      *o.progress << "\n[recovery] iteration " << it
+                  << ": gates folded into the opacities; removed " << stats.recovery_closed_gates
+                  << " Gaussians with a closed gate and " << stats.recovery_pruned
+                  << " least contributing ones, " << stats.num_gaussians << " left; "
+                  << config.recovery_iterations
                   << " iterations without gates, L0 and drops follow\n";
     }
     if (stats.removed_floaters > 0 && o.progress) {
@@ -343,7 +344,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
   const auto run = readRunJson(run_dir);
   if (scene_override.empty() && !(run.contains("scene") && run["scene"].is_string())) {
-    throw Error(run_dir + "/run.json", "scene", "the path of the run's scene (a string)");
+    throw Error(run_dir + "/run.json", "scene", "the path of the run's scene (a string)",
+                run.contains("scene") ? run["scene"].dump().substr(0, 40) : std::string("missing"));
   }
   const std::string scene_path =
       scene_override.empty() ? run["scene"].get<std::string>() : scene_override;

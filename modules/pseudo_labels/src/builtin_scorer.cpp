@@ -68,7 +68,8 @@ class BuiltinScorer : public TargetScorer {
     if (y.empty()) {
       throw Error(scene.source, "labelled views",
                   "at least one labelled training view with label maps (the built-in backend's "
-                  "few-shot examples)");
+                  "few-shot examples)",
+                  "none");
     }
     FewShotClassifier classifier(options_.classifier);
     classifier.fit(x, kRegionFeatureDim, y, group, C);
@@ -131,7 +132,7 @@ class BuiltinScorer : public TargetScorer {
     for (std::size_t i = 0; i < factors.size(); ++i) {
       if (factors[i] < 1 || (i > 0 && factors[i] <= factors[i - 1])) {
         throw Error("<pseudo-labels builtin>", "multiscale factors (--scales)",
-                    "ascending integers >= 1, e.g. 1,2,4");
+                    "ascending integers >= 1, e.g. 1,2,4", std::to_string(factors[i]));
       }
       const SlicOptions o = options_.superpixels;
       const bool scaled = options_.scale_region_size;

@@ -89,7 +89,9 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim,
   if (dim < 1 || num_classes < 2 || labels.empty() || features.size() != labels.size() * dim ||
       groups.size() != labels.size()) {
     throw Error("<few-shot classifier>", "training samples",
-                "n x dim descriptors with n labels and n groups, at least 2 classes");
+                "n x dim descriptors with n labels and n groups, at least 2 classes",
+                std::to_string(labels.size()) + " labels, " + std::to_string(features.size()) +
+                    " values, " + std::to_string(num_classes) + " classes");
   }
   for (int l : labels) {
     if (l < 0 || l >= num_classes) {
@@ -152,9 +154,11 @@ void FewShotClassifier::fit(const std::vector<float>& features, int dim,
 
 std::vector<float> FewShotClassifier::predictProbabilities(
     const std::vector<float>& features) const {
-  if (dim_ == 0) throw Error("<few-shot classifier>", "state", "fit() before predicting");
+  if (dim_ == 0)
+    throw Error("<few-shot classifier>", "state", "fit() before predicting", "predict before fit");
   if (features.size() % dim_ != 0)
-    throw Error("<few-shot classifier>", "features", "n x dim values");
+    throw Error("<few-shot classifier>", "features", "n x dim values",
+                std::to_string(features.size()) + " values for dim " + std::to_string(dim_));
   if (features.empty()) return {};
   const std::vector<float> z = logits(model_, expand(features));
   const std::int64_t n = static_cast<std::int64_t>(features.size() / dim_);

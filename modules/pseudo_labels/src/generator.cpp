@@ -14,7 +14,7 @@ TargetLayer resolveLayers(const std::vector<TargetLayer>& layers, int C,
                           const std::vector<std::vector<double>>& top1,
                           const std::vector<std::vector<std::uint8_t>>& kept,
                           std::vector<std::uint8_t>& refined_kept) {
-  if (layers.empty()) throw Error("<pseudo-labels>", "target layers", "at least one layer");
+  if (layers.empty()) throw Error("<pseudo-labels>", "target layers", "at least one layer", "none");
   const TargetLayer& base = layers[0];
   const std::size_t pixels = base.segmentation.region.size();
   for (std::size_t l = 1; l < layers.size(); ++l) {
@@ -22,7 +22,9 @@ TargetLayer resolveLayers(const std::vector<TargetLayer>& layers, int C,
     if (s.width != base.segmentation.width || s.height != base.segmentation.height ||
         s.region.size() != pixels || layers[l].feature_dim != base.feature_dim) {
       throw Error("<pseudo-labels>", "target layer " + std::to_string(l),
-                  "the size and feature dimension of layer 0");
+                  "the size and feature dimension of layer 0",
+                  std::to_string(s.width) + "x" + std::to_string(s.height) + ", dim " +
+                      std::to_string(layers[l].feature_dim));
     }
   }
 
@@ -181,13 +183,14 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
                 "a share in [0, 1]", std::to_string(options.min_class_precision));
   }
   const int C = static_cast<int>(scene.classes.size());
-  if (C < 2) throw Error(scene.source, "classes", "at least 2 classes for pseudo-labels");
+  if (C < 2)
+    throw Error(scene.source, "classes", "at least 2 classes for pseudo-labels", std::to_string(C));
   std::vector<int> views;
   for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) {
     scene.views[i].pseudo = {};
     if (scene.views[i].train) views.push_back(i);
   }
-  if (views.empty()) throw Error(scene.source, "split", "at least one training view");
+  if (views.empty()) throw Error(scene.source, "split", "at least one training view", "none");
   std::vector<ViewTargets> targets = scorer.score(scene, views, progress);
   if (targets.size() != views.size()) {
     throw Error("<pseudo-labels " + scorer.name() + ">", "scored views",
@@ -198,7 +201,7 @@ PseudoLabelSummary generatePseudoLabels(io::Scene& scene, TargetScorer& scorer,
   std::vector<TargetMeasures> measures;
   for (const ViewTargets& t : targets) {
     if (t.layers.empty()) {
-      throw Error("<pseudo-labels " + scorer.name() + ">", "target layers", "at least one");
+      throw Error("<pseudo-labels " + scorer.name() + ">", "target layers", "at least one", "none");
     }
     for (const TargetLayer& layer : t.layers) {
       for (int r = 0; r < layer.segmentation.num_regions; ++r) {

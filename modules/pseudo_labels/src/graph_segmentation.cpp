@@ -79,13 +79,17 @@ Segmentation graphSegmentation(const io::Image8& rgb, const io::Image8& mask,
                                const GraphSegmentationOptions& o) {
   if (rgb.channels != 3 ||
       rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
-    throw Error("<graph segmentation>", "image", "a 3-channel image");
+    throw Error("<graph segmentation>", "image", "a 3-channel image",
+                std::to_string(rgb.channels) + " channels");
   }
   if (!mask.empty() && (mask.width != rgb.width || mask.height != rgb.height)) {
-    throw Error("<graph segmentation>", "mask", "the image's size");
+    throw Error("<graph segmentation>", "mask", "the image's size",
+                std::to_string(mask.width) + "x" + std::to_string(mask.height));
   }
   if (!(o.k > 0) || o.min_size < 1 || !(o.sigma >= 0)) {
-    throw Error("<graph segmentation>", "options", "k > 0, min_size >= 1, sigma >= 0");
+    throw Error("<graph segmentation>", "options", "k > 0, min_size >= 1, sigma >= 0",
+                "k " + std::to_string(o.k) + ", min_size " + std::to_string(o.min_size) +
+                    ", sigma " + std::to_string(o.sigma));
   }
   const int W = rgb.width, H = rgb.height;
   const std::size_t N = static_cast<std::size_t>(W) * H;

@@ -60,7 +60,8 @@ PseudoLabelQuality evaluatePseudoLabels(const io::Scene& scene) {
   if (q.views == 0) {
     throw Error(
         scene.source, "views",
-        "a training view with pseudo-labels and a label map that does not supervise training");
+        "a training view with pseudo-labels and a label map that does not supervise training",
+        "none");
   }
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
   q.precision = ratio(correct, q.kept_pixels);

@@ -48,13 +48,18 @@ std::vector<float> imageToLab(const io::Image8& rgb) {
 Segmentation slicSuperpixels(const io::Image8& rgb, const io::Image8& mask, const SlicOptions& o) {
   if (rgb.channels != 3 ||
       rgb.pixels.size() != static_cast<std::size_t>(rgb.width) * rgb.height * 3) {
-    throw Error("<superpixels>", "image", "a 3-channel image");
+    throw Error("<superpixels>", "image", "a 3-channel image",
+                std::to_string(rgb.channels) + " channels");
   }
   if (!mask.empty() && (mask.width != rgb.width || mask.height != rgb.height)) {
-    throw Error("<superpixels>", "mask", "the image's size");
+    throw Error("<superpixels>", "mask", "the image's size",
+                std::to_string(mask.width) + "x" + std::to_string(mask.height));
   }
   if (o.region_size < 2 || o.iterations < 1 || !(o.compactness > 0)) {
-    throw Error("<superpixels>", "options", "region_size >= 2, iterations >= 1, compactness > 0");
+    throw Error("<superpixels>", "options", "region_size >= 2, iterations >= 1, compactness > 0",
+                "region_size " + std::to_string(o.region_size) + ", iterations " +
+                    std::to_string(o.iterations) + ", compactness " +
+                    std::to_string(o.compactness));
   }
   const int W = rgb.width, H = rgb.height, S = o.region_size;
   const std::size_t N = static_cast<std::size_t>(W) * H;

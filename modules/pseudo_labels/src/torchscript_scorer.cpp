@@ -45,7 +45,8 @@ class TorchScriptScorer : public TargetScorer {
     if (o.device != "cpu" && o.device != "cuda")
       throw Error("<torchscript backend>", "device", "cpu or cuda", o.device);
     if (o.points_per_side < 1 || o.points_per_batch < 1) {
-      throw Error("<torchscript backend>", "points_per_side / points_per_batch", "at least 1");
+      throw Error("<torchscript backend>", "points_per_side / points_per_batch", "at least 1",
+                  std::to_string(o.points_per_side) + " / " + std::to_string(o.points_per_batch));
     }
     device_ = o.device == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU);
     sam_ = loadModule(sam_path, "SAM");
@@ -96,7 +97,8 @@ class TorchScriptScorer : public TargetScorer {
     at::Tensor t = clip_.attr("text_embeddings").toTensor().to(device_, at::kFloat);
     if (t.dim() != 2 || t.size(0) != static_cast<std::int64_t>(scene.classes.size())) {
       throw Error(clip_path_, "text_embeddings",
-                  "[C, E] with C = " + std::to_string(scene.classes.size()));
+                  "[C, E] with C = " + std::to_string(scene.classes.size()),
+                  std::to_string(t.dim()) + "-d with " + std::to_string(t.size(0)) + " rows");
     }
     return t / t.norm(2, 1, true).clamp_min(1e-12);
   }
@@ -137,7 +139,8 @@ class TorchScriptScorer : public TargetScorer {
       const auto result = sam_.get_method("decode")({embedding, pts, H, W});
       if (!result.isTuple() || result.toTupleRef().elements().size() != 2) {
         throw Error(sam_path_, "decode output",
-                    "a tuple (mask logits [B, K, H, W], predicted IoU [B, K])");
+                    "a tuple (mask logits [B, K, H, W], predicted IoU [B, K])",
+                    result.isTuple() ? "a tuple of another size" : "not a tuple");
       }
       const at::Tensor logits = result.toTupleRef().elements()[0].toTensor().to(at::kFloat);
       const at::Tensor iou = result.toTupleRef().elements()[1].toTensor().to(at::kFloat).cpu();
@@ -145,7 +148,9 @@ class TorchScriptScorer : public TargetScorer {
           iou.dim() != 2 || iou.size(0) != b || iou.size(1) != logits.size(1)) {
         throw Error(sam_path_, "decode output shapes",
                     "[B, K, H, W] logits and [B, K] IoU with B = " + std::to_string(b) +
-                        ", H x W = " + std::to_string(H) + " x " + std::to_string(W));
+                        ", H x W = " + std::to_string(H) + " x " + std::to_string(W),
+                    "logits " + std::to_string(logits.dim()) + "-d, IoU " +
+                        std::to_string(iou.dim()) + "-d");
       }
       const double off = options_.stability_offset;
       const at::Tensor hi = (logits > off).flatten(2).sum(2).to(at::kFloat);
@@ -233,7 +238,9 @@ class TorchScriptScorer : public TargetScorer {
       const at::Tensor e = clip_.get_method("encode_image")({batch}).toTensor().to(at::kFloat);
       if (e.dim() != 2 || e.size(0) != batch.size(0) || e.size(1) != text.size(1)) {
         throw Error(clip_path_, "encode_image output",
-                    "[B, E] with E = " + std::to_string(text.size(1)));
+                    "[B, E] with E = " + std::to_string(text.size(1)),
+                    "[" + std::to_string(e.size(0)) + ", " +
+                        std::to_string(e.dim() > 1 ? e.size(1) : 0) + "]");
       }
       embeddings.push_back(e);
     }

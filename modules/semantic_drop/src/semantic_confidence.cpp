@@ -10,7 +10,9 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
                               const std::vector<gaussians::RasterCamera>& cameras,
                               const std::vector<at::Tensor>& confidence_maps, at::Tensor* seen) {
   if (cameras.size() != confidence_maps.size()) {
-    throw Error("<semantic confidence>", "confidence maps", "one per camera");
+    throw Error("<semantic confidence>", "confidence maps", "one per camera",
+                std::to_string(confidence_maps.size()) + " for " + std::to_string(cameras.size()) +
+                    " cameras");
   }
   const auto opts = means.options();
   at::Tensor sum = at::zeros({means.size(0)}, opts), count = at::zeros({means.size(0)}, opts);
@@ -21,7 +23,9 @@ at::Tensor semanticConfidence(const at::Tensor& means, const at::Tensor& opaciti
         map.size(1) != cam.width) {
       throw Error("<semantic confidence>", "confidence map " + std::to_string(v),
                   "[H, W, C] or [H, W] with the camera's " + std::to_string(cam.width) + "x" +
-                      std::to_string(cam.height));
+                      std::to_string(cam.height),
+                  std::to_string(map.dim()) + "-d " + std::to_string(map.size(0)) + "x" +
+                      std::to_string(map.size(1)));
     }
     const double q[4] = {cam.qvec[0], cam.qvec[1], cam.qvec[2], cam.qvec[3]};
     double R[9];

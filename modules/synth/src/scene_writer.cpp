@@ -16,7 +16,8 @@ namespace {
 
 void writePng(const std::string& path, const cv::Mat& image) {
   std::vector<std::uint8_t> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw Error(path, "PNG encoding", "success");
+  if (!cv::imencode(".png", image, bytes))
+    throw Error(path, "PNG encoding", "success", "a failure of OpenCV's encoder");
   io::writeFileAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(bytes.data()),
               static_cast<std::streamsize>(bytes.size()));

@@ -52,7 +52,8 @@ void writeLineChart(const std::string& path, const ChartFrame& frame,
   bool any = false;
   for (const auto& s : series) {
     if (s.x.size() != s.y.size()) {
-      throw Error(path, "series " + s.name, "as many x as y values");
+      throw Error(path, "series " + s.name, "as many x as y values",
+                  std::to_string(s.x.size()) + " x and " + std::to_string(s.y.size()) + " y");
     }
     any = any || !s.x.empty();
   }

@@ -456,7 +456,8 @@ std::string keyHelp() {
 void showModels(const std::vector<ViewModel>& models, const SplatViewOptions& options,
                 std::ostream* log) {
   if (models.empty() || models.size() > 2) {
-    throw Error("<command line>", "models", "one model, or two with --compare");
+    throw Error("<command line>", "models", "one model, or two with --compare",
+                std::to_string(models.size()) + " models");
   }
   if (options.width < 16 || options.height < 16 || options.width > 8192 || options.height > 8192) {
     throw Error("<command line>", "--size", "WIDTHxHEIGHT between 16 and 8192",

@@ -17,8 +17,8 @@ class Error : public std::runtime_error {
   /// \param[in] file the file (or directory, or "<config>") the problem is in
   /// \param[in] field the field, element, property or line within the file
   /// \param[in] expected what a correct input has there
-  /// \param[in] got what was found instead (may be empty)
-  Error(std::string file, std::string field, std::string expected, std::string got = "");
+  /// \param[in] got what was found instead (required: a message says what it found)
+  Error(std::string file, std::string field, std::string expected, std::string got);
 
   /// \brief The file the problem is in.
   const std::string& file() const { return file_; }
