@@ -83,14 +83,9 @@ class DefaultDensification : public DensificationStrategy {
   }
 
   void checkRows(std::int64_t rows) const override {
-    for (const auto& [t, name] : {std::make_pair(&grad_accum_, "grad_accum"),
-                                  std::make_pair(&denom_, "denom"),
-                                  std::make_pair(&max_radii_, "max_radii")}) {
-      if (!t->defined() || t->size(0) != rows) {
-        throw Error("<trainer>", name, std::to_string(rows) + " rows",
-                    t->defined() ? std::to_string(t->size(0)) : "undefined");
-      }
-    }
+    requireRows(grad_accum_, "grad_accum", rows);
+    requireRows(denom_, "denom", rows);
+    requireRows(max_radii_, "max_radii", rows);
   }
 
  private:

@@ -144,13 +144,8 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
 }
 
 void DropState::checkRows(std::int64_t rows) const {
-  for (const auto& [t, name] : {std::make_pair(&confidence_, "confidence"),
-                                std::make_pair(&l0_weights_, "l0_weights")}) {
-    if (!t->defined() || t->size(0) != rows) {
-      throw Error("<trainer>", name, std::to_string(rows) + " rows",
-                  t->defined() ? std::to_string(t->size(0)) : "undefined");
-    }
-  }
+  requireRows(confidence_, "confidence", rows);
+  requireRows(l0_weights_, "l0_weights", rows);
 }
 
 }  // namespace gaussians

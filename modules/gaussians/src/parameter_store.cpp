@@ -140,19 +140,19 @@ void ParameterStore::load(const TensorArchive& a, const std::string& path,
   adam_step_ = static_cast<std::int64_t>(a.number("adam_step", path));
 }
 
+void requireRows(const at::Tensor& t, const std::string& name, std::int64_t rows) {
+  if (!t.defined() || t.size(0) != rows) {
+    throw Error("<trainer>", name, std::to_string(rows) + " rows",
+                t.defined() ? std::to_string(t.size(0)) : "undefined");
+  }
+}
+
 void ParameterStore::checkRows() const {
-  const std::int64_t n = rows();
-  auto expect = [&](const at::Tensor& t, const std::string& name) {
-    if (!t.defined() || t.size(0) != n) {
-      throw Error("<trainer>", name, std::to_string(n) + " rows",
-                  t.defined() ? std::to_string(t.size(0)) : "undefined");
-    }
-  };
   for (const Parameter& q : params_) {
     if (!q.per_gaussian) continue;
-    expect(q.value, q.name);
-    expect(q.m, q.name + " Adam m");
-    expect(q.v, q.name + " Adam v");
+    requireRows(q.value, q.name, rows());
+    requireRows(q.m, q.name + " Adam m", rows());
+    requireRows(q.v, q.name + " Adam v", rows());
   }
 }
 

@@ -27,6 +27,10 @@ struct RowChange {
   at::Tensor apply(const at::Tensor& t, double fill) const;
 };
 
+/// \brief Throws naming `name` unless `t` is defined with `rows` rows: the consistency check of
+/// every per-row state that follows the parameters.
+void requireRows(const at::Tensor& t, const std::string& name, std::int64_t rows);
+
 /// \brief One optimised tensor with its Adam moments.
 struct Parameter {
   std::string name;
