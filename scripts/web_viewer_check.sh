@@ -69,8 +69,11 @@ for spec in "gs3d model.ply" "gs3d model.splat" "gs3d model_v2.spz" \
             "spark model.ply" "spark model.splat" "spark model.spz"; do
   set -- $spec
   png="$out/${1}_${2/./_}.png"
+  # .spz holds RUB axes (the spec), the PLY RDF: the viewers load both as they are, so the .spz
+  # is turned 180 degrees about x (viewer.html's flip) to be compared under the same camera.
+  flip=0; [ "${2##*.}" = spz ] && flip=1
   state=$(cd "$web" && node --experimental-websocket cdp_screenshot.mjs "$debug" \
-    "http://127.0.0.1:$port/viewer.html?viewer=$1&file=$2&c=$centre&e=$eye" "$png" 120 2>/dev/null)
+    "http://127.0.0.1:$port/viewer.html?viewer=$1&file=$2&c=$centre&e=$eye&flip=$flip" "$png" 120 2>/dev/null)
   stats=$(cd "$web" && node png_stats.mjs "$png" "$out/${1}_model_ply.png")
   echo "$1 $2 $state $stats" | tee -a "$out/summary.txt"
   share=${stats%% *}
