@@ -25,15 +25,20 @@ def ascii_ply(values, extra=''):
     return head + extra + 'end_header\n' + values + '\n'
 
 
+def zip_entry(z, name, text):
+    z.writestr(zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0)), text)  # deterministic
+
+
 def legacy_spz(count, payload, version=3, degree=3):
     return gzip.compress(struct.pack('<IIIBBBB', 0x5053474e, version, count, degree, 12, 0, 0)
-                         + payload, 9)
+                         + payload, 9, mtime=0)  # deterministic bytes
 
 
 # SPZ: a small gzip whose header claims 40 Gaussians and inflates to 16 MB (a bomb); version 1;
 # a version-4 header claiming 2^27 Gaussians in 64 bytes; a version-4 table past the end.
 write('splat_formats', 'gzip_bomb.spz', legacy_spz(40, bytes(16 << 20)))
 write('splat_formats', 'version1.spz', legacy_spz(40, bytes(40 * 20), version=1))
+write('splat_formats', 'bad_degree.spz', legacy_spz(40, bytes(4096), degree=9))
 v4 = struct.pack('<IIIBBBBI', 0x5053474e, 4, 1 << 27, 0, 12, 0, 5, 32) + bytes(12)
 write('splat_formats', 'v4_huge_count.spz', v4 + bytes(32))
 v4 = struct.pack('<IIIBBBBI', 0x5053474e, 4, 2, 0, 12, 0, 5, 32) + bytes(12)
@@ -42,15 +47,15 @@ write('splat_formats', 'empty.splat', b'')
 # SOG: a ZIP without meta.json; one whose meta.json is version 1; one with absurd image sizes.
 buf = io.BytesIO()
 with zipfile.ZipFile(buf, 'w') as z:
-    z.writestr('other.txt', 'x')
+    zip_entry(z, 'other.txt', 'x')
 write('splat_formats', 'sog_no_meta.sog', buf.getvalue())
 buf = io.BytesIO()
 with zipfile.ZipFile(buf, 'w') as z:
-    z.writestr('meta.json', '{"means": {"shape": [1, 3]}}')
+    zip_entry(z, 'meta.json', '{"means": {"shape": [1, 3]}}')
 write('splat_formats', 'sog_version1.sog', buf.getvalue())
 buf = io.BytesIO()
 with zipfile.ZipFile(buf, 'w', zipfile.ZIP_DEFLATED) as z:
-    z.writestr('meta.json', '{"version": 2, "count": 1e30}')
+    zip_entry(z, 'meta.json', '{"version": 2, "count": 1e30}')
 write('splat_formats', 'sog_huge_count.sog', buf.getvalue())
 
 # 3DGS PLY: values beyond float range or plausibility, an infinite opacity (clamped, a correct

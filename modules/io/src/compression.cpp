@@ -32,7 +32,13 @@ void inflateBounded(const std::string& path, const std::string& field, z_stream&
       throw Error(path, field, "a valid compressed stream", "corrupt or truncated data");
     }
     const std::size_t produced = sizeof(buffer) - s.avail_out;
-    const std::size_t limit = limit_of(out);
+    std::size_t limit = 0;
+    try {
+      limit = limit_of(out);  // may throw on a bad header: free zlib's state first
+    } catch (...) {
+      inflateEnd(&s);
+      throw;
+    }
     if (out.size() + produced > limit) {
       inflateEnd(&s);
       throw Error(path, field,
