@@ -26,7 +26,9 @@ def ascii_ply(values, extra=''):
 
 
 def zip_entry(z, name, text):
-    z.writestr(zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0)), text)  # deterministic
+    info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))  # deterministic bytes
+    info.compress_type = z.compression
+    z.writestr(info, text)
 
 
 def legacy_spz(count, payload, version=3, degree=3):
