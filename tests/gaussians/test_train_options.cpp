@@ -19,7 +19,9 @@ TEST(TrainOptions, KeysAndFlagsAreUniqueAndTheJsonHasExactlyTheTablesKeys) {
   std::set<std::string> keys, flags;
   for (const TrainOption& o : trainOptions()) {
     EXPECT_TRUE(keys.insert(o.key).second) << o.key;
-    if (o.flag != nullptr) EXPECT_TRUE(flags.insert(o.flag).second) << o.flag;
+    if (o.flag != nullptr) {
+      EXPECT_TRUE(flags.insert(o.flag).second) << o.flag;
+    }
     EXPECT_GT(std::string(o.help).size(), 5u) << o.key;
   }
   const nlohmann::json j = nlohmann::json::parse(TrainConfig{}.toJson());

@@ -55,10 +55,7 @@ class TrainCommand : public Command {
       CLI::Option* flag = c->add_option(o.flag, values_[&o], help);
       // A value outside the table's range or choices is a usage error (exit 2) here already.
       if (o.choices != nullptr) {
-        std::vector<std::string> choices;
-        std::stringstream list(o.choices);
-        for (std::string choice; std::getline(list, choice, '|');) choices.push_back(choice);
-        flag->check(CLI::IsMember(choices));
+        flag->check(CLI::IsMember(gaussians::optionChoices(o)));
       } else if (!std::holds_alternative<std::string gaussians::TrainConfig::*>(o.member)) {
         const bool real = std::holds_alternative<double gaussians::TrainConfig::*>(o.member);
         flag->type_name(real ? "FLOAT" : "INT");

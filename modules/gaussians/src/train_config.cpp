@@ -199,20 +199,6 @@ std::string numberText(double v) {
   return out.str();
 }
 
-bool isChoice(const char* choices, const std::string& value) {
-  std::stringstream list(choices);
-  for (std::string c; std::getline(list, c, '|');) {
-    if (c == value) return true;
-  }
-  return false;
-}
-
-std::string choiceText(const char* choices) {
-  std::string text = choices;
-  std::replace(text.begin(), text.end(), '|', ',');
-  return text;
-}
-
 // Sets the option from a JSON value, with the reader's type and integer checks.
 void setFromJson(const TrainOption& o, const nlohmann::json& value, TrainConfig& c,
                  const std::string& origin) {
@@ -260,6 +246,14 @@ nlohmann::json toJsonValue(const TrainOption& o, const TrainConfig& c) {
 
 const std::vector<TrainOption>& trainOptions() { return kOptions; }
 
+std::vector<std::string> optionChoices(const TrainOption& option) {
+  std::vector<std::string> choices;
+  if (option.choices == nullptr) return choices;
+  std::stringstream list(option.choices);
+  for (std::string c; std::getline(list, c, '|');) choices.push_back(c);
+  return choices;
+}
+
 std::string optionText(const TrainOption& option, const TrainConfig& config) {
   const nlohmann::json v = toJsonValue(option, config);
   return v.is_string() ? v.get<std::string>() : v.dump();
@@ -297,8 +291,12 @@ void TrainConfig::check(const std::string& origin) const {
                                          : numberText(o.min) + " .. " + numberText(o.max);
       throw Error(origin, o.key, range, v.dump());
     }
-    if (v.is_string() && o.choices != nullptr && !isChoice(o.choices, v.get<std::string>())) {
-      throw Error(origin, o.key, choiceText(o.choices), v.get<std::string>());
+    const std::vector<std::string> choices = optionChoices(o);
+    if (v.is_string() && !choices.empty() &&
+        std::find(choices.begin(), choices.end(), v.get<std::string>()) == choices.end()) {
+      std::string expected;
+      for (const std::string& c : choices) expected += (expected.empty() ? "" : ",") + c;
+      throw Error(origin, o.key, expected, v.get<std::string>());
     }
   }
   if (recovery_iterations >= iterations) {

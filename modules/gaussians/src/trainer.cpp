@@ -165,7 +165,7 @@ StepStats Trainer::step(bool read_losses) {
     enterPhase(profile, "L0 weights");
     s.drop.refreshL0Weights(s.params, s.views, s.iteration);
   }
-  if (gated) g.opacity_gate = s.drop.trainingGate(s.params, it);
+  g.opacity_gate = s.drop.trainingGate(s.params, it);  // undefined when not gated
   at::Tensor total;
   // Loss values stay on the device until the end of the step: one host synchronisation per step.
   at::Tensor rgb_sum, sem_sum;

@@ -34,6 +34,9 @@ struct TrainOption {
 /// \brief Every training option, in documentation order.
 const std::vector<TrainOption>& trainOptions();
 
+/// \brief The accepted values of a string option (empty: any).
+std::vector<std::string> optionChoices(const TrainOption& option);
+
 /// \brief The option's value in `config` as text ("0.2", "true", "cpu", "[0, 0, 0]").
 std::string optionText(const TrainOption& option, const TrainConfig& config);
 
