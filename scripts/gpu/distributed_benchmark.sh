@@ -15,24 +15,20 @@
 # $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
 # and the metrics.
 set -euo pipefail
+source "$(dirname "$0")/lib.sh"   # NVLink multicast off (inherited by the ranks), build, scene caches
 iterations="${1:-7000}"
 gpus="${2:-2}"
-out="${OUT:-/tmp/sadsplat-gpu-out}"
-mkdir -p "$out"
-# NVLink multicast stays off, also in the ranks the launcher starts (they inherit this).
-export NCCL_NVLS_ENABLE=0 TORCH_SYMM_MEM_DISABLE_MULTICAST=1 NVSHMEM_DISABLE_NVLS=1
-[ -x build-gpu/bin/sadsplat ] || bash scripts/gpu/build.sh > "$out/build.log" 2>&1 || { tail -30 "$out/build.log"; exit 1; }
-export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
-bin=$PWD/build-gpu/bin/sadsplat
+out="$OUT"
+[ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
+export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
+bin=$SADSPLAT_BIN
 work=/tmp/sadsplat-distributed
 mkdir -p "$work"
 summary="$out/summary.txt"
 echo "== $(date -u +%F) iterations $iterations, $gpus GPUs: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" | tee -a "$summary"
 
-xl="$work/city_xl_800x450.cache"
-city="$work/city_0_800x450.cache"
-[ -f "$xl" ] || "$bin" synth --kind city --preset city-xl --width 800 --height 450 --cache "$xl" > "$out/synth_xl.log" 2>&1
-[ -f "$city" ] || "$bin" synth --kind city --seed 0 --width 800 --height 450 --cache "$city" > "$out/synth_city.log" 2>&1
+xl=$(scene_cache city-xl)
+city=$(scene_cache city_0)
 
 # Peak memory.used per GPU while a command runs (nvidia-smi, every 200 ms).
 peak_memory() {

@@ -1,52 +1,101 @@
 #!/usr/bin/env bash
-# Run ON THE GPU MACHINE: the drop and pseudo-label experiments of one benchmark scene, several
-# trainings at once on the one GPU (timings from such runs are not clean single-run times).
-#   bash scripts/gpu/experiments.sh KIND SEED [JOBS=2] [DEADLINE_S=540] [RUN ...]
-# Builds build-gpu/ if missing, generates the scene at 800x450 as a cache, runs
-# `sadsplat pseudo-labels` on it (report kept), then trains + evaluates each RUN (default: all
-# below, most important first) with 7000 iterations. No run starts after DEADLINE_S seconds and
-# every run is stopped at it, so a run on the GPU machine returns in time with what finished.
-# Runs:  none_nopl  none_pl  full_p1_nopl  full_p{0,0.5,1,1.5,2}_pl  semantic_p1_pl  structure_p1_pl
-#        (suffix _pl: trained on the cache with pseudo-labels; _nopl: without); an infix _lambdaX
-#        (e.g. full_p1_lambda0.4_pl) sets lambda_l0 = X, _lpX lambda_pseudo = X, and _decgt
-#        pseudo_labels_train_decoder = false (e.g. none_decgt_pl), _recN recovery_iterations = N
-#        and _cutX recovery_prune = X (e.g. full_p1_lambda0.2_rec1000_cut0.3_pl), _refssim
-#        fused_ssim = false, _gthX densify_grad_threshold = X (fewer Gaussians without a drop),
-#        _radX max_screen_radius = X (e.g. none_rad100000_nopl: no screen-size pruning, as gsplat's
-#        default strategy).
-# $OUT gets results_KIND_SEED.tar.gz (metrics, configs, logs, pseudo-label report) and
-# summary_KIND_SEED.txt. Env PL_ARGS: extra `sadsplat pseudo-labels` arguments, with PL_TAG (a
-# name suffix for the work dir and the outputs, so that two label variants can run side by side).
+# ON THE GPU MACHINE from the repository root: the experiment tables, one named table per mode.
+# Builds build-gpu/ if missing (scripts/gpu/lib.sh); scenes are synth caches at 800x450 made once.
+#
+#   bash scripts/gpu/experiments.sh one KIND_SEED [ITERATIONS=7000] [train args...]
+#       one training + eval (TAG=name tells apart runs of one scene with different args)
+#   bash scripts/gpu/experiments.sh profile [ITERATIONS=7000] [KIND_SEED ...]
+#       where the training time goes: RUNS (full_plain full_profile none_profile) one at a time;
+#       PL=1 trains the full runs on the scene with pseudo-labels; CONFIG=json goes to every run
+#   bash scripts/gpu/experiments.sh runs KIND_SEED [JOBS=2] [DEADLINE_S=540] [RUN ...]
+#       the drop / pseudo-label runs of one scene, JOBS at once (timings are then not clean)
+#   bash scripts/gpu/experiments.sh table TABLE [JOBS=4] [DEADLINE_S=540]
+#       the trainings of a benchmark table, resuming across calls (below)
+#
+# RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
+#   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set
+#   training keys: _lambdaX lambda_l0, _lpX lambda_pseudo, _decgt pseudo_labels_train_decoder false,
+#   _recN recovery_iterations, _cutX recovery_prune, _refssim fused_ssim false, _gthX
+#   densify_grad_threshold, _radX max_screen_radius (e.g. none_rad100000_nopl: no screen-size
+#   pruning, as gsplat's default strategy). PL_ARGS: extra `sadsplat pseudo-labels` arguments.
+#
+# TABLE (table): a run counts as done when the repository holds
+# docs/experiments/TABLE/<kind>_<seed>/<config>_t<training seed>/metrics.json; $OUT gets
+# table_TABLE.tgz (the new metrics.json files in that layout, train logs) and table_TABLE.txt:
+#   tar xzf table_TABLE.tgz -C docs/experiments/TABLE && sadsplat table docs/experiments/TABLE \
+#     --out docs/experiments/TABLE/README.md
+#   ablation   9 scenes (city/country/port x seeds 0-2) x none (Net-1), drop (Net-2), pl (Net-3),
+#              full (Net-4) x training seeds 0-2
+#   pbase      3 seed-0 scenes x full with P_base 0 / 0.5 / 1 / 1.5 / 2 x training seeds 0-2
+#   l0schedule 3 seed-0 scenes x full with the L0 weight off until N (_fromN), rising over M
+#              (_rampM), weight X (_lambdaX)
+#   growth     3 seed-0 scenes x Net-1 grown to fewer Gaussians (none_gradX: densify threshold X)
+#   A configuration full_<parts> takes any of pX (P_base), lambdaX, fromN, rampM, impG
+#   (--l0-importance G). Env SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run
+#   starts with less left; SADSPLAT_BIN, DEVICE (cuda), WIDTH x HEIGHT (800 x 450), ITERATIONS
+#   (7000) change the setup (e.g. a quick CPU check).
 set -uo pipefail
-# 2 at once by default. A training used ~30 GB in an earlier version (5 or 3 at once ran out of
-# memory on an 80 GB H100); the current code peaks near 2 GB per process
-# (docs/measurements/h100_screen_radius/), so JOBS=6 fits; the GPU's time is shared either way.
-export PYTORCH_CUDA_ALLOC_CONF=expandable_segments:True
-kind="$1"; seed="$2"; jobs="${3:-2}"; deadline="${4:-540}"; shift $(( $# < 4 ? $# : 4 ))
-runs=("$@")
-[ ${#runs[@]} -gt 0 ] || runs=(none_nopl full_p1_pl none_pl full_p1_nopl structure_p1_pl semantic_p1_pl
-                                full_p0_pl full_p2_pl full_p0.5_pl full_p1.5_pl)
-start=$(date +%s)
-out="${OUT:-/tmp/sadsplat-gpu-out}"
-mkdir -p "$out"
-[ -x build-gpu/bin/sadsplat ] || bash scripts/gpu/build.sh > /tmp/sadsplat-build.log 2>&1 || { tail -30 /tmp/sadsplat-build.log; exit 1; }
-export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
-bin=build-gpu/bin/sadsplat
-tag="${kind}_${seed}${PL_TAG:-}"
-work=/tmp/sadsplat-exp/$tag
-res=$work/results
-mkdir -p "$res"
-cache="$work/scene.cache"
-[ -f "$cache" ] || "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" > "$res/synth.log" 2>&1
-[ -f "$work/scene_pl.cache" ] || /usr/bin/time -v "$bin" pseudo-labels "$cache" --out "$work/scene_pl.cache" \
-  --report "$res/pseudo_report" ${PL_ARGS:-} > "$res/pseudo_labels.log" 2>&1
-echo "prepared in $(( $(date +%s) - start )) s"
+source "$(dirname "$0")/lib.sh"
+mode="${1:?usage: experiments.sh one|profile|runs|table ...}"; shift
+[ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
+export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
+bin=$SADSPLAT_BIN
 
-train_one() {
-  local name="$1" left="$2"
-  local args=() scene="$cache"
-  case "$name" in *_pl) scene="$work/scene_pl.cache" ;; esac
-  local keys=()
+metrics_line() {  # NAME METRICS_JSON
+  python3 - "$@" <<'PY'
+import json, sys
+name, path = sys.argv[1:3]
+try:
+    m = json.load(open(path))
+except Exception as e:
+    print(name, "unreadable", e); sys.exit()
+miou = "%6.2f" % (100 * m["miou"]) if m.get("miou") is not None else "  none"
+print("%-24s mIoU %s  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.1f s" % (
+    name, miou, m["psnr"], m["ssim"], m["num_gaussians"], m["train_seconds"]))
+PY
+}
+
+mode_one() {
+  local scene="$1" iterations="${2:-7000}"; shift $(( $# < 2 ? $# : 2 ))
+  local cache; cache=$(scene_cache "$scene") || return 1
+  local name="${scene}${TAG:+_$TAG}" run="/tmp/sadsplat-one/run_${scene}${TAG:+_$TAG}"
+  rm -rf "$run"; mkdir -p /tmp/sadsplat-one
+  "$bin" train "$cache" --device cuda --iterations "$iterations" --out "$run" "$@" > "$OUT/train_$name.log" 2>&1 ||
+    { tail -5 "$OUT/train_$name.log"; return 1; }
+  echo "drop events: $(tr '\r' '\n' < "$OUT/train_$name.log" | grep -c '^\[drop\]')"
+  "$bin" eval "$run" > "$OUT/metrics_$name.json" && cp "$run/config.json" "$OUT/config_$name.json"
+  metrics_line "$name" "$OUT/metrics_$name.json"
+}
+
+mode_profile() {
+  local iterations="${1:-7000}"; shift $(( $# < 1 ? $# : 1 ))
+  local scenes=("$@"); [ ${#scenes[@]} -gt 0 ] || scenes=(city_0)
+  local summary="$OUT/summary.txt" scene run
+  for scene in "${scenes[@]}"; do
+    local cache pl=""; cache=$(scene_cache "$scene") || return 1
+    [ "${PL:-0}" = 1 ] && { pl=$(pl_cache "$cache") || return 1; }
+    for run in ${RUNS:-full_plain full_profile none_profile}; do
+      local drop=${run%_*} flags=()
+      [ "${run#*_}" = profile ] && flags=(--profile)
+      [ -n "${CONFIG:-}" ] && flags+=(--config "$CONFIG")
+      local scene_file="$cache"; [ -n "$pl" ] && [ "$drop" = full ] && scene_file="$pl"
+      local dir="/tmp/sadsplat-profile/${scene}_$run"; rm -rf "$dir"; mkdir -p /tmp/sadsplat-profile
+      local start; start=$(date +%s%N)
+      "$bin" train "$scene_file" --device cuda --iterations "$iterations" --drop "$drop" --out "$dir" \
+        "${flags[@]}" > "$OUT/train_${scene}_$run.log" 2>&1
+      echo "$scene $run: wall $(( ($(date +%s%N) - start) / 1000000 )) ms (process), $(train_summary "$OUT/train_${scene}_$run.log")" | tee -a "$summary"
+      [ -f "$dir/profile.md" ] && cp "$dir/profile.md" "$OUT/profile_${scene}_$run.md"
+      [ "${run#*_}" = plain ] && "$bin" eval "$dir" > "$OUT/metrics_${scene}_$run.json" 2>/dev/null
+    done
+  done
+  nvidia-smi --query-gpu=name,memory.used,memory.total --format=csv >> "$summary" 2>&1 || true
+}
+
+# One run of mode `runs`: its flags from its name.
+runs_train_one() {
+  local name="$1" cache="$2" pl="$3" work="$4" res="$5"
+  local args=() scene="$cache" keys=()
+  case "$name" in *_pl) scene="$pl" ;; esac
   case "$name" in *_lambda*) local l0=${name#*_lambda}; keys+=("\"lambda_l0\": ${l0%%_*}") ;; esac
   case "$name" in *_lp*) local lp=${name#*_lp}; keys+=("\"lambda_pseudo\": ${lp%%_*}") ;; esac
   case "$name" in *_decgt*) keys+=("\"pseudo_labels_train_decoder\": false") ;; esac
@@ -65,45 +114,134 @@ train_one() {
     structure_p1_*) args+=(--drop structure --p-base 1) ;;
     *) echo "unknown run $name"; return 1 ;;
   esac
-  timeout "$left" "$bin" train "$scene" --device cuda --iterations 7000 --out "$work/run_$name" "${args[@]}" \
+  run_until_deadline "$bin" train "$scene" --device cuda --iterations 7000 --out "$work/run_$name" "${args[@]}" \
     > "$res/train_$name.log" 2>&1 || { echo "$name: train stopped (rc $?)"; return 1; }
   "$bin" eval "$work/run_$name" > "$res/metrics_$name.json" 2> "$res/eval_$name.log"
   cp "$work/run_$name/config.json" "$res/config_$name.json"
 }
 
-for name in "${runs[@]}"; do
-  now=$(( $(date +%s) - start ))
-  [ "$now" -lt "$deadline" ] || { echo "$name: not started (deadline)"; continue; }
-  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
-  now=$(( $(date +%s) - start ))
-  # A run needs about RUN_SECONDS (2 at once on an H100: ~160 s); don't start one that can't end.
-  [ $(( now + ${RUN_SECONDS:-170} )) -lt "$deadline" ] || { echo "$name: not started (deadline)"; continue; }
-  train_one "$name" $(( deadline - now )) &
-done
-wait
+mode_runs() {
+  local scene="$1" jobs="${2:-2}"; deadline_start "${3:-540}"; shift $(( $# < 3 ? $# : 3 ))
+  local runs=("$@")
+  [ ${#runs[@]} -gt 0 ] || runs=(none_nopl full_p1_pl none_pl full_p1_nopl structure_p1_pl semantic_p1_pl
+                                  full_p0_pl full_p2_pl full_p0.5_pl full_p1.5_pl)
+  local tag="${scene}${PL_TAG:-}" work="/tmp/sadsplat-exp/${scene}${PL_TAG:-}"
+  local res="$work/results"; mkdir -p "$res"
+  local cache pl; cache=$(scene_cache "$scene") || return 1
+  # shellcheck disable=SC2086
+  pl=$(pl_cache "$cache" "$bin" ${PL_ARGS:-}) || return 1
+  local name
+  for name in "${runs[@]}"; do
+    # A run needs about RUN_SECONDS (2 at once on an H100: ~160 s); don't start one that can't end.
+    [ "$(seconds_left)" -gt "${RUN_SECONDS:-170}" ] || { echo "$name: not started (deadline)"; continue; }
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+    runs_train_one "$name" "$cache" "$pl" "$work" "$res" &
+  done
+  wait
+  local summary="$OUT/summary_$tag.txt" f
+  echo "$scene 800x450, 7000 iterations, $jobs at once; pseudo-labels args: '${PL_ARGS:-}'" > "$summary"
+  for f in "$res"/metrics_*.json; do [ -f "$f" ] && metrics_line "$(basename "${f%.json}" | cut -c9-)" "$f"; done >> "$summary"
+  for f in "$res"/train_*.log; do tr '\r' '\n' < "$f" | grep '^\[drop\]\|semantic supervision' | tail -3 | sed "s|^|$(basename "$f"): |"; done >> "$summary"
+  tar -czf "$OUT/results_$tag.tar.gz" -C "$work" results
+  cat "$summary"
+}
 
-python3 - "$res" "$kind" "$seed" "${PL_ARGS:-}" > "$out/summary_$tag.txt" <<'PY'
-import glob, json, os, sys
-res, kind, seed, pl_args = sys.argv[1:]
-print(f"{kind} seed {seed}, 800x450, 7000 iterations, H100, several runs at once; pseudo-labels args: '{pl_args}'")
-rows = []
-for f in sorted(glob.glob(os.path.join(res, "metrics_*.json"))):
-    name = os.path.basename(f)[8:-5]
-    try:
-        m = json.load(open(f))
-    except Exception as e:
-        print(name, "unreadable", e); continue
-    rows.append((name, m))
-    print("%-16s mIoU %6.2f  mAcc %6.2f  OA %6.2f  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.0f s  render %.2f ms" % (
-        name, 100*m['miou'], 100*m['macc'], 100*m['oacc'], m['psnr'], m['ssim'], m['num_gaussians'], m['train_seconds'],
-        m.get('render_ms', float('nan'))))
-rep = os.path.join(res, "pseudo_report", "report.txt")
-if os.path.exists(rep):
-    print(open(rep).read())
-PY
-grep -h 'builtin:\|Elapsed\|Maximum resident' "$res/pseudo_labels.log" >> "$out/summary_$tag.txt" || true
-for f in "$res"/train_*.log; do tr '\r' '\n' < "$f" | grep '^\[drop\]\|semantic supervision' | tail -3 | sed "s|^|$(basename "$f"): |"; done \
-  >> "$out/summary_$tag.txt"
-tar -czf "$out/results_$tag.tar.gz" -C "$work" results
-cat "$out/summary_$tag.txt"
-echo "total $(( $(date +%s) - start )) s"
+# One training of mode `table`: table_run_one SCENE CONFIG SEED.
+table_run_one() {
+  local scene=$1 config=$2 seed=$3
+  local name="${config}_t$seed" cache flags=(--drop none)
+  cache=$(scene_cache "$scene" "$size") || return 1
+  case "$config" in
+    none) ;;
+    none_grad*)
+      local json="$work/${config}.json"
+      echo "{\"densify_grad_threshold\": ${config#none_grad}}" > "$json"
+      flags+=(--config "$json") ;;
+    drop) flags=(--drop full) ;;
+    pl) cache=$(pl_cache "$cache") ;;
+    full|full_*)
+      cache=$(pl_cache "$cache"); flags=(--drop full)
+      local token
+      for token in ${config//_/ }; do
+        case "$token" in
+          full) ;;
+          p[0-9]*) flags+=(--p-base "${token#p}") ;;
+          lambda*) flags+=(--lambda-l0 "${token#lambda}") ;;
+          from*) flags+=(--lambda-l0-from "${token#from}") ;;
+          ramp*) flags+=(--lambda-l0-ramp "${token#ramp}") ;;
+          imp*) flags+=(--l0-importance "${token#imp}") ;;
+          *) echo "unknown part $token of configuration $config"; return 1 ;;
+        esac
+      done ;;
+    *) echo "unknown configuration $config"; return 1 ;;
+  esac
+  local run="$work/runs/$scene/$name" dest="$new/$scene/$name"
+  rm -rf "$run"; mkdir -p "$(dirname "$run")" "$dest"
+  local t0; t0=$(date +%s)
+  if run_until_deadline "$bin" train "$cache" --device "$device" --iterations "$iterations" \
+       --seed "$seed" --out "$run" "${flags[@]}" > "$dest/train.log" 2>&1 &&
+     "$bin" eval "$run" > "$run/eval.out" 2> "$dest/eval.log"; then
+    cp "$run/metrics.json" "$dest/metrics.json"
+    echo "$scene $name: $(( $(date +%s) - t0 )) s" >> "$log"
+  else
+    echo "$scene $name: stopped after $(( $(date +%s) - t0 )) s" >> "$log"
+    rm -f "$dest/metrics.json"
+  fi
+  # Keep the log small: the progress lines are carriage-return updates.
+  tr '\r' '\n' < "$dest/train.log" | grep -v '^\[[0-9]*/[0-9]*\] loss' | tail -40 > "$dest/train.log.tail"
+  mv "$dest/train.log.tail" "$dest/train.log"
+}
+
+mode_table() {
+  table="${1:?usage: experiments.sh table ablation|pbase|l0schedule|growth [JOBS] [DEADLINE_S]}"
+  local parallel="${2:-4}"; deadline_start "${3:-540}"
+  device="${DEVICE:-cuda}"; size="${WIDTH:-800}x${HEIGHT:-450}"; iterations="${ITERATIONS:-7000}"
+  local scenes configs
+  case "$table" in
+    ablation) scenes=(city_0 country_0 port_0 city_1 country_1 port_1 city_2 country_2 port_2)
+              configs=(none full drop pl) ;;
+    pbase)    scenes=(city_0 country_0 port_0); configs=(full_p1 full_p0 full_p2 full_p0.5 full_p1.5) ;;
+    l0schedule) scenes=(city_0 country_0 port_0)
+              configs=(full_from3500 full_from3500_lambda0.4 full_from2000_ramp1500) ;;
+    growth)   scenes=(city_0 country_0 port_0); configs=(none_grad0.0005 none_grad0.001 none_grad0.002) ;;
+    *) echo "unknown table $table (ablation, pbase, l0schedule or growth)"; return 2 ;;
+  esac
+  [ -n "${SCENES:-}" ] && read -r -a scenes <<< "$SCENES"
+  [ -n "${CONFIGS:-}" ] && read -r -a configs <<< "$CONFIGS"
+  local seeds=(0 1 2); [ -n "${SEEDS:-}" ] && read -r -a seeds <<< "$SEEDS"
+  local done_dir="docs/experiments/$table"
+  work=/tmp/sadsplat-table/$table; new="$work/new"; log="$OUT/table_$table.txt"
+  rm -rf "$new"; mkdir -p "$new"   # only this call's runs go back
+  echo "== $(date -u +%F) table $table: ${#scenes[@]} scenes x ${#configs[@]} configurations x ${#seeds[@]} seeds, $parallel at once, $device $size, $iterations iterations" | tee -a "$log"
+  local pending=0 scene config seed item
+  for scene in "${scenes[@]}"; do
+    local todo=()
+    for config in "${configs[@]}"; do
+      for seed in "${seeds[@]}"; do
+        [ -f "$done_dir/$scene/${config}_t$seed/metrics.json" ] || todo+=("$config:$seed")
+      done
+    done
+    [ ${#todo[@]} -eq 0 ] && continue
+    # The scene (and its pseudo-labels) once, before the runs that share it start.
+    scene_cache "$scene" "$size" > /dev/null && pl_cache "$(scene_cache "$scene" "$size")" > /dev/null ||
+      { echo "$scene: preparation stopped" | tee -a "$log"; break; }
+    for item in "${todo[@]}"; do
+      # A run started too late is killed at the deadline and wasted.
+      [ "$(seconds_left)" -le "${MIN_RUN_S:-30}" ] && break 2
+      while [ "$(jobs -rp | wc -l)" -ge "$parallel" ]; do wait -n; done
+      table_run_one "$scene" "${item%%:*}" "${item##*:}" &
+      pending=$((pending + 1))
+    done
+  done
+  wait
+  echo "started $pending runs, $(find "$new" -name metrics.json | wc -l) finished" | tee -a "$log"
+  tar czf "$OUT/table_$table.tgz" -C "$new" .
+}
+
+case "$mode" in
+  one) mode_one "$@" ;;
+  profile) mode_profile "$@" ;;
+  runs) mode_runs "$@" ;;
+  table) mode_table "$@" ;;
+  *) echo "unknown mode $mode (one, profile, runs or table)"; exit 2 ;;
+esac

@@ -15,10 +15,10 @@
 # No run starts when fewer than its expected seconds are left before LIMIT. $OUT gets
 # side_by_side.txt (the tables) and side_by_side.tgz (logs, metrics JSON).
 set -uo pipefail
+source "$(dirname "$0")/lib.sh"
 start=$(date +%s)
 limit="${LIMIT:-590}"
-out="${OUT:-/tmp/sadsplat-gpu-out}"
-mkdir -p "$out"
+out="$OUT"
 work=/tmp/side-by-side
 rm -rf "$work"; mkdir -p "$work/logs"
 summary="$out/side_by_side.txt"
@@ -26,7 +26,7 @@ left() { echo $(( limit - ($(date +%s) - start) )); }
 py="${PYTHON:-python3}"
 
 echo "== $(date -u +%F) sadsplat vs gsplat, $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" | tee "$summary"
-bash scripts/gpu/build.sh > "$work/logs/build_sadsplat.log" 2>&1 &
+gpu_build > "$work/logs/build_sadsplat.log" 2>&1 &
 sadsplat_build=$!
 # gsplat: the JIT build of its CUDA extension with the channel counts used here (3 = RGB,
 # 32 = a chunk of features, 35 = RGB + 32 features in one call).
@@ -65,7 +65,7 @@ smoke_done=0
 echo "gsplat build: rc $gs_ok, $(( $(date +%s) - gs_start )) s; $(tail -1 "$work/logs/build_gsplat.log")" | tee -a "$summary"
 [ -z "$prebuilt" ] && find /tmp/gsplat-ext -name '*.so' -exec cp {} "$out/" \;
 wait $sadsplat_build || { tail -30 "$work/logs/build_sadsplat.log"; }
-export LD_LIBRARY_PATH="/tmp/sadsplat-deps/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
+export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=build-gpu/bin/sadsplat
 echo "builds done at $(( $(date +%s) - start )) s" | tee -a "$summary"
 
@@ -89,10 +89,8 @@ train_sadsplat() {  # NAME CACHE ARGS...
     "$bin" eval "$run" > "$work/metrics_$name.json" 2>> "$work/logs/train_$name.log"
 }
 for scene in "${args[@]}"; do
-  kind=${scene%_*}; seed=${scene##*_}
   [ "$(left)" -gt 100 ] || { echo "no time left for $scene" | tee -a "$summary"; break; }
-  cache="$work/${scene}.cache"
-  "$bin" synth --kind "$kind" --seed "$seed" --width 800 --height 450 --cache "$cache" > "$work/logs/synth_$scene.log" 2>&1
+  cache=$(scene_cache "$scene") || break
   [ "$(left)" -gt 75 ] && train_sadsplat "${scene}_net1" "$cache" --drop none
   if [ "${LIKE_FOR_LIKE:-0}" = 1 ] && [ "$(left)" -gt 90 ]; then
     # Net-1 without the screen-size pruning, as gsplat's default strategy (refine_scale2d_stop_iter 0).
@@ -115,8 +113,7 @@ for scene in "${args[@]}"; do
     done
   fi
   if [ "$(left)" -gt 100 ]; then
-    "$bin" pseudo-labels "$cache" --out "$work/${scene}_pl.cache" > "$work/logs/pl_$scene.log" 2>&1 &&
-      train_sadsplat "${scene}_full" "$work/${scene}_pl.cache" --drop full
+    pl=$(pl_cache "$cache") && train_sadsplat "${scene}_full" "$pl" --drop full
   fi
 done
 
