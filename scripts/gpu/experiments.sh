@@ -11,6 +11,10 @@
 #       the drop / pseudo-label runs of one scene, JOBS at once (timings are then not clean)
 #   bash scripts/gpu/experiments.sh table TABLE [JOBS=4] [DEADLINE_S=540]
 #       the trainings of a benchmark table, resuming across calls (below)
+#   bash scripts/gpu/experiments.sh scene SCENE JOBS DEADLINE_S 'NAME:train flags' ...
+#       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
+#       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
+#       at once; ITERATIONS (7000); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs)
 #
 # RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
 #   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set
@@ -238,10 +242,48 @@ mode_table() {
   tar czf "$OUT/table_$table.tgz" -C "$new" .
 }
 
+mode_scene() {
+  local scene="$1" jobs="$2"; deadline_start "$3"; shift 3
+  local cache="$scene"
+  if [ ! -e "$scene" ]; then
+    case "$scene" in
+      *_pl) cache=$(scene_cache "${scene%_pl}") && cache=$(pl_cache "$cache") || return 1 ;;
+      *) cache=$(scene_cache "$scene") || return 1 ;;
+    esac
+  fi
+  local tag; tag=$(basename "${scene%.cache}")
+  local work="/tmp/sadsplat-scene/$tag"; rm -rf "$work"; mkdir -p "$work/results"
+  local spec
+  for spec in "$@"; do
+    local name="${spec%%:*}" flags="${spec#*:}"
+    [ "$(seconds_left)" -gt 20 ] || { echo "$name: not started (deadline)"; continue; }
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+    (
+      # shellcheck disable=SC2086
+      run_until_deadline "$bin" train "$cache" --device cuda --iterations "${ITERATIONS:-7000}" \
+        --out "$work/run_$name" $flags > "$work/results/train_$name.log" 2>&1 &&
+        "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" ||
+        echo "$name: stopped (rc $?)"
+    ) &
+  done
+  wait
+  local summary="$OUT/scene_$tag.txt" f
+  echo "== $(date -u +%F) $scene, ${ITERATIONS:-7000} iterations, $jobs at once, $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" > "$summary"
+  for spec in "$@"; do
+    local name="${spec%%:*}"
+    f="$work/results/metrics_$name.json"
+    [ -s "$f" ] && metrics_line "$name" "$f" >> "$summary"
+    echo "    flags: ${spec#*:}; $(train_summary "$work/results/train_$name.log"); drops: $(tr '\r' '\n' < "$work/results/train_$name.log" | grep -c '^\[drop\]')" >> "$summary"
+  done
+  tar -czf "$OUT/scene_$tag.tgz" -C "$work" results
+  cat "$summary"
+}
+
 case "$mode" in
+  scene) mode_scene "$@" ;;
   one) mode_one "$@" ;;
   profile) mode_profile "$@" ;;
   runs) mode_runs "$@" ;;
   table) mode_table "$@" ;;
-  *) echo "unknown mode $mode (one, profile, runs or table)"; exit 2 ;;
+  *) echo "unknown mode $mode (one, profile, runs, table or scene)"; exit 2 ;;
 esac

@@ -164,7 +164,7 @@ TEST(SceneCache, ChecksSemanticValidityOfWellFormedFiles) {
   scene = syntheticScene();
   scene.classes.resize(5000, scene.classes[0]);
   io::writeSceneCache(dir.file("classes.cache"), scene);
-  expectCacheError(dir.file("classes.cache"), "1 to 255 classes");
+  expectCacheError(dir.file("classes.cache"), "0 to 255 classes");
 
   scene = syntheticScene();
   scene.views[0].labels.pixels[3] = 7;  // only 2 classes

@@ -34,7 +34,8 @@ cv::Mat classImage(const std::vector<std::uint8_t>& ids, int W, int H,
 }
 
 void writePanel(const std::string& path, const io::View& view, const at::Tensor& render_rgb,
-                const std::vector<std::uint8_t>& pred, const std::vector<ClassInfo>& classes) {
+                const std::vector<std::uint8_t>& labels, const std::vector<std::uint8_t>& pred,
+                const std::vector<ClassInfo>& classes) {
   const int W = view.camera.width, H = view.camera.height;
   cv::Mat image(H, W, CV_8UC3, const_cast<std::uint8_t*>(view.rgb.pixels.data()));
   const at::Tensor bytes =
@@ -42,15 +43,19 @@ void writePanel(const std::string& path, const io::View& view, const at::Tensor&
   cv::Mat render(H, W, CV_8UC3, bytes.data_ptr<std::uint8_t>());
   cv::Mat error(H, W, CV_8UC3);
   for (int i = 0; i < W * H; ++i) {
-    const auto gt = view.labels.pixels[i];
+    const auto gt = labels[i];
     error.at<cv::Vec3b>(i / W, i % W) =
         gt == io::kIgnoreLabel ? cv::Vec3b(60, 60, 60)
                                : (gt == pred[i] ? cv::Vec3b(255, 255, 255) : cv::Vec3b(255, 0, 0));
   }
   cv::Mat panel;
-  cv::hconcat(std::vector<cv::Mat>{image, render, classImage(view.labels.pixels, W, H, classes),
-                                   classImage(pred, W, H, classes), error},
-              panel);
+  if (classes.empty()) {
+    cv::hconcat(std::vector<cv::Mat>{image, render}, panel);  // no classes: image | render
+  } else {
+    cv::hconcat(std::vector<cv::Mat>{image, render, classImage(labels, W, H, classes),
+                                     classImage(pred, W, H, classes), error},
+                panel);
+  }
   cv::Mat bgr;
   cv::cvtColor(panel, bgr, cv::COLOR_RGB2BGR);
   std::vector<std::uint8_t> png;
@@ -90,8 +95,9 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   bool any_test = false;
   for (const auto& v : scene.views) any_test = any_test || v.test;
   double psnr_sum = 0, ssim_sum = 0, render_seconds = 0;
+  const bool semantic = !scene.classes.empty();
   for (const io::View& view : scene.views) {
-    if ((any_test && !view.test) || view.labels.empty()) continue;
+    if (any_test && !view.test) continue;
     const gaussians::RenderResult r = trainer.renderView(view);
     {
       // Render time: r was the warm-up; reading a value back waits for the device.
@@ -101,12 +107,25 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
       render_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / kRepeats;
     }
-    const at::Tensor pred = trainer.predictClasses(r).to(at::kCPU).contiguous();
-    std::vector<std::uint8_t> labels = view.labels.pixels;
+    const std::size_t pixels = static_cast<std::size_t>(view.camera.width) * view.camera.height;
+    // Ignore everywhere when the view has no label map: the image metrics still count.
+    std::vector<std::uint8_t> labels =
+        view.labels.empty() ? std::vector<std::uint8_t>(pixels, io::kIgnoreLabel)
+                            : view.labels.pixels;
+    std::vector<std::uint8_t> pred8(pixels, io::kIgnoreLabel);
+    if (semantic) {
+      const at::Tensor pred = trainer.predictClasses(r).to(at::kCPU).contiguous();
+      const std::int64_t* p = pred.data_ptr<std::int64_t>();
+      for (std::size_t i = 0; i < pixels; ++i) pred8[i] = static_cast<std::uint8_t>(p[i]);
+    }
     for (std::size_t i = 0; i < labels.size(); ++i) {
       if (view.mask.pixels[i] == 0) labels[i] = io::kIgnoreLabel;
     }
-    result.confusion.add(labels.data(), pred.data_ptr<std::int64_t>(), labels.size());
+    if (semantic && !view.labels.empty()) {
+      std::vector<std::int64_t> pred64(pred8.begin(), pred8.end());
+      result.confusion.add(labels.data(), pred64.data(), labels.size());
+      ++result.labelled_views;
+    }
     const int W = view.camera.width, H = view.camera.height;
     const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(view.rgb.pixels.data()),
                                         {H, W, 3}, at::TensorOptions().dtype(at::kByte))
@@ -119,17 +138,21 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     result.views.push_back(view.name);
 #if SADSPLAT_HAVE_OPENCV
     if (!panel_dir.empty()) {
-      std::vector<std::uint8_t> pred8(pred.numel());
-      const std::int64_t* p = pred.data_ptr<std::int64_t>();
-      for (std::size_t i = 0; i < pred8.size(); ++i) pred8[i] = static_cast<std::uint8_t>(p[i]);
       const std::string stem = view.name.substr(0, view.name.find_last_of('.'));
-      writePanel(panel_dir + "/" + stem + ".png", view, rgb, pred8, scene.classes);
+      writePanel(panel_dir + "/" + stem + ".png", view, rgb, labels, pred8, scene.classes);
     }
 #endif
   }
   if (result.views.empty()) {
-    throw Error(scene.source, "test views", "at least one test view with a label map",
-                "none (no test view has a label map)");
+    throw Error(scene.source, "test views", "at least one view to evaluate", "none");
+  }
+  result.held_out = any_test;
+  if (!semantic) {
+    result.miou_note = "no classes (the scene has no classes.json): image metrics only";
+  } else if (result.labelled_views == 0) {
+    result.miou_note = std::string("no label map on any ") +
+                       (any_test ? "test" : "") +
+                       " view: add labels/ (or import annotations) for mIoU";
   }
   result.psnr = psnr_sum / result.views.size();
   result.ssim = ssim_sum / result.views.size();
@@ -152,10 +175,16 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
   }
   nlohmann::json names = nlohmann::json::array();
   for (const auto& c : classes) names.push_back(c.name);
+  // No labelled pixel scored: the class metrics are null (not 0) and the note says why.
+  const bool scored = r.miou_note.empty();
+  const auto metric = [&](double v) { return scored ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const nlohmann::json j = {
-      {"miou", r.confusion.meanIou()},
-      {"macc", r.confusion.meanAccuracy()},
-      {"oacc", r.confusion.overallAccuracy()},
+      {"miou", metric(r.confusion.meanIou())},
+      {"macc", metric(r.confusion.meanAccuracy())},
+      {"oacc", metric(r.confusion.overallAccuracy())},
+      {"miou_note", scored ? nlohmann::json(nullptr) : nlohmann::json(r.miou_note)},
+      {"labelled_views", r.labelled_views},
+      {"held_out", r.held_out},
       {"per_class_iou", per_class},
       {"psnr", r.psnr},
       {"ssim", r.ssim},

@@ -1,6 +1,8 @@
 #include "drop_state.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <tuple>
 
 #include "sadsplat/common/error.h"
@@ -42,9 +44,44 @@ at::Tensor DropState::effectiveOpacity(const ParameterStore& params, int iterati
 }
 
 at::Tensor DropState::regularisation(const ParameterStore& params, int it) const {
-  if (!gated(it)) return at::Tensor();
+  if (!gated(it) || balanced()) return at::Tensor();
   return drop_->regularisation(params["log_alpha"].value, it,
                                config_.l0_importance > 0 ? l0_weights_ : at::Tensor());
+}
+
+void DropState::addL0Gradient(ParameterStore& params, int it) const {
+  if (!gated(it) || !balanced()) return;
+  // The L0 schedule (lambda_l0_from, lambda_l0_ramp) applies to the strength as to lambda_l0.
+  if (it < config_.lambda_l0_from) return;
+  double strength = config_.l0_strength * guard_[0];
+  if (config_.lambda_l0_ramp > 0) {
+    strength *= std::min(1.0, static_cast<double>(it - config_.lambda_l0_from + 1) /
+                                  config_.lambda_l0_ramp);
+  }
+  Parameter& la = params["log_alpha"];
+  at::Tensor grad = la.value.grad();
+  if (strength == 0 || !grad.defined()) return;
+  const at::Tensor direction = drop_->l0Derivative(la.value);
+  if (!direction.defined()) return;
+  // The gates the losses reached this step (on every rank: the gradient is all-reduced).
+  const at::Tensor reached = (grad != 0).to(grad.dtype());
+  const at::Tensor rgb_force = (grad.abs() * reached).sum();
+  const at::Tensor l0_force = (direction * reached).sum();
+  // Both sums are over the same gates, so their ratio is the ratio of the means.
+  const at::Tensor scale = at::where(l0_force > 0, rgb_force / l0_force.clamp_min(1e-30),
+                                     at::zeros_like(l0_force));
+  at::Tensor force = direction * reached * (strength * scale);
+  if (config_.l0_importance > 0) force = force * l0_weights_;
+  grad.add_(force);
+}
+
+void DropState::observeRgbLoss(int done, double rgb_loss) {
+  if (!drop_ || !balanced() || config_.drop_guard <= 0 || !std::isfinite(rgb_loss)) return;
+  // Readings in the second half of each drop interval: the level the model has settled to.
+  const int interval = config_.drop_interval;
+  if (interval <= 0 || done % interval <= interval / 2) return;
+  guard_[2] += rgb_loss;
+  guard_[3] += 1;
 }
 
 bool DropState::refreshesL0Weights(int it) const {
@@ -66,6 +103,17 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
   DropDecision decision;
   if (!drop_->dropNow(done)) return decision;
   DropInputs in;
+  if (balanced()) {
+    if (config_.drop_guard > 0 && guard_[3] > 0) {
+      // The guard: the loss before this event against the loss before the previous one.
+      const double window = guard_[2] / guard_[3];
+      if (guard_[1] > 0 && window > guard_[1] * (1 + config_.drop_guard)) guard_[0] *= 0.5;
+      guard_[1] = window;
+    }
+    guard_[2] = guard_[3] = 0;
+    in.max_removed = static_cast<std::int64_t>(
+        std::floor(config_.drop_max_fraction * guard_[0] * static_cast<double>(params.rows())));
+  }
   in.means = params["means"].value.detach();
   in.opacities = at::sigmoid(params["opacity"].value.detach());
   in.log_alpha = params["log_alpha"].value.detach();
@@ -134,6 +182,8 @@ void DropState::resized(const RowChange& change) {
 void DropState::save(TensorArchive& a) const {
   a.tensors["confidence"] = confidence_;
   a.tensors["l0_weights"] = l0_weights_;
+  a.tensors["drop_guard"] =
+      at::tensor(std::vector<double>(guard_.begin(), guard_.end()), at::kDouble);
 }
 
 void DropState::load(const TensorArchive& a, const std::string& path, const at::Device& device) {
@@ -141,6 +191,15 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
   // Checkpoints written before the importance-weighted L0 have no weights: the plain mean's.
   l0_weights_ = a.tensors.count("l0_weights") ? a.tensor("l0_weights", path).to(device)
                                               : at::ones_like(confidence_);
+  // Checkpoints written before the balanced rule have no guard state: a fresh guard.
+  guard_ = {1.0, -1.0, 0.0, 0.0};
+  if (a.tensors.count("drop_guard")) {
+    const at::Tensor g = a.tensor("drop_guard", path).to(at::kCPU).to(at::kDouble).contiguous();
+    if (g.numel() != 4) {
+      throw Error(path, "drop_guard", "4 values", std::to_string(g.numel()) + " values");
+    }
+    for (int k = 0; k < 4; ++k) guard_[k] = g.data_ptr<double>()[k];
+  }
 }
 
 void DropState::checkRows(std::int64_t rows) const {

@@ -5,6 +5,7 @@
 
 #include <ATen/ATen.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -40,8 +41,18 @@ class DropState {
   at::Tensor trainingGate(const ParameterStore& params, int it) const;
   // Activated opacity times the evaluation gate (when there is one).
   at::Tensor effectiveOpacity(const ParameterStore& params, int iteration) const;
-  // The strategy's loss term of `it` (undefined when not gated or none).
+  // The strategy's loss term of `it` (undefined when not gated or none, and under the balanced
+  // rule, whose L0 force is added to the gradient by addL0Gradient instead).
   at::Tensor regularisation(const ParameterStore& params, int it) const;
+  // The balanced rule's L0 force (TrainConfig::drop_rule), after the backward (and the
+  // all-reduce) of iteration `it`: on each gate whose gradient the losses reached, l0_strength x
+  // pressure x (the mean |gradient| over those gates) x dP_nonzero / mean dP_nonzero over them.
+  void addL0Gradient(ParameterStore& params, int it) const;
+  // The balanced rule's guard: the training RGB loss read after iteration `done` (losses are
+  // read on a fixed schedule, so a resumed run sees the readings an uninterrupted one does).
+  void observeRgbLoss(int done, double rgb_loss);
+  // The factor on the L0 strength and the drop cap that the guard has left (1 at the start).
+  double pressure() const { return guard_[0]; }
 
   // Whether the L0 term's weights are recomputed before iteration `it`: with l0_importance, when
   // the L0 schedule starts and every drop interval after (a fixed schedule, so that a resumed run
@@ -78,6 +89,10 @@ class DropState {
   std::shared_ptr<const DropStrategy> drop_;
   at::Tensor confidence_;  // [N] last semantic confidence computed by the drop (0 before)
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
+  bool balanced() const { return config_.drop_rule == "balanced"; }
+  // The guard's state: pressure, the mean RGB loss of the window before the previous drop event
+  // (< 0: none yet), the sum and count of the readings in the current window.
+  std::array<double, 4> guard_{1.0, -1.0, 0.0, 0.0};
 };
 
 }  // namespace gaussians

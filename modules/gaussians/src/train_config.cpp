@@ -191,6 +191,19 @@ const std::vector<TrainOption> kOptions = {
     {"recovery_prune", &C::recovery_prune,
      "at the start of the recovery also remove this share of the least contributing Gaussians",
      "--recovery-prune", 0, 0.999},
+    {"drop_rule", &C::drop_rule,
+     "balanced: L0 force relative to the RGB force, capped drop events, a loss guard (not the "
+     "paper); paper: the paper's rule as printed",
+     "--drop-rule", -kInf, kInf, "balanced|paper"},
+    {"l0_strength", &C::l0_strength,
+     "balanced rule: L0 force on a gate as a share of the mean RGB force on the gates",
+     "--l0-strength", 0, kInf},
+    {"drop_max_fraction", &C::drop_max_fraction,
+     "balanced rule: the largest share of the Gaussians one drop event removes", nullptr, 0, 1},
+    {"drop_guard", &C::drop_guard,
+     "balanced rule: relative rise of the training RGB loss between drop events that halves the "
+     "L0 strength and the cap (0: off)",
+     nullptr, 0, kInf},
 };
 
 std::string numberText(double v) {

@@ -85,15 +85,16 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
   }
   if (s.config.densify_until < 0) s.config.densify_until = config.iterations / 2;
   s.num_classes = static_cast<int>(scene.classes.size());
-  if (s.num_classes < 1) throw Error(scene.source, "classes", "at least one class", "none");
-  s.views = loadTrainingViews(scene, config, s.device);
+  // A scene without classes trains plain 3DGS: no features, no decoder rows, no semantic loss.
+  if (s.num_classes == 0) s.config.feature_dim = 0;
+  s.views = loadTrainingViews(scene, s.config, s.device);
   s.extent = sceneExtent(s.views.cameras);
 
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
   InitOptions init;
   init.seed = config.seed;
   const GaussianTensors t =
-      fromCloud(initialCloud(scene.points, init), s.device, config.feature_dim);
+      fromCloud(initialCloud(scene.points, init), s.device, s.config.feature_dim);
   ParameterStore& p = s.params;
   p.add("means", t.means, config.lr_position_init * s.extent);
   p.add("sh_dc", t.sh_dc, config.lr_sh_dc);
@@ -103,9 +104,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
   p.add("quats", t.rotations, config.lr_rotation);
   p.add("features", t.features, config.lr_feature, true, /*steps_without_gradient=*/true);
   at::Generator gen = seededGenerator(config.seed, 3, 0);
-  const double bound = 1.0 / std::sqrt(std::max(1, config.feature_dim));
+  const double bound = 1.0 / std::sqrt(std::max(1, s.config.feature_dim));
   p.add("decoder_w",
-        at::empty({s.num_classes, config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),
+        at::empty({s.num_classes, s.config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),
         config.lr_decoder, false);
   p.add("decoder_b", at::zeros({s.num_classes}, at::TensorOptions().device(s.device)),
         config.lr_decoder, false);
@@ -236,6 +237,7 @@ StepStats Trainer::step(bool read_losses) {
           sums);
       s.densification->reduced(*s.collective);
     }
+    s.drop.addL0Gradient(s.params, it);  // the balanced rule's L0 force (else a no-op)
     enterPhase(profile, "optimiser");
     s.params.adamStep();
     s.iteration = it + 1;
@@ -279,6 +281,7 @@ StepStats Trainer::step(bool read_losses) {
     stats.rgb_loss = value[1] / value[3];
     stats.semantic_loss = value[2] / batch;
     stats.loss = value[0];
+    s.drop.observeRgbLoss(s.iteration, stats.rgb_loss);
   } else {
     stats.loss = stats.rgb_loss = stats.semantic_loss = std::numeric_limits<double>::quiet_NaN();
   }
@@ -287,6 +290,7 @@ StepStats Trainer::step(bool read_losses) {
     profile->countIteration();
   }
   stats.num_gaussians = s.params.rows();
+  stats.drop_pressure = s.drop.pressure();
   stats.recovery_started = s.iteration == s.drop.recoveryStart();
   stats.pseudo_labelled_views = s.views.pseudo_labelled_views;
   return stats;

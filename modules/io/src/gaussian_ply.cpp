@@ -209,7 +209,12 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
   if (options.sh_degree < 0 || options.sh_degree > kMaxShDegree) {
     throw Error(path, "sh_degree option", "0..3", std::to_string(options.sh_degree));
   }
+  if (options.feature_dim < 0 || options.feature_dim > kFeatureDim) {
+    throw Error(path, "feature_dim option", "0.." + std::to_string(kFeatureDim),
+                std::to_string(options.feature_dim));
+  }
   checkWritableGaussians(path, cloud);
+  const int features = options.feature_dim;
   const int rest = shCoefficientsForDegree(options.sh_degree) - 1;
 
   std::ostringstream header;
@@ -223,7 +228,7 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
   for (int k = 0; k < 3; ++k) header << "property float scale_" << k << "\n";
   for (int k = 0; k < 4; ++k) header << "property float rot_" << k << "\n";
   if (options.semantic) {
-    for (int k = 0; k < kFeatureDim; ++k) header << "property float feature_" << k << "\n";
+    for (int k = 0; k < features; ++k) header << "property float feature_" << k << "\n";
     // `int`, not `uint`: Open3D's PLY reader skips uint properties. kUnlabelled is written as -1
     // (the same 32 bits).
     header << "property float log_alpha\nproperty float confidence\nproperty int label\n";
@@ -233,7 +238,7 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
 
   // One record per vertex, all fields 4 bytes, little endian (the host order on x86-64/ARM).
   const std::size_t floats_per_record =
-      9 + 3 * rest + 1 + 3 + 4 + (options.semantic ? kFeatureDim + 3 : 0);
+      9 + 3 * rest + 1 + 3 + 4 + (options.semantic ? features + 3 : 0);
   std::vector<float> record(floats_per_record);
   writeFileAtomically(path, [&](std::ostream& out) {
     out.write(header_text.data(), static_cast<std::streamsize>(header_text.size()));
@@ -247,7 +252,7 @@ void writeGaussianPly(const std::string& path, const pcl::PointCloud<GaussianPoi
       for (float v : p.scale) *r++ = v;
       for (float v : p.rot) *r++ = v;
       if (options.semantic) {
-        for (float v : p.feature) *r++ = v;
+        for (int k = 0; k < features; ++k) *r++ = p.feature[k];
         *r++ = p.log_alpha;
         *r++ = p.confidence;
         std::memcpy(r++, &p.label, sizeof(float));

@@ -282,9 +282,10 @@ Scene readSceneCache(const std::string& path) {
       scene.source = c.getString("source");
     } else if (tag == "CLAS") {
       const auto n = c.get<std::uint32_t>("class count");
-      // Label maps are bytes with 255 = ignore: at most 255 classes (as classes.json).
-      if (n == 0 || n > 255) {
-        throw Error(path, "chunk CLAS class count", "1 to 255 classes", std::to_string(n));
+      // Label maps are bytes with 255 = ignore: at most 255 classes (as classes.json); 0 is a
+      // scene without classes (plain 3DGS).
+      if (n > 255) {
+        throw Error(path, "chunk CLAS class count", "0 to 255 classes", std::to_string(n));
       }
       for (std::uint32_t i = 0; i < n; ++i) {
         ClassInfo cls;

@@ -48,7 +48,9 @@ std::vector<ClassInfo> readClassesJson(const std::string& path) {
   }
   const auto& list = doc.at("classes");
   if (list.empty() || list.size() > 255) {
-    throw Error(path, "classes", "1 to 255 classes", std::to_string(list.size()));
+    throw Error(path, "classes",
+                "1 to 255 classes (a scene without classes has no classes.json)",
+                std::to_string(list.size()));
   }
   std::vector<ClassInfo> classes;
   std::set<std::string> names;

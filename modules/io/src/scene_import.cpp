@@ -21,6 +21,34 @@ namespace io {
 
 bool haveSceneImport() { return SADSPLAT_HAVE_OPENCV != 0; }
 
+std::string findColmapModel(const std::string& dir) {
+  // COLMAP's mapper writes sparse/0, 1, ...; its image_undistorter writes sparse/ itself.
+  for (const std::string sub : {"/sparse/0", "/sparse"}) {
+    for (const char* file : {"/cameras.bin", "/cameras.txt"}) {
+      if (pathExists(dir + sub + file)) return dir + sub;
+    }
+  }
+  throw Error(dir + "/sparse", "COLMAP model",
+              "cameras, images and points3D (.bin or .txt) in sparse/0/ (COLMAP's mapper) or "
+              "sparse/ (its image_undistorter); `sadsplat sfm PHOTOS --out SCENE` makes one",
+              pathExists(dir + "/sparse") ? "no cameras.bin or cameras.txt there" : "missing");
+}
+
+SplitInfo defaultSplit(const ColmapModel& model, int test_every) {
+  std::vector<std::string> names;
+  for (const auto& im : model.images) names.push_back(im.name);
+  std::sort(names.begin(), names.end());
+  SplitInfo split;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    // Every test_every-th view (0, N, 2N, ...) is held out, as in Mip-NeRF 360's evaluation;
+    // a scene of fewer than 2 * test_every views keeps every view for training.
+    const bool test = test_every > 0 && names.size() >= 2 * static_cast<std::size_t>(test_every) &&
+                      i % test_every == 0;
+    (test ? split.test : split.train).push_back(names[i]);
+  }
+  return split;
+}
+
 #if !SADSPLAT_HAVE_OPENCV
 Scene importScene(const std::string& dir, const ImportOptions&) {
   throw Error(dir, "scene import", "a sadsplat build with OpenCV (SADSPLAT_WITH_OPENCV=ON)",
@@ -149,14 +177,19 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   if (!pathExists(dir)) throw Error(dir, "scene directory", "an existing directory", "missing");
   Scene scene;
   scene.source = dir;
-  scene.classes = readClassesJson(dir + "/classes.json");
-  const ColmapModel model = readColmapModel(dir + "/sparse/0");
+  // Without classes.json the scene trains as plain 3DGS (no semantic head).
+  if (pathExists(dir + "/classes.json")) scene.classes = readClassesJson(dir + "/classes.json");
+  const ColmapModel model = readColmapModel(findColmapModel(dir));
   std::map<std::uint32_t, const ColmapCamera*> cameras;
   for (const auto& c : model.cameras) cameras[c.id] = &c;
 
   SplitInfo split;
   const bool have_split = pathExists(dir + "/split.json");
-  if (have_split) split = readSplitJson(dir + "/split.json");
+  if (have_split) {
+    split = readSplitJson(dir + "/split.json");
+  } else {
+    split = defaultSplit(model, options.test_every);
+  }
   const std::set<std::string> train(split.train.begin(), split.train.end());
   const std::set<std::string> test(split.test.begin(), split.test.end());
   const std::set<std::string> labelled(split.labelled.begin(), split.labelled.end());
@@ -194,8 +227,8 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     view.name = im->name;
     view.camera.qvec = im->qvec;
     view.camera.tvec = im->tvec;
-    view.train = have_split ? train.count(im->name) > 0 : true;
-    view.test = have_split && test.count(im->name) > 0;
+    view.train = train.count(im->name) > 0;
+    view.test = test.count(im->name) > 0;
 
     cv::Mat labels;
     const std::string label_path = dir + "/labels/" + stem(im->name) + ".png";
@@ -208,6 +241,10 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
       }
     }
     view.labelled = have_split ? labelled.count(im->name) > 0 : (!labels.empty() && view.train);
+    if (!labels.empty() && scene.classes.empty()) {
+      throw Error(dir + "/classes.json", "file", "the class list the label maps in labels/ use",
+                  "missing");
+    }
     if (view.labelled && labels.empty()) {
       throw Error(label_path, "file", "a label map for labelled view " + im->name, "missing");
     }

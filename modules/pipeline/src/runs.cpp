@@ -73,8 +73,13 @@ void writeRunJson(const std::string& dir, const std::string& scene, double scale
 void writeModel(const std::string& dir, const gaussians::Trainer& trainer,
                 const std::vector<ClassInfo>& classes) {
   const auto cloud = trainer.toCloud();
-  io::writeGaussianPly(dir + "/model.ply", cloud);
+  io::PlyWriteOptions ply;
+  // A scene without classes trains plain 3DGS: a standard PLY without semantic properties.
+  ply.semantic = !classes.empty();
+  ply.feature_dim = trainer.config().feature_dim;
+  io::writeGaussianPly(dir + "/model.ply", cloud, ply);
   io::savePcd(dir + "/model.pcd", cloud);
+  if (classes.empty()) return;
   const auto semantic = toSemanticCloud(cloud, classes);
   io::savePcd(dir + "/model_semantic.pcd", semantic);
   io::writeSemanticPly(dir + "/model_semantic.ply", semantic);
@@ -143,10 +148,14 @@ TrainingInterrupted::TrainingInterrupted(const std::string& run, int iteration)
                 "; checkpoint written, continue with `sadsplat train ... --resume`"),
       iteration_(iteration) {}
 
-io::Scene loadScene(const std::string& path, double scale) {
+io::Scene loadScene(const std::string& path, double scale, std::ostream* progress) {
   if (isDirectory(path)) {
     io::ImportOptions options;
     options.scale = scale;
+    if (progress != nullptr) {
+      *progress << "importing " << path << " at image scale " << scale
+                << " (--scale; `sadsplat import` writes a scene cache to skip this step)\n";
+    }
     return io::importScene(path, options);
   }
   return io::readSceneCache(path);
@@ -172,7 +181,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                            ? run["train_seconds"].get<double>()
                            : 0.0;
   }
-  const io::Scene scene = loadScene(o.scene, o.scale);
+  const io::Scene scene = loadScene(o.scene, o.scale, o.progress);
   if (o.progress) {
     int labelled = 0, pseudo = 0;
     for (const io::View& v : scene.views) {
@@ -275,7 +284,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
-                  << config.drop << ", P_base " << config.p_base << "), " << stats.num_gaussians
+                  << config.drop << " " << config.drop_rule << ", P_base " << config.p_base
+                  << (config.drop_rule == "balanced"
+                          ? ", pressure " + std::to_string(stats.drop_pressure).substr(0, 6)
+                          : std::string())
+                  << "), " << stats.num_gaussians
                   << " left; of the removed: " << d.removed_low_confidence << " with P_conf < 0.5 ("
                   << d.removed_unseen << " seen by no confidence map), " << d.removed_closed_gate
                   << " with P_nonzero < 0.5\n";
@@ -337,7 +350,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   trainer.saveCheckpoint(checkpoint);
   writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);
   writeModel(o.out, trainer, scene.classes);
-  io::writeClassesJson(o.out + "/classes.json", scene.classes);
+  if (!scene.classes.empty()) io::writeClassesJson(o.out + "/classes.json", scene.classes);
   return total;
 }
 

@@ -23,7 +23,15 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         lambda_l0_from_(c.lambda_l0_from),
         lambda_l0_ramp_(c.lambda_l0_ramp),
         seed_(c.seed),
+        balanced_(c.drop_rule == "balanced"),
         hc_(hc) {}
+
+  at::Tensor l0Derivative(const at::Tensor& log_alpha) const override {
+    if (!structure_) return {};
+    // P_nonzero = sigmoid(log_alpha - beta logit(t)) (hard_concrete_math.h): dP = P (1 - P).
+    const at::Tensor p = probabilityNonZero(log_alpha.detach(), hc_);
+    return p * (1 - p);
+  }
 
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
@@ -63,6 +71,15 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
       confidence =
           semanticConfidence(in.means, in.opacities, in.cameras, in.confidence_maps, &seen);
     }
+    if (semantic_ && balanced_) {
+      // No map saw it: unknown, not ambiguous. It takes the mean confidence of the Gaussians the
+      // maps saw, and 0.5 when no map saw any (a scene without labels or pseudo-labels).
+      const at::Tensor n_seen = seen.sum();
+      const at::Tensor mean_seen = at::where(
+          n_seen > 0, (confidence * seen).sum() / n_seen.clamp_min(1).to(confidence.dtype()),
+          at::full({}, 0.5, confidence.options()));
+      confidence = at::where(seen, confidence, mean_seen.expand_as(confidence));
+    }
     const at::Tensor p_nonzero = probabilityNonZero(in.log_alpha, hc_);
     at::Tensor p_drop = at::full_like(confidence, p_base_);
     if (semantic_) p_drop = p_drop * (1 - confidence);
@@ -75,7 +92,21 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
             .to(in.means.device());
     gaussians::DropDecision d;
     d.keep = u >= p_drop;
+    if (in.max_removed >= 0) {
+      const at::Tensor removed_now = d.keep.logical_not();
+      const std::int64_t n = removed_now.sum().item<std::int64_t>();
+      if (n > in.max_removed) {
+        // Of the drawn ones, those of highest P_drop go (a stable sort: ties by index).
+        const at::Tensor drawn = removed_now.nonzero().squeeze(1);
+        const at::Tensor order =
+            std::get<1>(p_drop.index_select(0, drawn).sort(/*stable=*/true, 0, true));
+        const at::Tensor spared = drawn.index_select(0, order.narrow(0, in.max_removed,
+                                                                     n - in.max_removed));
+        d.keep.index_fill_(0, spared, true);
+      }
+    }
     d.confidence = confidence;
+    d.p_drop = p_drop;
     const at::Tensor removed = d.keep.logical_not();
     d.removed = removed.sum().item<std::int64_t>();
     if (semantic_) {
@@ -94,6 +125,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   double lambda_l0_;
   int lambda_l0_from_, lambda_l0_ramp_;
   std::uint64_t seed_;
+  bool balanced_;
   HardConcreteParams hc_;
 };
 

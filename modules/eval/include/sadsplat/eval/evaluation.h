@@ -35,12 +35,17 @@ struct EvalResult {
   double render_ms = 0;
   std::vector<std::string> views;
   FloaterCensus floaters;
+  int labelled_views = 0;  ///< evaluated views with a label map (the confusion matrix's)
+  bool held_out = false;   ///< the views are the scene's test views (else its training views)
+  std::string miou_note;   ///< why there are no class metrics; empty when there are
 };
 
-/// \brief Renders every test view (views with a label map; all views with labels if the scene
-/// has no test split) and scores it. If `panel_dir` is not empty and the build has OpenCV, writes
-/// one PNG per view there: image | render | ground truth | prediction | error mask.
-/// \throws sadsplat::Error if the scene has no labelled test view
+/// \brief Renders every test view (every view if the scene has no test split) and scores it:
+/// PSNR / SSIM on all of them, the confusion matrix on those with a label map (none: the class
+/// metrics are null and EvalResult::miou_note says why). If `panel_dir` is not empty and the build
+/// has OpenCV, writes one PNG per view there: image | render | ground truth | prediction | error
+/// mask (image | render without classes).
+/// \throws sadsplat::Error if the scene has no view
 EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                     const std::string& panel_dir = "");
 

@@ -37,6 +37,7 @@ struct StepStats {
   std::int64_t num_gaussians = 0;
   std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
   DropDecision drop;         ///< the decision behind `dropped` (tensors undefined if none)
+  double drop_pressure = 1;  ///< the balanced rule's factor on L0 strength and cap (guard)
   /// After the last iteration: Gaussians removed because their evaluation gate is closed (z = 0,
   /// they render nothing).
   std::int64_t removed_closed_gates = 0;

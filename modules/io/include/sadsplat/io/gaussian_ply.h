@@ -22,6 +22,7 @@ namespace io {
 struct PlyWriteOptions {
   int sh_degree = kMaxShDegree;  ///< 0..3; higher coefficients of the points are not written
   bool semantic = true;          ///< write feature_*, log_alpha, confidence, label
+  int feature_dim = kFeatureDim;  ///< 0..kFeatureDim feature_* properties when semantic
 };
 
 /// \brief What readGaussianPly found in a file.

@@ -16,7 +16,21 @@ struct ImportOptions {
   double scale = 1.0;
   /// If > 0, images wider than this are further scaled down to this width.
   int max_width = 0;
+  /// Without split.json: every test_every-th view (sorted by name, from the first) is a test
+  /// view and not trained on; 0 trains on every view. Scenes of fewer than 2 * test_every views
+  /// train on every view.
+  int test_every = 8;
 };
+
+struct ColmapModel;
+
+/// rief The folder of a scene directory's COLMAP model: `dir`/sparse/0 (COLMAP's mapper) or
+/// `dir`/sparse (COLMAP's image_undistorter), whichever holds cameras.bin or cameras.txt.
+/// 	hrows sadsplat::Error naming both layouts when neither exists
+std::string findColmapModel(const std::string& dir);
+
+/// rief The split of a scene without split.json (ImportOptions::test_every).
+SplitInfo defaultSplit(const ColmapModel& model, int test_every);
 
 /// \brief Whether this build can import scene directories (it has OpenCV).
 bool haveSceneImport();
@@ -26,8 +40,10 @@ bool haveSceneImport();
 /// Images are decoded, undistorted to a pinhole camera (SIMPLE_RADIAL, RADIAL, OPENCV), and
 /// resized; label maps (labels/<image stem>.png: 8-bit class ids with 255 = ignore, or colour
 /// PNGs mapped through the class colours with black = ignore unless a class is black) are
-/// warped the same way with nearest-neighbour sampling. split.json is optional: without it every
-/// view trains and every view with a label map is labelled.
+/// warped the same way with nearest-neighbour sampling. classes.json is optional: without it the
+/// scene has no classes (plain 3DGS) and may have no label maps. split.json is optional: without
+/// it ImportOptions::test_every decides the test views and every training view with a label map
+/// is labelled.
 /// \throws sadsplat::Error naming the file, the field and the expectation
 Scene importScene(const std::string& dir, const ImportOptions& options = {});
 

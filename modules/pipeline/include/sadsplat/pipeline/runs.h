@@ -21,8 +21,9 @@
 namespace sadsplat {
 namespace pipeline {
 
-/// \brief Loads a scene directory (imported at `scale`, needs OpenCV) or a scene cache file.
-io::Scene loadScene(const std::string& path, double scale = 0.5);
+/// \brief Loads a scene directory (imported at `scale`, needs OpenCV; said on `progress` when
+/// not null) or a scene cache file.
+io::Scene loadScene(const std::string& path, double scale = 0.5, std::ostream* progress = nullptr);
 
 /// \brief Options of a training run.
 struct TrainRunOptions {
