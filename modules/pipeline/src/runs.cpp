@@ -449,7 +449,8 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   out << "\noutputs: " << o.out << " (model.ply, metrics.json, panels/)\n";
   return 0;
 #else
-  throw Error("<demo>", "build", "a sadsplat build with OpenCV (the demo generates its scene)");
+  throw Error("<demo>", "build", "a sadsplat build with OpenCV (the demo generates its scene)",
+              "a build without OpenCV");
 #endif
 }
 
