@@ -86,14 +86,17 @@ scene_cache() {
   local scene="$1" size="${2:-800x450}" bin="${3:-$SADSPLAT_BIN}"
   local cache="$SCENES_DIR/${scene}_${size}.cache"
   mkdir -p "$SCENES_DIR"
+  # One maker per cache: calls running side by side wait for it (flock).
+  local lock; exec {lock}> "$cache.lock"; flock "$lock"
   if [ ! -f "$cache" ]; then
     local args
     if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
     else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
     "$bin" synth "${args[@]}" --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" \
-      > "$OUT/synth_${scene}_$size.log" 2>&1 || { echo "synth $scene failed" >&2; return 1; }
+      > "$OUT/synth_${scene}_$size.log" 2>&1 || { echo "synth $scene failed" >&2; flock -u "$lock"; return 1; }
     mv "$cache.part" "$cache"
   fi
+  flock -u "$lock"; exec {lock}>&-
   echo "$cache"
 }
 
@@ -101,11 +104,13 @@ pl_cache() {
   local cache="$1" bin="${2:-$SADSPLAT_BIN}"; shift $(( $# < 2 ? $# : 2 ))
   local tag=""; [ $# -gt 0 ] && tag="_$(echo "$*" | md5sum | cut -c1-8)"
   local pl="${cache%.cache}_pl$tag.cache"
+  local lock; exec {lock}> "$pl.lock"; flock "$lock"
   if [ ! -f "$pl" ]; then
     "$bin" pseudo-labels "$cache" --out "$pl.part" "$@" > "$OUT/pseudo_labels_$(basename "${pl%.cache}").log" 2>&1 ||
-      { echo "pseudo-labels of $cache failed" >&2; return 1; }
+      { echo "pseudo-labels of $cache failed" >&2; flock -u "$lock"; return 1; }
     mv "$pl.part" "$pl"
   fi
+  flock -u "$lock"; exec {lock}>&-
   echo "$pl"
 }
 

@@ -272,6 +272,7 @@ TEST_P(TrainerOnDevice, RecoveryFoldsTheGatesIntoTheOpacitiesAndTrainsWithoutThe
   TrainConfig c = small(20);
   c.recovery_iterations = 5;
   c.lr_opacity = 0;  // the opacities change only by the folding
+  c.drop_rule = "paper";  // the L0 term is in the loss
   Trainer trainer(scene_, c);
   auto gates = std::make_shared<ThirdsGates>();
   trainer.setDropStrategy(gates);
@@ -367,6 +368,7 @@ TEST_F(TrainerTest, L0WeightsFollowTheContributionsFromTheScheduleStartOnEveryDr
   c.l0_importance = 1.0;
   c.lambda_l0_from = 3;
   c.drop_interval = 2;
+  c.drop_rule = "paper";  // the weights reach the L0 term of the loss
   Trainer trainer(scene_, c);
   auto recorder = std::make_shared<L0WeightRecorder>();
   trainer.setDropStrategy(recorder);
@@ -397,7 +399,9 @@ TEST_F(TrainerTest, L0WeightsFollowTheContributionsFromTheScheduleStartOnEveryDr
 }
 
 TEST_F(TrainerTest, WithoutL0ImportanceTheL0TermGetsNoWeights) {
-  Trainer trainer(scene_, small(3));
+  TrainConfig c = small(3);
+  c.drop_rule = "paper";  // the L0 term of the loss
+  Trainer trainer(scene_, c);
   auto recorder = std::make_shared<L0WeightRecorder>();
   trainer.setDropStrategy(recorder);
   for (int it = 0; it < 3; ++it) trainer.step();
@@ -410,6 +414,7 @@ TEST_F(TrainerTest, ResumeBetweenL0WeightUpdatesIsExact) {
   c.l0_importance = 2.0;
   c.lambda_l0_from = 2;
   c.drop_interval = 4;
+  c.drop_rule = "paper";  // the weights reach the L0 term of the loss
   auto run = [&](Trainer& t, int steps) {
     auto recorder = std::make_shared<L0WeightRecorder>();
     t.setDropStrategy(recorder);

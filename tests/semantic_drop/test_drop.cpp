@@ -5,10 +5,12 @@
 #include <torch/csrc/autograd/autograd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
+#include "sadsplat/gaussians/image_metrics.h"
 
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
@@ -133,6 +135,7 @@ TEST(DropStrategy, DecisionCountsTheReasonsOfTheRemovals) {
   gaussians::TrainConfig c;
   c.drop = "full";
   c.p_base = 1.5;
+  c.drop_rule = "paper";  // unseen Gaussians have confidence 0
   const gaussians::DropDecision d = makeDropStrategy(c)->decide(in, 500);
   EXPECT_TRUE(d.keep.slice(0, 0, 200).all().item<bool>());
   EXPECT_FALSE(d.keep.slice(0, 200, 400).any().item<bool>());
@@ -252,6 +255,124 @@ TEST(DropStrategy, WeightedRegularisationIsTheMeanOfWeightTimesPNonZero) {
   drop->regularisation(la, 0, at::tensor({3.0f, 1.0f})).backward();
   EXPECT_NEAR(la.grad()[0].item<double>(), 3 * la.grad()[1].item<double>(), 1e-7);
   EXPECT_THROW(drop->regularisation(log_alpha, 0, at::ones({3})), Error);
+}
+
+
+// The balanced rule: a Gaussian that no confidence map sees is unknown, not ambiguous. It takes
+// the mean confidence of the Gaussians the maps see, and 0.5 when there are no maps at all.
+TEST(DropStrategy, BalancedRuleGivesUnseenGaussiansTheMeanConfidence) {
+  gaussians::RasterCamera cam;
+  cam.width = cam.height = 4;
+  cam.fx = cam.fy = 4;
+  cam.cx = cam.cy = 2;
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  gaussians::DropInputs in;
+  in.means = at::zeros({400, 3}, opts);
+  in.means.select(1, 2).slice(0, 0, 200).fill_(2.0f);     // seen, on a confidence-0.8 map
+  in.means.select(1, 2).slice(0, 200, 400).fill_(-2.0f);  // behind the camera: unseen
+  in.opacities = at::ones({400}, opts);
+  in.log_alpha = at::full({400}, -20.0f, opts);  // closed gates: P_drop = P_base (1 - P_conf)
+  in.cameras = {cam};
+  in.confidence_maps = {at::full({4, 4}, 0.8f, opts)};
+  gaussians::TrainConfig c;
+  c.drop = "full";
+  ASSERT_EQ(c.drop_rule, "balanced");  // the default
+  gaussians::DropDecision d = makeDropStrategy(c)->decide(in, 500);
+  EXPECT_TRUE(at::allclose(d.confidence, at::full({400}, 0.8f, opts)));
+  EXPECT_TRUE(at::allclose(d.p_drop, at::full({400}, 0.2f, opts), 1e-5, 1e-6));
+  EXPECT_EQ(d.removed_unseen, (d.keep.slice(0, 200, 400).logical_not()).sum().item<int>());
+  // No maps: every Gaussian 0.5.
+  in.cameras.clear();
+  in.confidence_maps.clear();
+  d = makeDropStrategy(c)->decide(in, 500);
+  EXPECT_TRUE(at::allclose(d.confidence, at::full({400}, 0.5f, opts)));
+  // The paper's rule: confidence 0 where no map sees, P_drop = P_base.
+  c.drop_rule = "paper";
+  d = makeDropStrategy(c)->decide(in, 500);
+  EXPECT_EQ(d.confidence.abs().max().item<float>(), 0.0f);
+  EXPECT_EQ(d.removed, 400);
+}
+
+// A cap on one event: of the drawn Gaussians, those of highest P_drop go, the others stay.
+TEST(DropStrategy, ACappedEventRemovesTheHighestDropProbabilitiesFirst) {
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  gaussians::DropInputs in;
+  const int n = 1000;
+  in.means = at::zeros({n, 3}, opts);
+  in.opacities = at::ones({n}, opts);
+  // log_alpha from -12 to -2: P_nonzero rises with the index, P_drop falls.
+  in.log_alpha = at::linspace(-12, -2, n, opts);
+  gaussians::TrainConfig c;
+  c.drop = "structure";
+  c.p_base = 1.0;
+  const auto drop = makeDropStrategy(c);
+  const gaussians::DropDecision all = drop->decide(in, 500);
+  ASSERT_GT(all.removed, 300);
+  in.max_removed = 100;
+  const gaussians::DropDecision capped = drop->decide(in, 500);
+  EXPECT_EQ(capped.removed, 100);
+  EXPECT_EQ(capped.keep.logical_not().sum().item<std::int64_t>(), 100);
+  // Everything removed under the cap was drawn without it, and has a P_drop at least that of
+  // every drawn Gaussian the cap spared.
+  EXPECT_FALSE((capped.keep.logical_not() & all.keep).any().item<bool>());
+  const at::Tensor removed_p = capped.p_drop.masked_select(capped.keep.logical_not());
+  const at::Tensor spared_p = capped.p_drop.masked_select(capped.keep & all.keep.logical_not());
+  EXPECT_GE(removed_p.min().item<float>(), spared_p.max().item<float>());
+}
+
+struct CollapseRun {
+  std::int64_t gaussians = 0;
+  double psnr = 0;  // mean over every view of the scene, rendered as evaluation renders
+};
+
+// The tiny scene with the drop's pressure far past what it can bear (lambda_l0 = 5, gates that
+// learn fast, drops every 25 iterations): the regime in which the paper's rule empties a model.
+CollapseRun trainUnderPressure(const std::string& drop, const std::string& rule) {
+  const io::Scene scene =
+      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
+  gaussians::TrainConfig c;
+  c.iterations = 200;
+  c.feature_dim = 8;
+  c.densify_from = 100000;
+  c.checkpoint_interval = 0;
+  c.drop = drop;
+  c.drop_rule = rule;
+  c.drop_interval = 25;
+  c.lambda_l0 = 5.0;
+  c.lr_log_alpha = 0.1;
+  gaussians::Trainer trainer(scene, c);
+  trainer.setDropStrategy(makeDropStrategy(c));
+  for (int i = 0; i < c.iterations; ++i) trainer.step();
+  CollapseRun run;
+  run.gaussians = trainer.numGaussians();
+  for (const io::View& v : scene.views) {
+    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
+                                        {v.camera.height, v.camera.width, 3}, at::kByte)
+                              .to(at::kFloat)
+                              .div(255);
+    run.psnr += gaussians::psnr(trainer.renderView(v).rgb.clamp(0, 1), gt) / scene.views.size();
+  }
+  return run;
+}
+
+TEST(DropStrategy, TheBalancedRuleKeepsAModelThePapersRuleEmpties) {
+  const CollapseRun net1 = trainUnderPressure("none", "balanced");
+  const CollapseRun paper = trainUnderPressure("full", "paper");
+  const CollapseRun balanced = trainUnderPressure("full", "balanced");
+  std::printf("Net-1 %lld Gaussians %.2f dB; paper %lld %.2f dB; balanced %lld %.2f dB\n",
+              static_cast<long long>(net1.gaussians), net1.psnr,
+              static_cast<long long>(paper.gaussians), paper.psnr,
+              static_cast<long long>(balanced.gaussians), balanced.psnr);
+  // The old rule's collapse, reproduced: under a tenth of the model left, the image lost.
+  EXPECT_LT(paper.gaussians, net1.gaussians / 10) << paper.gaussians << " of " << net1.gaussians;
+  EXPECT_LT(paper.psnr, net1.psnr - 3) << "paper " << paper.psnr << " Net-1 " << net1.psnr;
+  // The balanced rule at its defaults (lambda_l0 is the paper's and does not apply): at most
+  // drop_max_fraction per event over 7 events keeps at least 0.9^7 = 48 % of the model, and the
+  // image stays within 1 dB of Net-1's.
+  EXPECT_GE(balanced.gaussians, net1.gaussians * 0.47) << balanced.gaussians << " of "
+                                                       << net1.gaussians;
+  EXPECT_LT(balanced.gaussians, net1.gaussians);
+  EXPECT_GT(balanced.psnr, net1.psnr - 1) << "balanced " << balanced.psnr << " Net-1 " << net1.psnr;
 }
 
 }  // namespace

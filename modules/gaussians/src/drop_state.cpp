@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 #include <tuple>
 
@@ -182,8 +183,10 @@ void DropState::resized(const RowChange& change) {
 void DropState::save(TensorArchive& a) const {
   a.tensors["confidence"] = confidence_;
   a.tensors["l0_weights"] = l0_weights_;
-  a.tensors["drop_guard"] =
-      at::tensor(std::vector<double>(guard_.begin(), guard_.end()), at::kDouble);
+  // The archive stores no doubles: their bits as int64, so that a resumed run continues exactly.
+  std::vector<std::int64_t> bits(guard_.size());
+  std::memcpy(bits.data(), guard_.data(), sizeof(double) * guard_.size());
+  a.tensors["drop_guard"] = at::tensor(bits, at::kLong);
 }
 
 void DropState::load(const TensorArchive& a, const std::string& path, const at::Device& device) {
@@ -194,11 +197,15 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
   // Checkpoints written before the balanced rule have no guard state: a fresh guard.
   guard_ = {1.0, -1.0, 0.0, 0.0};
   if (a.tensors.count("drop_guard")) {
-    const at::Tensor g = a.tensor("drop_guard", path).to(at::kCPU).to(at::kDouble).contiguous();
-    if (g.numel() != 4) {
-      throw Error(path, "drop_guard", "4 values", std::to_string(g.numel()) + " values");
+    const at::Tensor g = a.tensor("drop_guard", path).to(at::kCPU).contiguous();
+    if (g.numel() != 4 || g.scalar_type() != at::kLong) {
+      throw Error(path, "drop_guard", "4 int64 values (the guard's doubles)",
+                  std::to_string(g.numel()) + " values of " + std::string(g.dtype().name()));
     }
-    for (int k = 0; k < 4; ++k) guard_[k] = g.data_ptr<double>()[k];
+    std::memcpy(guard_.data(), g.data_ptr<std::int64_t>(), sizeof(double) * guard_.size());
+    if (!(guard_[0] > 0 && guard_[0] <= 1)) {
+      throw Error(path, "drop_guard pressure", "a value in (0, 1]", std::to_string(guard_[0]));
+    }
   }
 }
 
