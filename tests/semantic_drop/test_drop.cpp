@@ -367,9 +367,9 @@ TEST(DropStrategy, TheBalancedRuleKeepsAModelThePapersRuleEmpties) {
   EXPECT_LT(paper.gaussians, net1.gaussians / 10) << paper.gaussians << " of " << net1.gaussians;
   EXPECT_LT(paper.psnr, net1.psnr - 3) << "paper " << paper.psnr << " Net-1 " << net1.psnr;
   // The balanced rule at its defaults (lambda_l0 is the paper's and does not apply): at most
-  // drop_max_fraction per event over 7 events keeps at least 0.9^7 = 48 % of the model, and the
+  // drop_max_fraction per event over 7 events keeps at least 0.85^7 = 32 % of the model, and the
   // image stays within 1 dB of Net-1's.
-  EXPECT_GE(balanced.gaussians, net1.gaussians * 0.47) << balanced.gaussians << " of "
+  EXPECT_GE(balanced.gaussians, net1.gaussians * 0.3) << balanced.gaussians << " of "
                                                        << net1.gaussians;
   EXPECT_LT(balanced.gaussians, net1.gaussians);
   EXPECT_GT(balanced.psnr, net1.psnr - 1) << "balanced " << balanced.psnr << " Net-1 " << net1.psnr;

@@ -64,8 +64,12 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
   if (strength == 0 || !grad.defined()) return;
   const at::Tensor direction = drop_->l0Derivative(la.value);
   if (!direction.defined()) return;
-  // The gates the losses reached this step (on every rank: the gradient is all-reduced).
-  const at::Tensor reached = (grad != 0).to(grad.dtype());
+  // The Gaussians the losses reached this step: visible, with an open gate sample (their
+  // opacity has a gradient; all-reduced, so every rank sees the same set). A gate sample clamped
+  // at 1 gives log_alpha no gradient, but the L0 force acts on it as in the paper's rule.
+  const at::Tensor opacity_grad = params["opacity"].value.grad();
+  if (!opacity_grad.defined()) return;
+  const at::Tensor reached = (opacity_grad != 0).to(grad.dtype());
   const at::Tensor rgb_force = (grad.abs() * reached).sum();
   const at::Tensor l0_force = (direction * reached).sum();
   // Both sums are over the same gates, so their ratio is the ratio of the means.

@@ -45,8 +45,9 @@ class DropState {
   // rule, whose L0 force is added to the gradient by addL0Gradient instead).
   at::Tensor regularisation(const ParameterStore& params, int it) const;
   // The balanced rule's L0 force (TrainConfig::drop_rule), after the backward (and the
-  // all-reduce) of iteration `it`: on each gate whose gradient the losses reached, l0_strength x
-  // pressure x (the mean |gradient| over those gates) x dP_nonzero / mean dP_nonzero over them.
+  // all-reduce) of iteration `it`: on each Gaussian the losses reached (its opacity has a
+  // gradient), l0_strength x pressure x (the mean |log_alpha gradient| over those Gaussians) x
+  // dP_nonzero / (the mean dP_nonzero over them).
   void addL0Gradient(ParameterStore& params, int it) const;
   // The balanced rule's guard: the training RGB loss read after iteration `done` (losses are
   // read on a fixed schedule, so a resumed run sees the readings an uninterrupted one does).

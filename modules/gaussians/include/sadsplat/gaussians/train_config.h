@@ -104,8 +104,8 @@ struct TrainConfig {
   /// gaussians/contribution.h). 0 = none; in [0, 1).
   double recovery_prune = 0.0;
   /// How the L0 pressure and the drop events are set (docs/GUIDE.md, "The drop rule"):
-  /// "balanced" (default, not the paper): the L0 force on each gate that the RGB loss reached
-  /// this step is l0_strength x the mean RGB force on those gates (no L0 term in the loss, so
+  /// "balanced" (default, not the paper): the L0 force on each gate of a Gaussian the losses
+  /// reached this step is l0_strength x the mean loss force on those gates (no L0 term in the loss, so
   /// image size, Gaussian count, view count and loss level cancel); one drop event removes at
   /// most drop_max_fraction of the Gaussians (those of highest P_drop); when the training RGB loss
   /// over the half interval before a drop event exceeds that before the previous event by more
@@ -115,7 +115,7 @@ struct TrainConfig {
   /// P_learned with P_conf = 0 where no map sees a Gaussian, no cap, no guard.
   std::string drop_rule = "balanced";
   double l0_strength = 0.5;
-  double drop_max_fraction = 0.1;
+  double drop_max_fraction = 0.15;
   double drop_guard = 0.05;
 
   /// \brief The same training for a global batch of `views` training views per step (ranks x
