@@ -114,7 +114,7 @@ struct TrainConfig {
   /// "paper": L_L0 = lambda_l0 x mean P_nonzero in the loss, P_drop = P_base (1 - P_conf)
   /// P_learned with P_conf = 0 where no map sees a Gaussian, no cap, no guard.
   std::string drop_rule = "balanced";
-  double l0_strength = 0.5;
+  double l0_strength = 1.0;
   double drop_max_fraction = 0.15;
   double drop_guard = 0.05;
 
