@@ -8,6 +8,8 @@ packages=(
   libtorch-dev libopencv-dev libgtest-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   # SPZ version 4 (zstd) and PlayCanvas' SOG (WebP images) in the web splat formats.
   libzstd-dev libwebp-dev
+  # Real photos: COLMAP for `sadsplat sfm`, libexif for the photos' GPS (the georeference).
+  colmap libexif-dev
   libopen3d-dev python3 python3-open3d
   # gloo's headers: LibTorch's c10d Gloo process group (data-parallel training, --nproc).
   libgloo-dev

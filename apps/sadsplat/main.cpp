@@ -17,6 +17,7 @@ namespace cli {
 std::vector<std::unique_ptr<Command>> allCommands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(makeInfoCommand());
+  commands.push_back(makeSfmCommand());
   commands.push_back(makeImportCommand());
   commands.push_back(makeConvertCommand());
   commands.push_back(makeExtractCommand());

@@ -9,6 +9,7 @@ namespace sadsplat {
 namespace cli {
 
 std::unique_ptr<Command> makeInfoCommand();
+std::unique_ptr<Command> makeSfmCommand();
 std::unique_ptr<Command> makeImportCommand();
 std::unique_ptr<Command> makeConvertCommand();
 std::unique_ptr<Command> makeExtractCommand();

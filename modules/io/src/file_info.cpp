@@ -109,6 +109,18 @@ void describeScene(std::ostream& out, const Scene& scene) {
   }
   out << "sparse points: " << scene.points.size() << "\n";
   describeBounds(out, scene.points, [](const ScenePoint& p) { return p.xyz; });
+  if (scene.georeference) {
+    const Georeference& g = *scene.georeference;
+    std::ostringstream geo;
+    geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude
+        << ", " << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
+        << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; "
+        << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit, RMS "
+        << g.rms_metres << " m\n";
+    out << geo.str();
+  } else {
+    out << "georeference: none (an SfM frame: no metres, no up)\n";
+  }
   // Kept pseudo-label pixels per class, over the views that have pseudo-labels.
   std::vector<std::size_t> kept_pixels(scene.classes.size(), 0);
   std::size_t pseudo_views = 0, targets = 0, kept_targets = 0, pixels = 0, kept = 0;

@@ -211,6 +211,12 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
     }
     payload.putChunk("PNTS", c);
   }
+  if (scene.georeference) {
+    // Older readers skip the chunk (unknown chunks are skipped): the version stays.
+    ByteWriter c;
+    c.putString(georeferenceToJson(*scene.georeference));
+    payload.putChunk("GEOR", c);
+  }
   const std::string& body = payload.bytes();
   ByteWriter header;
   for (char ch : kMagic) header.put<char>(ch);
@@ -358,6 +364,8 @@ Scene readSceneCache(const std::string& path) {
         }
         for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
       }
+    } else if (tag == "GEOR") {
+      scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
     } else if (tag == "PSLB") {
       const std::string name = c.getString("view name");
       if (scene.views.empty() || scene.views.back().name != name) {

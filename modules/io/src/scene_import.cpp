@@ -7,6 +7,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 
 #if SADSPLAT_HAVE_OPENCV
@@ -303,6 +304,10 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     scene.views.push_back(std::move(view));
   }
 
+  if (pathExists(dir + "/georeference.json")) {
+    scene.georeference = georeferenceFromJson(readWholeFile(dir + "/georeference.json"),
+                                              dir + "/georeference.json");
+  }
   scene.points.reserve(model.points.size());
   for (const auto& p : model.points) {
     ScenePoint sp;

@@ -351,6 +351,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   writeRunJson(o.out, o.scene, o.scale, config.device, trainer.iteration(), total);
   writeModel(o.out, trainer, scene.classes);
   if (!scene.classes.empty()) io::writeClassesJson(o.out + "/classes.json", scene.classes);
+  if (scene.georeference) {
+    // The model's frame: east-north-up metres around the origin (for GIS outputs and viewers).
+    writeText(o.out + "/georeference.json", io::georeferenceToJson(*scene.georeference));
+  }
   return total;
 }
 

@@ -5,10 +5,12 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sadsplat/common/class_info.h"
+#include "sadsplat/io/georeference.h"
 
 namespace sadsplat {
 namespace io {
@@ -102,6 +104,9 @@ struct Scene {
   std::vector<ClassInfo> classes;
   std::vector<View> views;  ///< sorted by name
   std::vector<ScenePoint> points;
+  /// Where the scene is on the Earth (its frame is then east-north-up metres); none for scenes
+  /// without GPS (an arbitrary SfM frame).
+  std::optional<Georeference> georeference;
 };
 
 /// \brief The class list and split of a scene directory, readable without OpenCV.

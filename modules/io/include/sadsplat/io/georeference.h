@@ -1,0 +1,81 @@
+#pragma once
+/// \file georeference.h
+/// \brief Where a scene is on the Earth: photo GPS positions (EXIF), WGS84 <-> local east-north-up
+/// metres, and the similarity that takes an SfM reconstruction's arbitrary frame into that local
+/// frame (metres, z up). No OpenCV, no LibTorch.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sadsplat {
+namespace io {
+
+/// \brief A WGS84 position: degrees, metres above the ellipsoid (EXIF altitudes are usually above
+/// sea level; the difference is a constant offset of the local frame's z, not a distortion).
+struct GeoPosition {
+  double latitude = 0;   ///< degrees, north positive
+  double longitude = 0;  ///< degrees, east positive
+  double altitude = 0;   ///< metres
+};
+
+/// \brief The GPS position in a photo's EXIF (GPSLatitude/Longitude/Altitude and their Ref tags),
+/// or nothing when it has none. Needs libexif (SADSPLAT_HAVE_EXIF); without it always nothing.
+/// \throws sadsplat::Error naming the file when its GPS tags are present but malformed (a latitude
+/// beyond +-90 degrees, a rational with a zero denominator)
+std::optional<GeoPosition> readExifGps(const std::string& path);
+/// \brief Whether this build reads EXIF (it has libexif).
+bool haveExif();
+
+/// \brief A JPEG's bytes with an EXIF APP1 segment holding `gps` inserted after the SOI marker
+/// (TIFF little endian, IFD0 with a GPS IFD pointer; what cameras write). For test data and
+/// `synth`'s photos.
+/// \throws sadsplat::Error when `jpeg` does not start with an SOI marker
+std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpeg,
+                                           const GeoPosition& gps);
+
+/// \brief Local east-north-up metres around `origin` (WGS84 ellipsoid, exact through ECEF).
+std::array<double, 3> toEnu(const GeoPosition& p, const GeoPosition& origin);
+/// \brief The inverse of toEnu.
+GeoPosition fromEnu(const std::array<double, 3>& enu, const GeoPosition& origin);
+
+/// \brief EPSG code of the WGS84 / UTM zone that holds `p` (326zz north, 327zz south; the
+/// standard 6-degree zones, without the Norway / Svalbard exceptions).
+int utmEpsg(const GeoPosition& p);
+
+/// \brief A similarity x' = scale * R x + t.
+struct Similarity {
+  double scale = 1;
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< row-major
+  std::array<double, 3> translation{0, 0, 0};
+  std::array<double, 3> apply(const std::array<double, 3>& x) const;
+};
+
+/// \brief The similarity from `from` to `to` (point pairs) with the least squared error (Umeyama
+/// 1991), robust to outliers: RANSAC over triples, inliers within `inlier_metres` of their target,
+/// refit on the largest inlier set. Needs >= 3 pairs not on one line.
+/// \param[out] inliers if not null, which pairs are inliers
+/// \throws sadsplat::Error when there are fewer than 3 pairs or they are degenerate
+Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
+                         const std::vector<std::array<double, 3>>& to, double inlier_metres,
+                         std::vector<bool>* inliers = nullptr);
+
+/// \brief A scene's georeference: its frame is east-north-up metres around `origin`.
+struct Georeference {
+  GeoPosition origin;
+  int epsg_utm = 0;          ///< the UTM zone of the origin, for GIS outputs
+  Similarity sfm_to_local;   ///< how the SfM frame was taken into the local frame
+  int photos_with_gps = 0;   ///< photos whose GPS took part in the fit
+  int inliers = 0;           ///< of those, within the inlier distance
+  double rms_metres = 0;     ///< RMS distance of the inliers' camera centres to their GPS
+};
+
+/// \brief georeference.json text (every field above).
+std::string georeferenceToJson(const Georeference& g);
+/// \brief Reads georeference.json text.
+/// \throws sadsplat::Error naming `origin` and the field
+Georeference georeferenceFromJson(const std::string& text, const std::string& origin);
+
+}  // namespace io
+}  // namespace sadsplat

@@ -1,0 +1,368 @@
+#include "sadsplat/io/georeference.h"
+
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/filesystem.h"
+
+#if SADSPLAT_HAVE_EXIF
+#include <libexif/exif-data.h>
+#endif
+
+namespace sadsplat {
+namespace io {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kA = 6378137.0;                // WGS84 semi-major axis
+constexpr double kF = 1.0 / 298.257223563;      // WGS84 flattening
+constexpr double kE2 = kF * (2 - kF);           // first eccentricity squared
+
+double radians(double deg) { return deg * kPi / 180.0; }
+double degrees(double rad) { return rad * 180.0 / kPi; }
+
+Eigen::Vector3d toEcef(const GeoPosition& p) {
+  const double lat = radians(p.latitude), lon = radians(p.longitude);
+  const double n = kA / std::sqrt(1 - kE2 * std::sin(lat) * std::sin(lat));
+  return {(n + p.altitude) * std::cos(lat) * std::cos(lon),
+          (n + p.altitude) * std::cos(lat) * std::sin(lon),
+          (n * (1 - kE2) + p.altitude) * std::sin(lat)};
+}
+
+GeoPosition fromEcef(const Eigen::Vector3d& x) {
+  // Bowring's iteration to convergence (sub-millimetre after a few steps).
+  const double lon = std::atan2(x.y(), x.x());
+  const double r = std::hypot(x.x(), x.y());
+  double lat = std::atan2(x.z(), r * (1 - kE2)), alt = 0;
+  for (int k = 0; k < 10; ++k) {
+    const double n = kA / std::sqrt(1 - kE2 * std::sin(lat) * std::sin(lat));
+    alt = r / std::cos(lat) - n;
+    lat = std::atan2(x.z(), r * (1 - kE2 * n / (n + alt)));
+  }
+  return {degrees(lat), degrees(lon), alt};
+}
+
+// Rows: east, north, up at `origin`, in ECEF.
+Eigen::Matrix3d enuBasis(const GeoPosition& origin) {
+  const double lat = radians(origin.latitude), lon = radians(origin.longitude);
+  Eigen::Matrix3d m;
+  m << -std::sin(lon), std::cos(lon), 0,  //
+      -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),  //
+      std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat);
+  return m;
+}
+
+// Umeyama's least-squares similarity of the pairs in `idx`.
+bool umeyama(const std::vector<std::array<double, 3>>& from,
+             const std::vector<std::array<double, 3>>& to, const std::vector<int>& idx,
+             Similarity* out) {
+  const int n = static_cast<int>(idx.size());
+  Eigen::Vector3d mf = Eigen::Vector3d::Zero(), mt = Eigen::Vector3d::Zero();
+  for (int i : idx) {
+    mf += Eigen::Vector3d(from[i].data());
+    mt += Eigen::Vector3d(to[i].data());
+  }
+  mf /= n;
+  mt /= n;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  double var_from = 0;
+  for (int i : idx) {
+    const Eigen::Vector3d a = Eigen::Vector3d(from[i].data()) - mf;
+    const Eigen::Vector3d b = Eigen::Vector3d(to[i].data()) - mt;
+    cov += b * a.transpose();
+    var_from += a.squaredNorm();
+  }
+  cov /= n;
+  var_from /= n;
+  if (!(var_from > 1e-18)) return false;
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d s = Eigen::Matrix3d::Identity();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) s(2, 2) = -1;
+  const Eigen::Vector3d sv = svd.singularValues();
+  // Points on one line: the second singular value vanishes and the rotation about it is free.
+  if (!(sv(1) > 1e-9 * std::max(1.0, sv(0)))) return false;
+  const Eigen::Matrix3d R = svd.matrixU() * s * svd.matrixV().transpose();
+  const double scale = (sv.asDiagonal() * s).trace() / var_from;
+  const Eigen::Vector3d t = mt - scale * R * mf;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out->rotation[3 * r + c] = R(r, c);
+    out->translation[r] = t(r);
+  }
+  out->scale = scale;
+  return std::isfinite(scale) && scale > 0;
+}
+
+double distance(const Similarity& s, const std::array<double, 3>& a,
+                const std::array<double, 3>& b) {
+  const auto x = s.apply(a);
+  return std::sqrt((x[0] - b[0]) * (x[0] - b[0]) + (x[1] - b[1]) * (x[1] - b[1]) +
+                   (x[2] - b[2]) * (x[2] - b[2]));
+}
+
+#if SADSPLAT_HAVE_EXIF
+// Degrees from an EXIF triple of rationals (degrees, minutes, seconds).
+double exifDegrees(const std::string& path, ExifEntry* e, ExifByteOrder order, const char* tag) {
+  if (e->format != EXIF_FORMAT_RATIONAL || e->components < 1) {
+    throw Error(path, std::string("EXIF ") + tag, "rationals (degrees, minutes, seconds)",
+                "format " + std::to_string(e->format));
+  }
+  double value = 0, unit = 1;
+  const unsigned size = exif_format_get_size(e->format);
+  for (unsigned k = 0; k < std::min<unsigned>(3, e->components); ++k) {
+    const ExifRational r = exif_get_rational(e->data + k * size, order);
+    if (r.denominator == 0) {
+      throw Error(path, std::string("EXIF ") + tag, "rationals with a non-zero denominator",
+                  std::to_string(r.numerator) + "/0");
+    }
+    value += unit * r.numerator / r.denominator;
+    unit /= 60;
+  }
+  return value;
+}
+#endif
+
+}  // namespace
+
+bool haveExif() { return SADSPLAT_HAVE_EXIF != 0; }
+
+std::optional<GeoPosition> readExifGps(const std::string& path) {
+#if SADSPLAT_HAVE_EXIF
+  requireRegularFile(path);
+  ExifData* data = exif_data_new_from_file(path.c_str());
+  if (data == nullptr) return std::nullopt;
+  struct Release {
+    ExifData* d;
+    ~Release() { exif_data_unref(d); }
+  } release{data};
+  const ExifByteOrder order = exif_data_get_byte_order(data);
+  ExifContent* gps = data->ifd[EXIF_IFD_GPS];
+  const auto entry = [&](int tag) {
+    return gps ? exif_content_get_entry(gps, static_cast<ExifTag>(tag)) : nullptr;
+  };
+  ExifEntry* lat = entry(0x0002);
+  ExifEntry* lon = entry(0x0004);
+  if (lat == nullptr || lon == nullptr) return std::nullopt;
+  GeoPosition p;
+  p.latitude = exifDegrees(path, lat, order, "GPSLatitude");
+  p.longitude = exifDegrees(path, lon, order, "GPSLongitude");
+  ExifEntry* lat_ref = entry(0x0001);
+  ExifEntry* lon_ref = entry(0x0003);
+  if (lat_ref && lat_ref->size > 0 && lat_ref->data[0] == 'S') p.latitude = -p.latitude;
+  if (lon_ref && lon_ref->size > 0 && lon_ref->data[0] == 'W') p.longitude = -p.longitude;
+  if (ExifEntry* alt = entry(0x0006)) {
+    if (alt->format == EXIF_FORMAT_RATIONAL && alt->components >= 1) {
+      const ExifRational r = exif_get_rational(alt->data, order);
+      if (r.denominator != 0) p.altitude = static_cast<double>(r.numerator) / r.denominator;
+    }
+    ExifEntry* alt_ref = entry(0x0005);
+    if (alt_ref && alt_ref->size > 0 && alt_ref->data[0] == 1) p.altitude = -p.altitude;
+  }
+  if (!(std::abs(p.latitude) <= 90) || !(std::abs(p.longitude) <= 180)) {
+    throw Error(path, "EXIF GPS position", "latitude within +-90, longitude within +-180 degrees",
+                std::to_string(p.latitude) + ", " + std::to_string(p.longitude));
+  }
+  return p;
+#else
+  (void)path;
+  return std::nullopt;
+#endif
+}
+
+std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpeg,
+                                           const GeoPosition& gps) {
+  if (jpeg.size() < 2 || jpeg[0] != 0xFF || jpeg[1] != 0xD8) {
+    throw Error("<jpeg>", "start", "a JPEG SOI marker (FF D8)", "other bytes");
+  }
+  // TIFF, little endian: header, IFD0 (1 entry: GPS IFD pointer), GPS IFD (7 entries), values.
+  std::vector<unsigned char> t;
+  const auto u16 = [&](std::uint32_t v) {
+    t.push_back(v & 0xFF);
+    t.push_back((v >> 8) & 0xFF);
+  };
+  const auto u32 = [&](std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) t.push_back((v >> (8 * k)) & 0xFF);
+  };
+  const std::uint32_t ifd0 = 8, gps_ifd = ifd0 + 2 + 12 + 4, entries = 7;
+  const std::uint32_t values = gps_ifd + 2 + 12 * entries + 4;
+  t.insert(t.end(), {'I', 'I', 42, 0});
+  u32(ifd0);
+  u16(1);
+  u16(0x8825);  // GPSInfo
+  u16(4);       // LONG
+  u32(1);
+  u32(gps_ifd);
+  u32(0);
+  const auto dms = [](double deg, std::uint32_t out[6]) {
+    deg = std::abs(deg);
+    const double d = std::floor(deg), m = std::floor((deg - d) * 60);
+    const double s = ((deg - d) * 60 - m) * 60;
+    out[0] = static_cast<std::uint32_t>(d), out[1] = 1;
+    out[2] = static_cast<std::uint32_t>(m), out[3] = 1;
+    out[4] = static_cast<std::uint32_t>(std::llround(s * 1e6)), out[5] = 1000000;
+  };
+  std::uint32_t lat[6], lon[6];
+  dms(gps.latitude, lat);
+  dms(gps.longitude, lon);
+  const std::uint32_t alt[2] = {static_cast<std::uint32_t>(std::llround(std::abs(gps.altitude) * 1000)),
+                                1000};
+  u16(entries);
+  const auto ascii = [&](std::uint16_t tag, char c) {
+    u16(tag), u16(2), u32(2);
+    t.push_back(c), t.push_back(0), t.push_back(0), t.push_back(0);
+  };
+  u16(0x0000), u16(1), u32(4), t.insert(t.end(), {2, 3, 0, 0});  // GPSVersionID 2.3.0.0
+  ascii(0x0001, gps.latitude < 0 ? 'S' : 'N');
+  u16(0x0002), u16(5), u32(3), u32(values);
+  ascii(0x0003, gps.longitude < 0 ? 'W' : 'E');
+  u16(0x0004), u16(5), u32(3), u32(values + 24);
+  u16(0x0005), u16(1), u32(1), t.insert(t.end(), {static_cast<unsigned char>(gps.altitude < 0), 0, 0, 0});
+  u16(0x0006), u16(5), u32(1), u32(values + 48);
+  u32(0);
+  for (auto v : lat) u32(v);
+  for (auto v : lon) u32(v);
+  for (auto v : alt) u32(v);
+  std::vector<unsigned char> app1 = {0xFF, 0xE1, 0, 0, 'E', 'x', 'i', 'f', 0, 0};
+  app1.insert(app1.end(), t.begin(), t.end());
+  const std::size_t length = app1.size() - 2;
+  app1[2] = static_cast<unsigned char>(length >> 8);
+  app1[3] = static_cast<unsigned char>(length & 0xFF);
+  std::vector<unsigned char> out(jpeg.begin(), jpeg.begin() + 2);
+  out.insert(out.end(), app1.begin(), app1.end());
+  out.insert(out.end(), jpeg.begin() + 2, jpeg.end());
+  return out;
+}
+
+std::array<double, 3> toEnu(const GeoPosition& p, const GeoPosition& origin) {
+  const Eigen::Vector3d d = enuBasis(origin) * (toEcef(p) - toEcef(origin));
+  return {d.x(), d.y(), d.z()};
+}
+
+GeoPosition fromEnu(const std::array<double, 3>& enu, const GeoPosition& origin) {
+  const Eigen::Vector3d x =
+      toEcef(origin) + enuBasis(origin).transpose() * Eigen::Vector3d(enu[0], enu[1], enu[2]);
+  return fromEcef(x);
+}
+
+int utmEpsg(const GeoPosition& p) {
+  const int zone = std::clamp(static_cast<int>(std::floor((p.longitude + 180) / 6)) + 1, 1, 60);
+  return (p.latitude >= 0 ? 32600 : 32700) + zone;
+}
+
+std::array<double, 3> Similarity::apply(const std::array<double, 3>& x) const {
+  std::array<double, 3> y{};
+  for (int r = 0; r < 3; ++r) {
+    y[r] = translation[r] + scale * (rotation[3 * r] * x[0] + rotation[3 * r + 1] * x[1] +
+                                     rotation[3 * r + 2] * x[2]);
+  }
+  return y;
+}
+
+Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
+                         const std::vector<std::array<double, 3>>& to, double inlier_metres,
+                         std::vector<bool>* inliers) {
+  const int n = static_cast<int>(from.size());
+  if (n < 3 || to.size() != from.size()) {
+    throw Error("<georeference>", "position pairs", "at least 3 (camera centre, GPS) pairs",
+                std::to_string(std::min(from.size(), to.size())));
+  }
+  std::vector<int> best;
+  std::mt19937 rng(12345);  // deterministic
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  const int trials = n <= 8 ? 200 : 1000;
+  for (int trial = 0; trial < trials; ++trial) {
+    std::vector<int> sample = all;
+    std::shuffle(sample.begin(), sample.end(), rng);
+    sample.resize(3);
+    Similarity s;
+    if (!umeyama(from, to, sample, &s)) continue;
+    std::vector<int> in;
+    for (int i = 0; i < n; ++i) {
+      if (distance(s, from[i], to[i]) <= inlier_metres) in.push_back(i);
+    }
+    if (in.size() > best.size()) best = in;
+    if (static_cast<int>(best.size()) == n) break;
+  }
+  Similarity s;
+  if (best.size() < 3 || !umeyama(from, to, best, &s)) {
+    // No consensus within the distance (GPS noisier than assumed): the least-squares fit of all.
+    if (!umeyama(from, to, all, &s)) {
+      throw Error("<georeference>", "camera centres",
+                  "positions not all on one line (a flight with some extent across)",
+                  "degenerate positions");
+    }
+    best = all;
+  }
+  if (inliers != nullptr) {
+    inliers->assign(n, false);
+    for (int i : best) (*inliers)[i] = true;
+  }
+  return s;
+}
+
+std::string georeferenceToJson(const Georeference& g) {
+  const nlohmann::json j = {
+      {"frame", "east-north-up metres around origin (WGS84)"},
+      {"origin",
+       {{"latitude", g.origin.latitude},
+        {"longitude", g.origin.longitude},
+        {"altitude", g.origin.altitude}}},
+      {"epsg_utm", g.epsg_utm},
+      {"sfm_to_local",
+       {{"scale", g.sfm_to_local.scale},
+        {"rotation", g.sfm_to_local.rotation},
+        {"translation", g.sfm_to_local.translation}}},
+      {"photos_with_gps", g.photos_with_gps},
+      {"inliers", g.inliers},
+      {"rms_metres", g.rms_metres}};
+  return j.dump(2) + "\n";
+}
+
+Georeference georeferenceFromJson(const std::string& text, const std::string& origin) {
+  Georeference g;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    const auto number = [&](const nlohmann::json& obj, const char* key, const std::string& field) {
+      if (!obj.contains(key) || !obj.at(key).is_number()) {
+        throw Error(origin, field, "a number", obj.contains(key) ? obj.at(key).dump() : "missing");
+      }
+      const double v = obj.at(key).get<double>();
+      if (!std::isfinite(v)) throw Error(origin, field, "a finite number", obj.at(key).dump());
+      return v;
+    };
+    if (!j.is_object() || !j.contains("origin") || !j.at("origin").is_object()) {
+      throw Error(origin, "origin", "an object with latitude, longitude, altitude", "missing");
+    }
+    const auto& o = j.at("origin");
+    g.origin = {number(o, "latitude", "origin.latitude"), number(o, "longitude", "origin.longitude"),
+                number(o, "altitude", "origin.altitude")};
+    if (std::abs(g.origin.latitude) > 90 || std::abs(g.origin.longitude) > 180) {
+      throw Error(origin, "origin", "latitude within +-90, longitude within +-180",
+                  o.dump());
+    }
+    g.epsg_utm = static_cast<int>(number(j, "epsg_utm", "epsg_utm"));
+    if (j.contains("sfm_to_local")) {
+      const auto& s = j.at("sfm_to_local");
+      g.sfm_to_local.scale = number(s, "scale", "sfm_to_local.scale");
+      g.sfm_to_local.rotation = s.at("rotation").get<std::array<double, 9>>();
+      g.sfm_to_local.translation = s.at("translation").get<std::array<double, 3>>();
+    }
+    g.photos_with_gps = static_cast<int>(j.value("photos_with_gps", 0));
+    g.inliers = static_cast<int>(j.value("inliers", 0));
+    g.rms_metres = j.value("rms_metres", 0.0);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(origin, "JSON", "a georeference.json as sadsplat writes it", e.what());
+  }
+  return g;
+}
+
+}  // namespace io
+}  // namespace sadsplat

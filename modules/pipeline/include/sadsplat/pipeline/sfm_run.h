@@ -1,0 +1,51 @@
+#pragma once
+/// \file sfm_run.h
+/// \brief `sadsplat sfm`: a folder of photos into a scene directory that sadsplat reads as is,
+/// through COLMAP's command line (Debian's `colmap`): feature extraction, matching, mapping,
+/// undistortion; then the georeference from the photos' GPS (EXIF) when they carry it.
+///
+/// The scene directory: images/ (undistorted), sparse/0/ (COLMAP text, PINHOLE cameras; in
+/// east-north-up metres when georeferenced), georeference.json (when georeferenced),
+/// sfm_report.json (stages, times, registered and unregistered photos), colmap/ (COLMAP's
+/// database, its own model and the logs of every stage).
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace sadsplat {
+namespace pipeline {
+
+struct SfmOptions {
+  std::string photos;  ///< folder of photos (JPEG, PNG, TIFF)
+  std::string out;     ///< scene directory to write (created; must not hold a scene yet)
+  /// auto: exhaustive up to 40 photos, spatial when most photos carry GPS, else sequential.
+  std::string matcher = "auto";  ///< auto | exhaustive | sequential | spatial
+  /// Longest image side for feature extraction and for the undistorted images (COLMAP's
+  /// max_image_size; a 4000x3000 survey photo is then 2000x1500).
+  int max_image_size = 2000;
+  bool single_camera = true;  ///< one camera for every photo (one drone, one lens)
+  int threads = -1;           ///< -1: every core
+  double gps_inlier_metres = 5;  ///< GPS within this of the fitted camera centre is an inlier
+  std::string colmap = "colmap";  ///< the program
+  std::ostream* progress = nullptr;
+};
+
+/// \brief What the run found.
+struct SfmSummary {
+  int photos = 0;
+  int registered = 0;
+  std::vector<std::string> unregistered;
+  std::size_t points = 0;
+  double mean_reprojection_error = 0;  ///< pixels, mean over the points
+  bool georeferenced = false;
+  double seconds = 0;
+};
+
+/// \brief Runs the whole reconstruction.
+/// \throws sadsplat::Error naming the missing program (and its Debian package), the photos
+/// folder, a failed stage (with its log), or a reconstruction that registered fewer than 2 photos
+SfmSummary sfmRun(const SfmOptions& options);
+
+}  // namespace pipeline
+}  // namespace sadsplat
