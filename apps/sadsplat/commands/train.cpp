@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "../cli_support.h"
 #include "commands.h"
 #include "sadsplat/distributed/rank_group.h"
@@ -76,15 +78,29 @@ class TrainCommand : public Command {
 
   int run(const Invocation& invocation) override {
     gaussians::TrainConfig config;
+    std::vector<std::string> given;  // keys the user set: a short run's schedule keeps them
     if (!config_file_.empty()) {
-      config = gaussians::TrainConfig::fromJson(io::readWholeFile(config_file_), config_file_);
+      const std::string text = io::readWholeFile(config_file_);
+      config = gaussians::TrainConfig::fromJson(text, config_file_);
       config.check(config_file_);  // a bad value names the file it came from
+      const nlohmann::json keys = nlohmann::json::parse(text);
+      for (const auto& item : keys.items()) given.push_back(item.key());
     }
     for (const auto& [option, flag] : flags_) {
       if (flag->count() == 0) continue;
+      given.push_back(option->key);
       const bool is_flag = std::holds_alternative<bool gaussians::TrainConfig::*>(option->member);
       gaussians::setOptionFromText(*option, is_flag ? "true" : values_[option], config,
                                    "<command line>");
+    }
+    if (!resume_) {
+      std::vector<std::string> changed;
+      config = config.shortRunSchedule(given, &changed);
+      if (!changed.empty()) {
+        std::cout << "schedule of a run of " << config.iterations << " iterations:";
+        for (const auto& c : changed) std::cout << " " << c << ";";
+        std::cout << " (set a key to keep its value)\n";
+      }
     }
     // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
     std::optional<distributed::LocalRanks> local_ranks;

@@ -294,6 +294,28 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
   setFromJson(option, value, config, origin);
 }
 
+TrainConfig TrainConfig::shortRunSchedule(const std::vector<std::string>& given,
+                                          std::vector<std::string>* changed) const {
+  TrainConfig c = *this;
+  if (iterations >= 7000) return c;
+  const auto free = [&](const char* key) {
+    return std::find(given.begin(), given.end(), key) == given.end();
+  };
+  const auto set = [&](const char* key, int& member, int value) {
+    if (!free(key) || member == value) return;
+    if (changed) changed->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
+                                    std::to_string(value));
+    member = value;
+  };
+  set("sh_increase_interval", c.sh_increase_interval,
+      std::min(sh_increase_interval, std::max(1, iterations / 4)));
+  set("densify_from", c.densify_from, std::min(densify_from, iterations / 10));
+  set("opacity_reset_interval", c.opacity_reset_interval,
+      std::max(iterations, opacity_reset_interval));
+  set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
+  return c;
+}
+
 void TrainConfig::check(const std::string& origin) const {
   for (const TrainOption& o : kOptions) {
     const nlohmann::json v = toJsonValue(o, *this);

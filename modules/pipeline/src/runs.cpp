@@ -418,13 +418,8 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
       << ")\n";
   gaussians::TrainConfig config;
   config.iterations = iterations;
-  config.sh_increase_interval = std::max(1, iterations / 4);
-  config.densify_from = std::min(config.densify_from, iterations / 10);
-  config.opacity_reset_interval = std::max(iterations, config.opacity_reset_interval);
-  if (!baseline) {
-    config.drop = "full";
-    config.drop_interval = std::min(config.drop_interval, std::max(1, iterations / 4));
-  }
+  if (!baseline) config.drop = "full";
+  config = config.shortRunSchedule({});
   TrainRunOptions o;
   o.scene = train_scene;
   o.out = out_dir + "/run";

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace sadsplat {
 namespace gaussians {
@@ -125,6 +126,14 @@ struct TrainConfig {
   /// Adam that Grendel uses for batched 3DGS). views = 1 returns this configuration.
   /// \throws sadsplat::Error when views < 1
   TrainConfig forGlobalBatch(int views) const;
+
+  /// \brief The schedule of a run shorter than the paper's 7000 iterations: the SH degree rises
+  /// every iterations / 4, densification starts by iterations / 10, no opacity reset falls inside
+  /// the run, drops come every iterations / 4 at most; each only where the default would not fit
+  /// and the key is not in `given` (keys the user set). Returns this configuration for longer runs.
+  /// \param[out] changed if not null, "key default -> value" for each key it changed
+  TrainConfig shortRunSchedule(const std::vector<std::string>& given,
+                               std::vector<std::string>* changed = nullptr) const;
 
   /// \brief Checks every option against its range in the option table (train_options.h) and
   /// the rules between options (recovery_iterations below iterations).
