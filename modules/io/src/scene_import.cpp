@@ -7,6 +7,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/annotations.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 
@@ -167,6 +168,43 @@ cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& clas
   return labels;
 }
 
+// The label map of an annotated image at the scene image's size (before undistortion).
+cv::Mat rasterise(const AnnotatedImage& a, const cv::Size& size,
+                  const std::map<std::string, std::uint8_t>& class_ids, const std::string& origin) {
+  const double sx = static_cast<double>(size.width) / a.width;
+  const double sy = static_cast<double>(size.height) / a.height;
+  if (std::abs(sx / sy - 1) > 0.02) {
+    throw Error(origin, "image " + a.file_name + " size",
+                "the aspect ratio of the scene's image " + std::to_string(size.width) + "x" +
+                    std::to_string(size.height),
+                std::to_string(a.width) + "x" + std::to_string(a.height));
+  }
+  cv::Mat labels(size, CV_8UC1, cv::Scalar(kIgnoreLabel));
+  constexpr int kShift = 4;  // sub-pixel polygon vertices: 1/16 pixel
+  for (const AnnotatedShape& shape : a.shapes) {
+    const std::uint8_t id = class_ids.at(shape.label);
+    if (!shape.mask.empty()) {
+      cv::Mat mask(a.height, a.width, CV_8UC1, const_cast<std::uint8_t*>(shape.mask.data()));
+      cv::Mat scaled;
+      cv::resize(mask, scaled, size, 0, 0, cv::INTER_NEAREST);
+      labels.setTo(cv::Scalar(id), scaled);
+      continue;
+    }
+    std::vector<std::vector<cv::Point>> rings;
+    for (const auto& polygon : shape.polygons) {
+      std::vector<cv::Point> ring;
+      for (const auto& p : polygon) {
+        // Annotation coordinates: pixel centres at +0.5, as sadsplat's cameras.
+        ring.emplace_back(static_cast<int>(std::lround((p[0] * sx - 0.5) * (1 << kShift))),
+                          static_cast<int>(std::lround((p[1] * sy - 0.5) * (1 << kShift))));
+      }
+      rings.push_back(std::move(ring));
+    }
+    cv::fillPoly(labels, rings, cv::Scalar(id), cv::LINE_8, kShift);
+  }
+  return labels;
+}
+
 }  // namespace
 
 Scene importScene(const std::string& dir, const ImportOptions& options) {
@@ -204,6 +242,39 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     }
   }
 
+  // Annotations from a labelling tool, by image file name.
+  std::map<std::string, AnnotatedImage> annotated;
+  if (!options.annotations.empty()) {
+    if (scene.classes.empty()) {
+      throw Error(dir + "/classes.json", "file", "the class list the annotations' labels name",
+                  "missing");
+    }
+    std::map<std::string, std::string> view_of;  // file name -> image name in the model
+    for (const auto& im : model.images) {
+      view_of[im.name.substr(im.name.find_last_of('/') + 1)] = im.name;
+    }
+    for (AnnotatedImage& a : readAnnotations(options.annotations)) {
+      const auto v = view_of.find(a.file_name);
+      if (v == view_of.end()) {
+        throw Error(options.annotations, "image " + a.file_name, "a photo of the scene",
+                    "no view of that name");
+      }
+      for (const AnnotatedShape& shape : a.shapes) {
+        const bool known = std::any_of(scene.classes.begin(), scene.classes.end(),
+                                       [&](const ClassInfo& c) { return c.name == shape.label; });
+        if (!known) {
+          throw Error(options.annotations, "label \"" + shape.label + "\" of " + a.file_name,
+                      "a class name from classes.json", "unknown");
+        }
+      }
+      annotated[v->second] = std::move(a);
+    }
+  }
+  std::map<std::string, std::uint8_t> class_ids;
+  for (std::size_t i = 0; i < scene.classes.size(); ++i) {
+    class_ids[scene.classes[i].name] = static_cast<std::uint8_t>(i);
+  }
+
   std::vector<const ColmapImage*> images;
   for (const auto& im : model.images) images.push_back(&im);
   std::sort(images.begin(), images.end(),
@@ -233,7 +304,14 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
 
     cv::Mat labels;
     const std::string label_path = dir + "/labels/" + stem(im->name) + ".png";
-    if (pathExists(label_path)) {
+    const auto annotation = annotated.find(im->name);
+    if (annotation != annotated.end()) {
+      if (pathExists(label_path)) {
+        throw Error(options.annotations, "image " + annotation->second.file_name,
+                    "one source of labels per view", "an annotation and " + label_path);
+      }
+      labels = rasterise(annotation->second, bgr.size(), class_ids, options.annotations);
+    } else if (pathExists(label_path)) {
       labels = readLabelMap(label_path, scene.classes);
       if (labels.size() != bgr.size()) {
         throw Error(label_path, "size",

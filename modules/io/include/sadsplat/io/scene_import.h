@@ -20,6 +20,11 @@ struct ImportOptions {
   /// view and not trained on; 0 trains on every view. Scenes of fewer than 2 * test_every views
   /// train on every view.
   int test_every = 8;
+  /// Annotations to rasterise into label maps (io/annotations.h: a LabelMe file or folder, or a
+  /// COCO file), matched to views by image file name and to classes.json by class name. Drawn in
+  /// the annotated image's pixels, scaled to the scene image's size (same aspect ratio within 2 %),
+  /// then undistorted and resized as label maps are. Empty: none.
+  std::string annotations;
 };
 
 struct ColmapModel;
