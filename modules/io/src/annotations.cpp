@@ -261,10 +261,12 @@ std::vector<AnnotatedImage> readAnnotations(const std::string& path, int* skippe
     std::vector<AnnotatedImage> images;
     for (const auto& f : files) {
       const json j = parseFile(f);
-      if (!j.is_object() || !j.contains("shapes")) {
-        throw Error(f, "shapes", "a LabelMe file (an object with \"shapes\")", "missing");
-      }
+      // Other JSON files in the folder (a classes.json) are not annotations.
+      if (!j.is_object() || !j.contains("shapes")) continue;
       images.push_back(readLabelMe(j, f, skipped));
+    }
+    if (images.empty()) {
+      throw Error(path, "annotations", "LabelMe .json files (objects with \"shapes\")", "none");
     }
     return images;
   }

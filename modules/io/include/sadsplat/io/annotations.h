@@ -30,7 +30,8 @@ struct AnnotatedImage {
 };
 
 /// \brief Reads annotations: a COCO JSON file (an object with "images", "annotations" and
-/// "categories"), a LabelMe JSON file (an object with "shapes"), or a folder of LabelMe files.
+/// "categories"), a LabelMe JSON file (an object with "shapes"), or a folder of LabelMe files
+/// (its other .json files are skipped).
 /// Shapes LabelMe draws as "polygon" and "rectangle" are read; "point", "line", "linestrip" and
 /// "circle" are skipped (they cover no area) and counted in `skipped`.
 /// \throws sadsplat::Error naming the file and the field (a polygon with fewer than 3 points, an
