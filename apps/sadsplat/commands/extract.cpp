@@ -45,7 +45,13 @@ class ExtractCommand : public Command {
   int run(const Invocation&) override {
     std::string in = in_, classes = classes_;
     if (io::isDirectory(in)) {  // a run directory: its model and its class list
-      if (classes.empty()) classes = in + "/classes.json";
+      if (classes.empty()) {
+        classes = in + "/classes.json";
+        if (!io::pathExists(classes) && io::pathExists(in + "/run.json")) {
+          throw Error(classes, "file", "a run trained with classes",
+                      "none (its scene had no classes.json: the model has no classes to extract)");
+        }
+      }
       in += "/model.ply";
     }
     const std::uint32_t id = classId(classes);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -164,6 +165,24 @@ std::string describeFile(const std::string& path) {
     const std::string ext = lowerExtension(path);
     if (ext == ".ply" || ext == ".pcd" || ext == ".splat" || ext == ".spz" || ext == ".sog") {
       throw Error(path, "file", "a " + ext + " file", "a directory");
+    }
+    if (pathExists(path + "/run.json") && pathExists(path + "/model.ply")) {
+      // A run directory: its model, and the frame it is in.
+      out << path << ": run directory (model.ply below)\n";
+      if (pathExists(path + "/georeference.json")) {
+        const Georeference g = georeferenceFromJson(readWholeFile(path + "/georeference.json"),
+                                                    path + "/georeference.json");
+        std::ostringstream geo;
+        geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude
+            << ", " << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
+            << " m (WGS84); the model is in east-north-up metres, z up; UTM EPSG:" << g.epsg_utm
+            << "\n";
+        out << geo.str();
+      } else {
+        out << "georeference: none (the scene's SfM frame)\n";
+      }
+      out << describeFile(path + "/model.ply");
+      return out.str();
     }
     out << path << ": scene directory\n";
     describeScene(out, importScene(path));
