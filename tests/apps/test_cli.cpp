@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
@@ -188,6 +189,38 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
 
 // A run trained on a relative scene path is evaluated from another working directory (run.json
 // keeps the scene's absolute path), and eval's metrics count the floaters.
+// A scene without classes.json and label maps (photos + COLMAP only): plain 3DGS end to end.
+TEST(Cli, AnRgbOnlySceneTrainsEvaluatesAndSaysWhyThereIsNoMiou) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  test::TempDir dir;
+  const std::string scene = test::copyTree(kScene, dir.file("scene"));
+  std::remove((scene + "/classes.json").c_str());
+  std::remove((scene + "/split.json").c_str());
+  ASSERT_EQ(std::system(("rm -rf '" + scene + "/labels'").c_str()), 0);
+  std::string out;
+  const std::string run = dir.file("run");
+  ASSERT_EQ(test::runCommand(kCli + " train " + scene + " --iterations 30 --out " + run, &out), 0)
+      << out;
+  // The import scale and the short run's schedule are said.
+  EXPECT_NE(out.find("at image scale 0.5"), std::string::npos) << out;
+  EXPECT_NE(out.find("schedule of a run of 30 iterations"), std::string::npos) << out;
+  io::PlyFileInfo info;
+  io::readGaussianPly(run + "/model.ply", &info);
+  EXPECT_EQ(info.feature_dim, 0);
+  EXPECT_FALSE(io::pathExists(run + "/model_semantic.ply"));
+  ASSERT_EQ(test::runCommand(kCli + " eval " + run, &out), 0) << out;
+  EXPECT_NE(out.find("\"miou\": null"), std::string::npos) << out;
+  EXPECT_NE(out.find("no classes"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"psnr\""), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(kCli + " info " + run, &out), 0) << out;
+  EXPECT_NE(out.find("run directory"), std::string::npos) << out;
+  EXPECT_NE(out.find("georeference: none"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + " extract " + run + " --class road --out " + dir.file("r.pcd"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("no classes to extract"), std::string::npos) << out;
+}
+
 TEST(Cli, EvalFindsTheSceneOfARunFromAnyDirectory) {
   test::TempDir dir;
   std::string out;
