@@ -213,7 +213,8 @@ std::vector<std::uint32_t> cocoRleCounts(const std::string& s, const std::string
       more = (c & 0x20) != 0;
       ++p;
       ++k;
-      if (!more && (c & 0x10)) x |= -1LL << (5 * k);
+      // The sign bit set: the k * 5-bit value is negative (x - 2^(5k); no shift of a negative).
+      if (!more && (c & 0x10)) x -= 1LL << (5 * k);
     }
     if (counts.size() > 2) x += counts[counts.size() - 2];
     if (x < 0) throw Error(origin, "segmentation.counts", "non-negative runs", std::to_string(x));
