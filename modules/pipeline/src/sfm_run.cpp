@@ -209,6 +209,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
     match.insert(match.end(), {"--SequentialMatching.overlap", "10"});
   }
   stage(matcher + "_matcher", match);
+  // Models of an earlier, failed run must not be taken for this run's.
+  fs::remove_all(work + "/sparse");
   io::makeDirectory(work + "/sparse");
   stage("mapper", {o.colmap, "mapper", "--database_path", db, "--image_path", o.photos,
                    "--output_path", work + "/sparse", "--Mapper.num_threads", threads});
