@@ -31,7 +31,7 @@ timed() {  # NAME COMMAND...
   local name=$1; shift
   local t0; t0=$(date +%s.%N)
   "$@" > "$out/$name.log" 2>&1 || { echo "$name failed: $(tail -1 "$out/$name.log")" | tee -a "$summary"; exit 1; }
-  echo "$name: $(echo "$(date +%s.%N) - $t0" | bc) s" | tee -a "$summary"
+  echo "$name: $(python3 -c "import sys; print(round(float(sys.argv[1]) - float(sys.argv[2]), 1))" "$(date +%s.%N)" "$t0") s" | tee -a "$summary"
 }
 [ -d "$out/scene/sparse" ] || timed sfm "$bin" sfm "$photos" --out "$out/scene" --max-image-size "$max_size"
 grep '^sfm: registered\|^sfm: not registered' "$out/sfm.log" | tee -a "$summary" || true
