@@ -182,7 +182,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                            : 0.0;
   }
   const io::Scene scene = loadScene(o.scene, o.scale, o.progress);
-  if (o.progress) {
+  if (o.progress && scene.classes.empty()) {
+    *o.progress << "RGB only: the scene has no classes.json, so no semantic head (plain 3DGS"
+                << (config.drop == "none" ? "" : ", drop " + config.drop + " without confidence maps")
+                << ")\n";
+  } else if (o.progress) {
     int labelled = 0, pseudo = 0;
     for (const io::View& v : scene.views) {
       if (!v.train) continue;
