@@ -22,6 +22,17 @@ namespace sadsplat {
 namespace io {
 namespace {
 
+// One line: where the frame is on the Earth and how well the GPS fit it.
+void describeGeoreference(std::ostream& out, const Georeference& g) {
+  std::ostringstream geo;
+  geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude << ", "
+      << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
+      << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; "
+      << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit, RMS "
+      << g.rms_metres << " m\n";
+  out << geo.str();
+}
+
 template <typename Range, typename GetXyz>
 void describeBounds(std::ostream& out, const Range& points, GetXyz xyz) {
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
@@ -111,14 +122,7 @@ void describeScene(std::ostream& out, const Scene& scene) {
   out << "sparse points: " << scene.points.size() << "\n";
   describeBounds(out, scene.points, [](const ScenePoint& p) { return p.xyz; });
   if (scene.georeference) {
-    const Georeference& g = *scene.georeference;
-    std::ostringstream geo;
-    geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude
-        << ", " << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
-        << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; "
-        << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit, RMS "
-        << g.rms_metres << " m\n";
-    out << geo.str();
+    describeGeoreference(out, *scene.georeference);
   } else {
     out << "georeference: none (an SfM frame: no metres, no up)\n";
   }
@@ -170,14 +174,8 @@ std::string describeFile(const std::string& path) {
       // A run directory: its model, and the frame it is in.
       out << path << ": run directory (model.ply below)\n";
       if (pathExists(path + "/georeference.json")) {
-        const Georeference g = georeferenceFromJson(readWholeFile(path + "/georeference.json"),
-                                                    path + "/georeference.json");
-        std::ostringstream geo;
-        geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude
-            << ", " << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
-            << " m (WGS84); the model is in east-north-up metres, z up; UTM EPSG:" << g.epsg_utm
-            << "\n";
-        out << geo.str();
+        describeGeoreference(out, georeferenceFromJson(readWholeFile(path + "/georeference.json"),
+                                                       path + "/georeference.json"));
       } else {
         out << "georeference: none (the scene's SfM frame)\n";
       }
