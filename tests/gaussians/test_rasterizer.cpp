@@ -177,6 +177,91 @@ TEST(Rasterizer, GradientsThroughTheFrustumClampMatchFiniteDifferences) {
   expectGradientsMatchFiniteDifferences(g, cam, settings, 1e-5);
 }
 
+// An orthographic camera projects affinely, so the 2D covariance of a rotated, anisotropic
+// Gaussian is exactly f^2 times the top-left 2x2 block of R S R^T (+ the dilation), whatever its
+// depth: the same Gaussian at z = 3 and at z = 300 renders the same pixels.
+TEST(Rasterizer, OrthographicCameraProjectsTheCovarianceExactly) {
+  RasterCamera cam = frontCamera(48, 40, 0);
+  cam.orthographic = true;
+  cam.fx = 30.0;  // pixels per world unit
+  cam.fy = 27.0;
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  const double opacity = 0.8;
+  const double q[4] = {0.9, 0.2, -0.3, 0.25};
+  const double sx = 0.12, sy = 0.05, sz = 0.3;
+  GaussianParams g;
+  g.means = at::tensor({0.1, -0.05, 3.0}, opts).reshape({1, 3});
+  g.quats = at::tensor({q[0], q[1], q[2], q[3]}, opts).reshape({1, 4});
+  g.log_scales = at::tensor({std::log(sx), std::log(sy), std::log(sz)}, opts).reshape({1, 3});
+  g.opacity_logits = at::full({1}, std::log(opacity / (1 - opacity)), opts);
+  g.sh = at::zeros({1, 16, 3}, opts);
+  g.features = at::ones({1, 1}, opts);
+  const auto near = gaussians::render(g, cam);
+  g.means[0][2] = 300.0;
+  const auto far = gaussians::render(g, cam);
+  EXPECT_EQ((near.alpha - far.alpha).abs().max().item<double>(), 0.0);
+  EXPECT_NEAR(far.depth[20][27].item<double>(), 300.0, 1e-9);
+
+  // The expected covariance, written out independently of raster_math.h.
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                          {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                          {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+  const double s2[3] = {sx * sx, sy * sy, sz * sz};
+  double S[2][2] = {{0, 0}, {0, 0}};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 3; ++k) S[i][j] += R[i][k] * s2[k] * R[j][k];
+  const double a = cam.fx * cam.fx * S[0][0] + 0.3, b = cam.fx * cam.fy * S[0][1],
+               c = cam.fy * cam.fy * S[1][1] + 0.3;
+  const double det = a * c - b * b;
+  const double mx = cam.fx * 0.1 + cam.cx, my = cam.fy * -0.05 + cam.cy;
+  EXPECT_NEAR(near.means2d[0][0].item<double>(), mx, 1e-12);
+  EXPECT_NEAR(near.means2d[0][1].item<double>(), my, 1e-12);
+  int checked = 0;
+  for (int py = 0; py < cam.height; ++py) {
+    for (int px = 0; px < cam.width; ++px) {
+      const double dx = mx - (px + 0.5), dy = my - (py + 0.5);
+      const double power = -0.5 * (c * dx * dx - 2 * b * dx * dy + a * dy * dy) / det;
+      const double alpha = std::min(0.99, opacity * std::exp(power));
+      if (alpha < 1.5 / 255) continue;
+      ASSERT_NEAR(near.alpha[py][px].item<double>(), alpha, 1e-12) << px << "," << py;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20);
+}
+
+TEST(Rasterizer, OrthographicGradientsMatchFiniteDifferences) {
+  RasterCamera cam = frontCamera(16, 14, 0);
+  cam.orthographic = true;
+  cam.fx = 21.0;
+  cam.fy = 19.0;
+  cam.cx = 7.6;
+  const double angle = 0.3;
+  cam.qvec = {std::cos(angle / 2), std::sin(angle / 2), 0.0, 0.0};
+  cam.tvec = {0.1, 0.2, 0.4};
+  RenderSettings settings;
+  settings.sh_degree = 3;
+  settings.background = {0.2f, 0.1f, 0.0f};
+  auto g = randomScene(4, 2, 3, 0.25);
+  expectGradientsMatchFiniteDifferences(g, cam, settings, 1e-5);
+}
+
+// Gaussians behind an orthographic camera (z below the near plane) are culled; nothing is
+// divided by their depth.
+TEST(Rasterizer, OrthographicCameraCullsBehindItself) {
+  RasterCamera cam = frontCamera(16, 16, 0);
+  cam.orthographic = true;
+  cam.fx = cam.fy = 10.0;
+  auto g = randomScene(6, 1, 4);
+  g.means.select(1, 2).fill_(-1.0);
+  const auto r = gaussians::render(g, cam);
+  EXPECT_EQ((r.radii > 0).sum().item<int64_t>(), 0);
+  EXPECT_EQ(r.alpha.abs().max().item<double>(), 0.0);
+}
+
 TEST(Rasterizer, CulledAndDegenerateGaussiansGiveZerosNotNaNs) {
   const RasterCamera cam = frontCamera(20, 20, 20.0);
   const auto opts = at::TensorOptions().dtype(at::kFloat);

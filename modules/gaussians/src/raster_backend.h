@@ -21,6 +21,7 @@ struct CameraParams {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   int width = 0, height = 0;
   double near_plane = 0.01;
+  bool orthographic = false;
 };
 
 struct ProjectionResult {
@@ -116,6 +117,7 @@ Camera<T> toCamera(const CameraParams& p) {
   c.width = p.width;
   c.height = p.height;
   c.near_plane = static_cast<T>(p.near_plane);
+  c.orthographic = p.orthographic;
   return c;
 }
 

@@ -39,13 +39,15 @@ raster::CameraParams toParams(const RasterCamera& c) {
   p.width = c.width;
   p.height = c.height;
   p.near_plane = c.near_plane;
+  p.orthographic = c.orthographic;
   return p;
 }
 
 std::vector<double> packCamera(const CameraParams& p) {
   std::vector<double> v(p.R.begin(), p.R.end());
   v.insert(v.end(), p.t.begin(), p.t.end());
-  v.insert(v.end(), {p.fx, p.fy, p.cx, p.cy, double(p.width), double(p.height), p.near_plane});
+  v.insert(v.end(), {p.fx, p.fy, p.cx, p.cy, double(p.width), double(p.height), p.near_plane,
+                     p.orthographic ? 1.0 : 0.0});
   return v;
 }
 
@@ -60,6 +62,7 @@ CameraParams unpackCamera(const std::vector<double>& v) {
   p.width = static_cast<int>(v[16]);
   p.height = static_cast<int>(v[17]);
   p.near_plane = v[18];
+  p.orthographic = v[19] != 0;
   return p;
 }
 
@@ -279,6 +282,19 @@ std::array<double, 3> RasterCamera::centre() const {
   return c;
 }
 
+std::array<double, 3> RasterCamera::shViewpoint() const {
+  if (!orthographic) return centre();
+  // Every ray of an orthographic camera runs along its z axis (row 2 of R): a viewpoint far back
+  // on that axis sees each Gaussian from that direction; at 1e7 units the direction is off by
+  // under 1e-5 rad for a Gaussian 100 units from the axis.
+  const double q[4] = {qvec[0], qvec[1], qvec[2], qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  std::array<double, 3> c = centre();
+  for (int j = 0; j < 3; ++j) c[j] -= 1e7 * R[6 + j];
+  return c;
+}
+
 at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
                       const std::array<double, 3>& camera_centre, int degree) {
   if (degree < 0 || degree > 3) {
@@ -350,7 +366,7 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
       g.features.defined() && settings.features ? g.features : at::zeros({n, 0}, g.means.options());
 
   auto [means2d, conics, depths, radii] = projectGaussians(g.means, g.quats, g.log_scales, camera);
-  const at::Tensor colors = evaluateSh(g.sh, g.means, camera.centre(), settings.sh_degree);
+  const at::Tensor colors = evaluateSh(g.sh, g.means, camera.shViewpoint(), settings.sh_degree);
   const at::Tensor values = settings.depth ? at::cat({colors, features, depths.unsqueeze(1)}, 1)
                             : features.size(1) > 0 ? at::cat({colors, features}, 1)
                                                    : colors;

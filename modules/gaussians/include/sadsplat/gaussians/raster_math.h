@@ -99,7 +99,10 @@ SADSPLAT_HD T mmax(T a, T b) {
   return a > b ? a : b;
 }
 
-/// A pinhole camera with its world-to-camera pose, in the scalar type of the computation.
+/// A pinhole (or orthographic) camera with its world-to-camera pose, in the scalar type of the
+/// computation. Pinhole: pixel = f p_xy / p_z + c. Orthographic: pixel = f p_xy + c (f in pixels
+/// per world unit); the projection is affine, so its Jacobian is the constant diag(fx, fy) and the
+/// 2D covariance J R S R^T J^T is exact (no frustum clamp, no first-order approximation).
 template <typename T>
 struct Camera {
   T R[9];  ///< row-major world-to-camera rotation
@@ -107,6 +110,7 @@ struct Camera {
   T fx, fy, cx, cy;
   int width, height;
   T near_plane;
+  bool orthographic;
 };
 
 /// Rotation matrix (row-major) of the normalised quaternion q = (w, x, y, z).
@@ -190,21 +194,32 @@ SADSPLAT_HD void ewaTerms(const T mean[3], const T quat[4], const T log_scale[3]
     }
   }
   const T z = e->p[2];
-  const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
-  const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
-  const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
-  const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
-  const T rx = e->p[0] / z, ry = e->p[1] / z;
-  e->clamp_x = rx > lim_x_pos || rx < -lim_x_neg;
-  e->clamp_y = ry > lim_y_pos || ry < -lim_y_neg;
-  e->cx_ratio = mmin(lim_x_pos, mmax(-lim_x_neg, rx));
-  e->cy_ratio = mmin(lim_y_pos, mmax(-lim_y_neg, ry));
-  e->tx = e->cx_ratio * z;
-  e->ty = e->cy_ratio * z;
-  e->J00 = cam.fx / z;
-  e->J02 = -cam.fx * e->tx / (z * z);
-  e->J11 = cam.fy / z;
-  e->J12 = -cam.fy * e->ty / (z * z);
+  if (cam.orthographic) {
+    e->clamp_x = e->clamp_y = false;
+    e->cx_ratio = e->cy_ratio = T(0);
+    e->tx = e->p[0];
+    e->ty = e->p[1];
+    e->J00 = cam.fx;
+    e->J02 = T(0);
+    e->J11 = cam.fy;
+    e->J12 = T(0);
+  } else {
+    const T lim_x_pos = T(kFrustumClamp) * (T(cam.width) - cam.cx) / cam.fx;
+    const T lim_x_neg = T(kFrustumClamp) * cam.cx / cam.fx;
+    const T lim_y_pos = T(kFrustumClamp) * (T(cam.height) - cam.cy) / cam.fy;
+    const T lim_y_neg = T(kFrustumClamp) * cam.cy / cam.fy;
+    const T rx = e->p[0] / z, ry = e->p[1] / z;
+    e->clamp_x = rx > lim_x_pos || rx < -lim_x_neg;
+    e->clamp_y = ry > lim_y_pos || ry < -lim_y_neg;
+    e->cx_ratio = mmin(lim_x_pos, mmax(-lim_x_neg, rx));
+    e->cy_ratio = mmin(lim_y_pos, mmax(-lim_y_neg, ry));
+    e->tx = e->cx_ratio * z;
+    e->ty = e->cy_ratio * z;
+    e->J00 = cam.fx / z;
+    e->J02 = -cam.fx * e->tx / (z * z);
+    e->J11 = cam.fy / z;
+    e->J12 = -cam.fy * e->ty / (z * z);
+  }
   for (int j = 0; j < 3; ++j) {
     e->Tm[j] = e->J00 * R[j] + e->J02 * R[6 + j];
     e->Tm[3 + j] = e->J11 * R[3 + j] + e->J12 * R[6 + j];
@@ -241,8 +256,13 @@ SADSPLAT_HD bool projectGaussian(const T mean[3], const T quat[4], const T log_s
   const T lambda = mid + msqrt(mmax(T(0.1), mid * mid - det));
   const T radius = mceil(T(3) * msqrt(lambda));
   const T z = e.p[2];
-  out->mean2d[0] = cam.fx * e.p[0] / z + cam.cx;
-  out->mean2d[1] = cam.fy * e.p[1] / z + cam.cy;
+  if (cam.orthographic) {
+    out->mean2d[0] = cam.fx * e.p[0] + cam.cx;
+    out->mean2d[1] = cam.fy * e.p[1] + cam.cy;
+  } else {
+    out->mean2d[0] = cam.fx * e.p[0] / z + cam.cx;
+    out->mean2d[1] = cam.fy * e.p[1] / z + cam.cy;
+  }
   out->depth = z;
   if (!mfinite(out->mean2d[0]) || !mfinite(out->mean2d[1]) || !mfinite(radius)) return false;
   // Off-screen: the 3-sigma box misses the image.
@@ -300,27 +320,34 @@ SADSPLAT_HD void projectGaussianBackward(const T mean[3], const T quat[4], const
   const T gJ02 = gTm[0] * R[6] + gTm[1] * R[7] + gTm[2] * R[8];
   const T gJ11 = gTm[3] * R[3] + gTm[4] * R[4] + gTm[5] * R[5];
   const T gJ12 = gTm[3] * R[6] + gTm[4] * R[7] + gTm[5] * R[8];
-  // J as a function of (tx, ty, z); tx = clamp(x / z) z.
   T gp[3] = {T(0), T(0), T(0)};
-  const T z2 = z * z, z3 = z2 * z;
-  gp[2] += -cam.fx / z2 * gJ00 + T(2) * cam.fx * e.tx / z3 * gJ02 - cam.fy / z2 * gJ11 +
-           T(2) * cam.fy * e.ty / z3 * gJ12;
-  const T g_tx = -cam.fx / z2 * gJ02;
-  const T g_ty = -cam.fy / z2 * gJ12;
-  if (e.clamp_x) {
-    gp[2] += g_tx * e.cx_ratio;  // tx = lim z
+  if (cam.orthographic) {
+    // J is constant; mean2d = f p_xy + c; depth = z.
+    gp[0] += g_mean2d[0] * cam.fx;
+    gp[1] += g_mean2d[1] * cam.fy;
+    gp[2] += g_depth;
   } else {
-    gp[0] += g_tx;
+    // J as a function of (tx, ty, z); tx = clamp(x / z) z.
+    const T z2 = z * z, z3 = z2 * z;
+    gp[2] += -cam.fx / z2 * gJ00 + T(2) * cam.fx * e.tx / z3 * gJ02 - cam.fy / z2 * gJ11 +
+             T(2) * cam.fy * e.ty / z3 * gJ12;
+    const T g_tx = -cam.fx / z2 * gJ02;
+    const T g_ty = -cam.fy / z2 * gJ12;
+    if (e.clamp_x) {
+      gp[2] += g_tx * e.cx_ratio;  // tx = lim z
+    } else {
+      gp[0] += g_tx;
+    }
+    if (e.clamp_y) {
+      gp[2] += g_ty * e.cy_ratio;
+    } else {
+      gp[1] += g_ty;
+    }
+    // mean2d = f p / z + c; depth = z.
+    gp[0] += g_mean2d[0] * cam.fx / z;
+    gp[1] += g_mean2d[1] * cam.fy / z;
+    gp[2] += -g_mean2d[0] * cam.fx * e.p[0] / z2 - g_mean2d[1] * cam.fy * e.p[1] / z2 + g_depth;
   }
-  if (e.clamp_y) {
-    gp[2] += g_ty * e.cy_ratio;
-  } else {
-    gp[1] += g_ty;
-  }
-  // mean2d = f p / z + c; depth = z.
-  gp[0] += g_mean2d[0] * cam.fx / z;
-  gp[1] += g_mean2d[1] * cam.fy / z;
-  gp[2] += -g_mean2d[0] * cam.fx * e.p[0] / z2 - g_mean2d[1] * cam.fy * e.p[1] / z2 + g_depth;
   for (int j = 0; j < 3; ++j) g_mean[j] += R[j] * gp[0] + R[3 + j] * gp[1] + R[6 + j] * gp[2];
 
   // S = M M^T: dL/dM = 2 gS M (gS symmetric).

@@ -17,7 +17,9 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief A pinhole camera for rendering (COLMAP conventions, see io::PinholeCamera).
+/// \brief A pinhole or orthographic camera for rendering (COLMAP conventions, see
+/// io::PinholeCamera). Orthographic: pixel = (fx x_cam + cx, fy y_cam + cy), fx and fy in pixels
+/// per world unit, depth = z_cam; every ray runs along the camera's z axis (a top-down map render).
 struct RasterCamera {
   int width = 0;
   int height = 0;
@@ -25,11 +27,15 @@ struct RasterCamera {
   std::array<double, 4> qvec{1, 0, 0, 0};  ///< world-to-camera rotation (w, x, y, z)
   std::array<double, 3> tvec{0, 0, 0};     ///< world-to-camera translation
   double near_plane = 0.01;                ///< Gaussians closer than this are culled
+  bool orthographic = false;               ///< affine projection (see above)
 
   /// \brief The camera of an imported view.
   static RasterCamera fromPinhole(const io::PinholeCamera& camera);
   /// \brief Camera centre in world coordinates (-R^T t).
   std::array<double, 3> centre() const;
+  /// \brief Where the spherical harmonics are seen from: the centre (pinhole), or a point far back
+  /// along the viewing axis (orthographic: one view direction for every Gaussian).
+  std::array<double, 3> shViewpoint() const;
 };
 
 /// \brief What to render.
