@@ -297,6 +297,10 @@ StepStats Trainer::step(bool read_losses) {
 }
 
 RenderResult Trainer::renderView(const io::View& view) const {
+  return renderCamera(RasterCamera::fromPinhole(view.camera));
+}
+
+RenderResult Trainer::renderCamera(const RasterCamera& camera) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;
   RenderSettings settings;
@@ -304,7 +308,7 @@ RenderResult Trainer::renderView(const io::View& view) const {
   settings.background = s.config.background;
   GaussianParams g = s.params.gaussians();
   g.opacity_gate = s.drop.evaluationGate(s.params, s.iteration);
-  return render(g, RasterCamera::fromPinhole(view.camera), settings);
+  return render(g, camera, settings);
 }
 
 at::Tensor Trainer::predictClasses(const RenderResult& r) const {
@@ -313,6 +317,14 @@ at::Tensor Trainer::predictClasses(const RenderResult& r) const {
   // argmax of cos(decoded, one-hot class embedding) = argmax of the decoded vector.
   return logits.argmax(2);
 }
+
+at::Tensor Trainer::classProbabilities(const RenderResult& r) const {
+  c10::AutoGradMode no_grad(false);
+  if (numClasses() == 0) return at::Tensor();
+  return at::softmax(state_->decode(r.features), 2);
+}
+
+int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }
 
 pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
   c10::AutoGradMode no_grad(false);

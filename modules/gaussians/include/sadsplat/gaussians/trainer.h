@@ -89,9 +89,18 @@ class Trainer {
 
   /// \brief Renders a view of the scene with the current Gaussians (no gradients).
   RenderResult renderView(const io::View& view) const;
+  /// \brief Renders the current Gaussians through any camera (no gradients): other sizes,
+  /// novel views, the orthographic map camera. As renderView for a view's own camera.
+  RenderResult renderCamera(const RasterCamera& camera) const;
   /// \brief Per-pixel class ids [H, W] int64 from a render's feature image (argmax of the cosine
   /// similarity of the decoded feature to each class embedding).
   at::Tensor predictClasses(const RenderResult& render) const;
+  /// \brief Per-pixel class probabilities [H, W, classes] (softmax of the decoded feature; the
+  /// maximum is the confidence of predictClasses' class). Undefined tensor when the model has no
+  /// classes.
+  at::Tensor classProbabilities(const RenderResult& render) const;
+  /// \brief Classes the model decodes (0: a plain 3DGS model).
+  int numClasses() const;
 
   /// \brief The Gaussians as a PCL cloud; label = class of the decoded feature of each Gaussian,
   /// log_alpha / confidence as stored.
