@@ -10,6 +10,8 @@ packages=(
   libzstd-dev libwebp-dev
   # Real photos: COLMAP for `sadsplat sfm`, libexif for the photos' GPS (the georeference).
   colmap libexif-dev
+  # Map outputs: GDAL writes GeoTIFF / PNG and projects to UTM; gdal-bin's gdalinfo checks them.
+  libgdal-dev gdal-bin
   libopen3d-dev python3 python3-open3d
   # gloo's headers: LibTorch's c10d Gloo process group (data-parallel training, --nproc).
   libgloo-dev

@@ -24,6 +24,8 @@ std::vector<std::unique_ptr<Command>> allCommands() {
   commands.push_back(makeTrainCommand());
   commands.push_back(makePseudoLabelsCommand());
   commands.push_back(makeEvalCommand());
+  commands.push_back(makeRenderCommand());
+  commands.push_back(makeOrthoCommand());
   commands.push_back(makeTableCommand());
   commands.push_back(makeDemoCommand());
   commands.push_back(makeSynthCommand());

@@ -2,7 +2,9 @@
 #include <iostream>
 
 #include "commands.h"
+#include "sadsplat/geo/las_export.h"
 #include "sadsplat/io/cloud_files.h"
+#include "sadsplat/io/filesystem.h"
 
 namespace sadsplat {
 namespace cli {
@@ -15,9 +17,14 @@ class ConvertCommand : public Command {
         "convert",
         "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz (also read: .sog, .compressed.ply), "
         "semantic clouds .ply/.pcd");
-    c->add_option("IN", in_, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")
+    c->add_option("IN", in_, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")->required();
+    c->add_option("OUT", out_,
+                  "output .ply, .pcd, .splat, .spz, or .las (LAS 1.4: centres, colour, ASPRS "
+                  "class, in the georeference's UTM zone; classes.json and georeference.json are "
+                  "read from the input's folder)")
         ->required();
-    c->add_option("OUT", out_, "output .ply, .pcd, .splat or .spz")->required();
+    c->add_option("--classification-map", classification_map_,
+                  ".las: JSON {\"class name\": ASPRS code} replacing the default codes");
     c->add_option("--spz-version", options_.spz_version,
                   ".spz: 3 (gzip, every SPZ reader), 4 (zstd, the current version) or 2 (what "
                   "older web viewers read)")
@@ -26,13 +33,21 @@ class ConvertCommand : public Command {
     return c;
   }
   int run(const Invocation&) override {
+    if (io::lowerExtension(out_) == ".las") {
+      const geo::LasExportOptions options = geo::lasOptionsBeside(in_, classification_map_);
+      std::cout << (io::cloudKind(in_) == io::CloudKind::kSemantic
+                        ? geo::writeSemanticLas(out_, io::readSemanticCloud(in_), options)
+                        : geo::writeGaussiansLas(out_, io::readGaussians(in_), options))
+                << "\n";
+      return 0;
+    }
     const std::string note = io::convertCloudFile(in_, out_, options_);
     if (!note.empty()) std::cerr << "sadsplat: note: " << note << "\n";
     return 0;
   }
 
  private:
-  std::string in_, out_;
+  std::string in_, out_, classification_map_;
   io::ConvertOptions options_;
 };
 

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "sadsplat/pipeline/map_products.h"
 #include "sadsplat/pipeline/runs.h"
 
 namespace sadsplat {
@@ -14,15 +15,24 @@ class EvalCommand : public Command {
     CLI::App* c = app.add_subcommand("eval", "Evaluate a training run on its test views");
     c->add_option("RUN", run_, "run directory")->required();
     c->add_option("--scene", scene_, "scene to evaluate on (default: the run's)");
+    c->add_flag("--ortho", ortho_,
+                "score the class map on the map grid instead: against the scene's "
+                "ortho_truth.json (from `sadsplat synth`); writes RUN/ortho_metrics.json");
+    c->add_option("--truth", truth_, "--ortho: the ground truth's JSON (default: the scene's)");
     return c;
   }
   int run(const Invocation&) override {
+    if (ortho_) {
+      std::cout << pipeline::evalOrthoRun(run_, truth_);
+      return 0;
+    }
     std::cout << pipeline::evalRun(run_, scene_);
     return 0;
   }
 
  private:
-  std::string run_, scene_;
+  std::string run_, scene_, truth_;
+  bool ortho_ = false;
 };
 
 }  // namespace

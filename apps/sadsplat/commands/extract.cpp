@@ -4,11 +4,12 @@
 #include "commands.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/filters/class_extraction.h"
+#include "sadsplat/geo/las_export.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
-#include "sadsplat/filters/class_extraction.h"
 
 namespace sadsplat {
 namespace cli {
@@ -37,7 +38,9 @@ class ExtractCommand : public Command {
     c->add_option("MODEL", in_, "input .ply / .pcd, or a run directory")->required();
     c->add_option("--class", class_, "class name (or id)")->required();
     c->add_option("--classes", classes_, "classes.json or scene cache naming classes");
-    c->add_option("--out", out_, "output .ply or .pcd")->required();
+    c->add_option("--out", out_, "output .ply, .pcd or .las")->required();
+    c->add_option("--classification-map", classification_map_,
+                  ".las: JSON {\"class name\": ASPRS code} replacing the default codes");
     c->add_flag("--negative", negative_, "keep every class except this one");
     return c;
   }
@@ -55,13 +58,35 @@ class ExtractCommand : public Command {
       in += "/model.ply";
     }
     const std::uint32_t id = classId(classes);
+    const bool las = io::lowerExtension(out_) == ".las";
+    geo::LasExportOptions las_options;
+    if (las) {
+      las_options = geo::lasOptionsBeside(in, classification_map_);
+      if (!classes.empty()) {
+        las_options.classes = io::isSceneCache(classes) ? io::readSceneCache(classes).classes
+                                                        : io::readClassesJson(classes);
+      }
+    }
     if (io::cloudKind(in) == io::CloudKind::kSemantic) {
-      extractClass<pcl::PointXYZRGBL>(in, out_, id, negative_, io::readSemanticCloud,
-                                      io::writeSemanticCloud);
+      extractClass<pcl::PointXYZRGBL>(
+          in, out_, id, negative_, io::readSemanticCloud,
+          [&](const std::string& p, const pcl::PointCloud<pcl::PointXYZRGBL>& c) {
+            if (las) {
+              std::cout << geo::writeSemanticLas(p, c, las_options) << "\n";
+            } else {
+              io::writeSemanticCloud(p, c);
+            }
+          });
     } else {
       extractClass<GaussianPoint>(
           in, out_, id, negative_, [](const std::string& p) { return io::readGaussians(p); },
-          io::writeGaussians);
+          [&](const std::string& p, const pcl::PointCloud<GaussianPoint>& c) {
+            if (las) {
+              std::cout << geo::writeGaussiansLas(p, c, las_options) << "\n";
+            } else {
+              io::writeGaussians(p, c);
+            }
+          });
     }
     return 0;
   }
@@ -89,7 +114,7 @@ class ExtractCommand : public Command {
     return by_name.getClassId();
   }
 
-  std::string in_, out_, class_, classes_;
+  std::string in_, out_, class_, classes_, classification_map_;
   bool negative_ = false;
 };
 

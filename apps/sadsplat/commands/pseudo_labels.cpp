@@ -48,8 +48,9 @@ class PseudoLabelsCommand : public Command {
         ->capture_default_str();
     c->add_flag("--fixed-region-size", fixed_region_size_,
                 "builtin: --region-size in pixels whatever the view's size");
-    c->add_option("--filter-scale", scale_, "TOP1/dTOP measured on the scores (paper) or as "
-                                            "log-odds")
+    c->add_option("--filter-scale", scale_,
+                  "TOP1/dTOP measured on the scores (paper) or as "
+                  "log-odds")
         ->check(CLI::IsMember({"score", "log-odds"}))
         ->capture_default_str();
     c->add_option("--targets", targets_,

@@ -42,14 +42,14 @@ class TableCommand : public Command {
     std::cout << text;
     if (plots_.empty()) return 0;
 #if SADSPLAT_HAVE_VIZ
-    for (const std::string& path :
-         viz::writeFrontierCharts(plots_, eval::frontierPoints(runs, baseline_), baseline_,
-                                  {goal_fewer_, goal_psnr_})) {
+    for (const std::string& path : viz::writeFrontierCharts(
+             plots_, eval::frontierPoints(runs, baseline_), baseline_, {goal_fewer_, goal_psnr_})) {
       std::cout << "wrote " << path << "\n";
     }
     return 0;
 #else
-    throw Error(plots_, "--plots", "a build with VTK (charts)", "this sadsplat was built without it");
+    throw Error(plots_, "--plots", "a build with VTK (charts)",
+                "this sadsplat was built without it");
 #endif
   }
 

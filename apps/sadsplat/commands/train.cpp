@@ -105,9 +105,8 @@ class TrainCommand : public Command {
     // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
     std::optional<distributed::LocalRanks> local_ranks;
     if (nproc_ > 0 && std::getenv("RANK") == nullptr) {
-      local_ranks.emplace(nproc_,
-                          std::vector<std::string>(invocation.argv + 1,
-                                                   invocation.argv + invocation.argc));
+      local_ranks.emplace(
+          nproc_, std::vector<std::string>(invocation.argv + 1, invocation.argv + invocation.argc));
       gaussians::setCpuThreads();
     }
     const auto rank_env = distributed::RankEnvironment::fromProcessEnvironment();
@@ -131,7 +130,8 @@ class TrainCommand : public Command {
     installStopHandlers();
     const double seconds = pipeline::trainRun(options, config);
     if (local_ranks) local_ranks->waitAll();
-    if (!quiet_rank) std::cout << "trained in " << seconds << " s; model in " << out_ << "/model.ply\n";
+    if (!quiet_rank)
+      std::cout << "trained in " << seconds << " s; model in " << out_ << "/model.ply\n";
     return 0;
   }
 

@@ -14,12 +14,14 @@ class ViewCommand : public Command {
  public:
   CLI::App* add(CLI::App& app) override {
     CLI::App* c = app.add_subcommand(
-        "view", "Look at a model in 3D (VTK): splats by class, colour, confidence, gate or opacity");
+        "view",
+        "Look at a model in 3D (VTK): splats by class, colour, confidence, gate or opacity");
     c->add_option("MODEL", model_, "run directory, or a .ply / .pcd cloud")->required();
     c->add_option("--color", color_, "class, rgb, confidence, gate or opacity")
         ->capture_default_str();
     c->add_option("--class", classes_, "show only these classes (names or ids, comma-separated)");
-    c->add_option("--view", options_.view, "start at this camera of the run's scene (e.g. view_042)");
+    c->add_option("--view", options_.view,
+                  "start at this camera of the run's scene (e.g. view_042)");
     c->add_option("--compare", compare_, "a second model beside it, cameras linked");
     c->add_option("--screenshot", options_.screenshot, "write this PNG (offscreen) and exit");
     c->add_option("--size", size_, "window / screenshot size")->capture_default_str();

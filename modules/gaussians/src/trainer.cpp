@@ -318,10 +318,11 @@ at::Tensor Trainer::predictClasses(const RenderResult& r) const {
   return logits.argmax(2);
 }
 
-at::Tensor Trainer::classProbabilities(const RenderResult& r) const {
+at::Tensor Trainer::classCosines(const RenderResult& r) const {
   c10::AutoGradMode no_grad(false);
   if (numClasses() == 0) return at::Tensor();
-  return at::softmax(state_->decode(r.features), 2);
+  const at::Tensor d = state_->decode(r.features);
+  return d / d.norm(2, 2, true).clamp_min(1e-12);
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }

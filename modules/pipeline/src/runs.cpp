@@ -184,7 +184,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   const io::Scene scene = loadScene(o.scene, o.scale, o.progress);
   if (o.progress && scene.classes.empty()) {
     *o.progress << "RGB only: the scene has no classes.json, so no semantic head (plain 3DGS"
-                << (config.drop == "none" ? "" : ", drop " + config.drop + " without confidence maps")
+                << (config.drop == "none" ? ""
+                                          : ", drop " + config.drop + " without confidence maps")
                 << ")\n";
   } else if (o.progress) {
     int labelled = 0, pseudo = 0;
@@ -362,32 +363,38 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   return total;
 }
 
-std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
+OpenedRun openRun(const std::string& run_dir, const std::string& scene_override, double scale) {
   const auto run = readRunJson(run_dir);
   if (scene_override.empty() && !(run.contains("scene") && run["scene"].is_string())) {
     throw Error(run_dir + "/run.json", "scene", "the path of the run's scene (a string)",
                 run.contains("scene") ? run["scene"].dump().substr(0, 40) : std::string("missing"));
   }
-  const std::string scene_path =
-      scene_override.empty() ? run["scene"].get<std::string>() : scene_override;
-  const double run_scale =
-      scene_override.empty() && run.contains("scale") && run["scale"].is_number()
-          ? run["scale"].get<double>()
-          : scale;
-  const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
-      io::readWholeFile(run_dir + "/config.json"), run_dir + "/config.json");
-  const io::Scene scene = loadScene(scene_path, run_scale);
-  gaussians::Trainer trainer(scene, config);
-  trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
-  trainer.loadCheckpoint(run_dir + "/checkpoint.bin");
+  OpenedRun o;
+  o.dir = run_dir;
+  o.scene_path = scene_override.empty() ? run["scene"].get<std::string>() : scene_override;
+  o.scale = scene_override.empty() && run.contains("scale") && run["scale"].is_number()
+                ? run["scale"].get<double>()
+                : scale;
+  o.train_seconds = run.value("train_seconds", 0.0);
+  o.config = gaussians::TrainConfig::fromJson(io::readWholeFile(run_dir + "/config.json"),
+                                              run_dir + "/config.json");
+  o.scene = loadScene(o.scene_path, o.scale);
+  o.trainer = std::make_unique<gaussians::Trainer>(o.scene, o.config);
+  o.trainer->setDropStrategy(semantic_drop::makeDropStrategy(o.config));
+  o.trainer->loadCheckpoint(run_dir + "/checkpoint.bin");
+  return o;
+}
+
+std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
+  const OpenedRun run = openRun(run_dir, scene_override, scale);
   makeDirectory(run_dir + "/panels");
-  const eval::EvalResult result = eval::evaluate(trainer, scene, run_dir + "/panels");
+  const eval::EvalResult result = eval::evaluate(*run.trainer, run.scene, run_dir + "/panels");
   eval::RunFacts facts;
-  facts.num_gaussians = trainer.numGaussians();
-  facts.iterations = trainer.iteration();
-  facts.train_seconds = run.value("train_seconds", 0.0);
-  facts.device = config.device;
-  const std::string text = eval::metricsJson(result, scene.classes, facts);
+  facts.num_gaussians = run.trainer->numGaussians();
+  facts.iterations = run.trainer->iteration();
+  facts.train_seconds = run.train_seconds;
+  facts.device = run.config.device;
+  const std::string text = eval::metricsJson(result, run.scene.classes, facts);
   writeText(run_dir + "/metrics.json", text);
   return text;
 }

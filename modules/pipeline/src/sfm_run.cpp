@@ -110,7 +110,8 @@ void transformModel(io::ColmapModel& model, const io::Similarity& sim) {
     // x_cam = Rc x + tc = Rc R^T (x' - t) / s + tc; scaling camera coordinates by s changes no
     // projection: Rc' = Rc R^T, tc' = s tc - Rc' t.
     const Eigen::Matrix3d rc = rotationOf(im.qvec) * R.transpose();
-    const Eigen::Vector3d tc = sim.scale * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]) - rc * t;
+    const Eigen::Vector3d tc =
+        sim.scale * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]) - rc * t;
     const Eigen::Quaterniond q(rc);
     im.qvec = {q.w(), q.x(), q.y(), q.z()};
     im.tvec = {tc.x(), tc.y(), tc.z()};
@@ -126,12 +127,14 @@ SfmSummary sfmRun(const SfmOptions& o) {
     if (log) *log << text << std::flush;
   };
   if (!onPath(o.colmap)) {
-    throw Error(o.colmap, "program",
-                "COLMAP on the PATH (Debian: apt install colmap; scripts/setup_debian.sh installs it)",
-                "missing");
+    throw Error(
+        o.colmap, "program",
+        "COLMAP on the PATH (Debian: apt install colmap; scripts/setup_debian.sh installs it)",
+        "missing");
   }
   if (!io::isDirectory(o.photos)) {
-    throw Error(o.photos, "photos", "a folder of photos", io::pathExists(o.photos) ? "not a folder" : "missing");
+    throw Error(o.photos, "photos", "a folder of photos",
+                io::pathExists(o.photos) ? "not a folder" : "missing");
   }
   std::vector<std::string> photos;
   for (const auto& e : fs::directory_iterator(o.photos)) {
@@ -149,10 +152,12 @@ SfmSummary sfmRun(const SfmOptions& o) {
     throw Error("<sfm options>", "matcher", "auto, exhaustive, sequential or spatial", o.matcher);
   }
   if (o.max_image_size < 100) {
-    throw Error("<sfm options>", "max image size", ">= 100 pixels", std::to_string(o.max_image_size));
+    throw Error("<sfm options>", "max image size", ">= 100 pixels",
+                std::to_string(o.max_image_size));
   }
   if (io::pathExists(o.out + "/sparse") || io::pathExists(o.out + "/images")) {
-    throw Error(o.out, "scene directory", "a new or empty folder", "one with images/ or sparse/ already");
+    throw Error(o.out, "scene directory", "a new or empty folder",
+                "one with images/ or sparse/ already");
   }
   const std::string work = o.out + "/colmap";
   io::makeDirectory(o.out);
@@ -170,14 +175,16 @@ SfmSummary sfmRun(const SfmOptions& o) {
       (io::haveExif() ? "" : " (this build reads no EXIF: no georeference)") + "\n");
   std::string matcher = o.matcher;
   if (matcher == "auto") {
-    matcher = photos.size() <= 40 ? "exhaustive"
+    matcher = photos.size() <= 40               ? "exhaustive"
               : gps.size() * 2 >= photos.size() ? "spatial"
                                                 : "sequential";
   }
   const std::string threads = std::to_string(o.threads);
   const std::string size = std::to_string(o.max_image_size);
-  nlohmann::json report = {{"photos", photos.size()}, {"photos_with_gps", gps.size()},
-                           {"matcher", matcher}, {"max_image_size", o.max_image_size}};
+  nlohmann::json report = {{"photos", photos.size()},
+                           {"photos_with_gps", gps.size()},
+                           {"matcher", matcher},
+                           {"max_image_size", o.max_image_size}};
   nlohmann::json stages = nlohmann::json::array();
   int stage_number = 0;
   const auto stage = [&](const std::string& name, const std::vector<std::string>& args) {
@@ -202,9 +209,14 @@ SfmSummary sfmRun(const SfmOptions& o) {
          "--ImageReader.single_camera", o.single_camera ? "1" : "0",
          "--SiftExtraction.max_image_size", size, "--SiftExtraction.num_threads", threads,
          "--SiftExtraction.use_gpu", "0"});
-  std::vector<std::string> match = {o.colmap, matcher + "_matcher", "--database_path", db,
-                                    "--SiftMatching.num_threads", threads,
-                                    "--SiftMatching.use_gpu", "0"};
+  std::vector<std::string> match = {o.colmap,
+                                    matcher + "_matcher",
+                                    "--database_path",
+                                    db,
+                                    "--SiftMatching.num_threads",
+                                    threads,
+                                    "--SiftMatching.use_gpu",
+                                    "0"};
   if (matcher == "sequential") {
     match.insert(match.end(), {"--SequentialMatching.overlap", "10"});
   }
@@ -253,8 +265,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
   for (const auto& im : model.images) {
     const auto it = gps.find(im.name);
     if (it == gps.end()) continue;
-    const Eigen::Vector3d c = -rotationOf(im.qvec).transpose() *
-                              Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
+    const Eigen::Vector3d c =
+        -rotationOf(im.qvec).transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
     centres.push_back({c.x(), c.y(), c.z()});
     used.push_back(&it->second);
   }
@@ -312,8 +324,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
   std::ostringstream done;
   done.precision(3);
   done << "sfm: registered " << summary.registered << " of " << summary.photos << " photos, "
-       << summary.points << " points, mean reprojection error "
-       << summary.mean_reprojection_error << " px";
+       << summary.points << " points, mean reprojection error " << summary.mean_reprojection_error
+       << " px";
   if (summary.georeferenced) {
     const auto g = io::georeferenceFromJson(io::readWholeFile(o.out + "/georeference.json"),
                                             o.out + "/georeference.json");

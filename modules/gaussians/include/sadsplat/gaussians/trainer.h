@@ -95,10 +95,12 @@ class Trainer {
   /// \brief Per-pixel class ids [H, W] int64 from a render's feature image (argmax of the cosine
   /// similarity of the decoded feature to each class embedding).
   at::Tensor predictClasses(const RenderResult& render) const;
-  /// \brief Per-pixel class probabilities [H, W, classes] (softmax of the decoded feature; the
-  /// maximum is the confidence of predictClasses' class). Undefined tensor when the model has no
-  /// classes.
-  at::Tensor classProbabilities(const RenderResult& render) const;
+  /// \brief Per-pixel cosine similarity of the decoded feature to each class's one-hot
+  /// embedding [H, W, classes]: what the semantic loss trains (1 - cosine), so its maximum is at
+  /// predictClasses' class and is that class's confidence (1: the decoded feature is exactly the
+  /// class's embedding; near 1/sqrt(classes): no class stands out). Not a calibrated
+  /// probability. Undefined tensor when the model has no classes.
+  at::Tensor classCosines(const RenderResult& render) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 

@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -63,6 +64,24 @@ class TrainingInterrupted : public Error {
 /// \throws sadsplat::Error on bad input, a diverged training or no GPU memory;
 /// TrainingInterrupted when `stop` was set
 double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& config);
+
+/// \brief A trained run opened for rendering: its scene, configuration and model (the trainer
+/// restored from checkpoint.bin).
+struct OpenedRun {
+  std::string dir;
+  std::string scene_path;  ///< the scene the run trained on (or the override)
+  double scale = 0.5;      ///< the import scale of a scene directory
+  double train_seconds = 0;
+  io::Scene scene;
+  gaussians::TrainConfig config;
+  std::unique_ptr<gaussians::Trainer> trainer;
+};
+
+/// \brief Opens a run directory (run.json, config.json, checkpoint.bin) on its scene or on
+/// `scene_override`.
+/// \throws sadsplat::Error naming the run's file and field
+OpenedRun openRun(const std::string& run_dir, const std::string& scene_override = "",
+                  double scale = 0.5);
 
 /// \brief Evaluates a run directory on its scene (or `scene_override`): writes metrics.json and
 /// panels/, returns the metrics.json text.

@@ -24,9 +24,9 @@ struct SfmOptions {
   /// Longest image side for feature extraction and for the undistorted images (COLMAP's
   /// max_image_size; a 4000x3000 survey photo is then 2000x1500).
   int max_image_size = 2000;
-  bool single_camera = true;  ///< one camera for every photo (one drone, one lens)
-  int threads = -1;           ///< -1: every core
-  double gps_inlier_metres = 5;  ///< GPS within this of the fitted camera centre is an inlier
+  bool single_camera = true;      ///< one camera for every photo (one drone, one lens)
+  int threads = -1;               ///< -1: every core
+  double gps_inlier_metres = 5;   ///< GPS within this of the fitted camera centre is an inlier
   std::string colmap = "colmap";  ///< the program
   std::ostream* progress = nullptr;
 };

@@ -1,0 +1,53 @@
+// `sadsplat ortho RUN --out DIR`: the map products of a trained run as GeoTIFF: true
+// orthophoto, class map, surface model, confidence, and the area of every class.
+#include <array>
+#include <iostream>
+#include <vector>
+
+#include "commands.h"
+#include "sadsplat/pipeline/map_products.h"
+
+namespace sadsplat {
+namespace cli {
+namespace {
+
+class OrthoCommand : public Command {
+ public:
+  CLI::App* add(CLI::App& app) override {
+    CLI::App* c = app.add_subcommand(
+        "ortho",
+        "Map products of a trained run: orthophoto, class map, surface model and confidence as "
+        "GeoTIFF (UTM of the georeference, or local metres), class areas");
+    c->add_option("RUN", o_.run, "run directory")->required();
+    c->add_option("--out", o_.out, "output directory")->required();
+    c->add_option("--gsd", gsd_, "metres per pixel (default: the photos' ground sample distance)");
+    c->add_option("--bounds", bounds_,
+                  "xmin,ymin,xmax,ymax in the map's CRS (default: the "
+                  "model's footprint)")
+        ->delimiter(',')
+        ->expected(4);
+    return c;
+  }
+  int run(const Invocation&) override {
+    if (gsd_set()) o_.gsd = gsd_;
+    if (!bounds_.empty())
+      o_.bounds = std::array<double, 4>{bounds_[0], bounds_[1], bounds_[2], bounds_[3]};
+    o_.progress = &std::cout;
+    std::cout << pipeline::orthoRun(o_);
+    return 0;
+  }
+
+ private:
+  bool gsd_set() const { return gsd_ != kUnset; }
+  static constexpr double kUnset = -1e300;
+  pipeline::OrthoRunOptions o_;
+  double gsd_ = kUnset;
+  std::vector<double> bounds_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> makeOrthoCommand() { return std::make_unique<OrthoCommand>(); }
+
+}  // namespace cli
+}  // namespace sadsplat

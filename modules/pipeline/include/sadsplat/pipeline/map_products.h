@@ -1,0 +1,58 @@
+#pragma once
+/// \file map_products.h
+/// \brief The jobs behind `sadsplat render` (per-photo class, colour, RGB, depth and confidence
+/// images, at the photos' own size, and novel views along an orbit) and `sadsplat ortho` (the
+/// semantic orthophoto, class map, surface model and confidence as GeoTIFF, with class areas),
+/// and `sadsplat eval --ortho` (the class map scored against a map-grid ground truth).
+
+#include <array>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace sadsplat {
+namespace pipeline {
+
+/// \brief Options of `sadsplat render`.
+struct RenderRunOptions {
+  std::string run;            ///< run directory
+  std::string out;            ///< output directory (created)
+  std::string views = "all";  ///< all | train | test | comma-separated image names
+  int width = 0, height = 0;  ///< --size WxH (0: see scale)
+  double scale = 0;           ///< --scale S of the imported size (0: the original photos')
+  std::vector<std::string> outputs{"class", "colour", "rgb", "depth", "confidence"};
+  std::string path;  ///< "orbit:N": N novel views around the scene instead
+  std::ostream* progress = nullptr;
+};
+
+/// \brief Renders the views; returns the number of images written. Files:
+/// OUT/class/NAME.png (8-bit class ids, 255 = none), OUT/colour/NAME.png (class palette),
+/// OUT/rgb/NAME.png, OUT/depth/NAME.tif (float32 camera z, 0 = none), OUT/confidence/NAME.png
+/// (8-bit, 255 x the decoded class's cosine, Trainer::classCosines), NAME = the image name without extension.
+/// \throws sadsplat::Error for unknown views or outputs, bad sizes, an unwritable OUT
+int renderRun(const RenderRunOptions& options);
+
+/// \brief Options of `sadsplat ortho`.
+struct OrthoRunOptions {
+  std::string run;
+  std::string out;
+  std::optional<double>
+      gsd;  ///< metres per pixel (> 0); none = the photos' median ground sample distance
+  std::optional<std::array<double, 4>> bounds;  ///< xmin, ymin, xmax, ymax in the map CRS
+  std::ostream* progress = nullptr;
+};
+
+/// \brief Writes OUT/orthophoto.tif (RGBA), classes.tif (class ids with a colour table, 255 =
+/// nodata), dsm.tif (float32 height, -9999 = nodata), confidence.tif (float32, -1 = nodata),
+/// their PNG previews, classes.csv (pixels, area in m^2 and share per class) and ortho.json (the
+/// grid, CRS and fit). Returns a short summary for the terminal.
+std::string orthoRun(const OrthoRunOptions& options);
+
+/// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's
+/// ortho_truth.json (written by `sadsplat synth`) and scores it: mIoU, per-class IoU, and the
+/// area error per class. Writes RUN/ortho_metrics.json and returns its text.
+std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json = "");
+
+}  // namespace pipeline
+}  // namespace sadsplat

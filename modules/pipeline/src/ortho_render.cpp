@@ -1,0 +1,198 @@
+#include "sadsplat/pipeline/ortho_render.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sadsplat/common/error.h"
+
+namespace sadsplat {
+namespace pipeline {
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+// The quaternion (w, x, y, z) of a row-major rotation matrix (Shepperd's method).
+std::array<double, 4> quaternionOf(const std::array<double, 9>& R) {
+  const double tr = R[0] + R[4] + R[8];
+  std::array<double, 4> q{};
+  if (tr > 0) {
+    const double s = 2 * std::sqrt(1 + tr);
+    q = {0.25 * s, (R[7] - R[5]) / s, (R[2] - R[6]) / s, (R[3] - R[1]) / s};
+  } else if (R[0] > R[4] && R[0] > R[8]) {
+    const double s = 2 * std::sqrt(1 + R[0] - R[4] - R[8]);
+    q = {(R[7] - R[5]) / s, 0.25 * s, (R[1] + R[3]) / s, (R[2] + R[6]) / s};
+  } else if (R[4] > R[8]) {
+    const double s = 2 * std::sqrt(1 + R[4] - R[0] - R[8]);
+    q = {(R[2] - R[6]) / s, (R[1] + R[3]) / s, 0.25 * s, (R[5] + R[7]) / s};
+  } else {
+    const double s = 2 * std::sqrt(1 + R[8] - R[0] - R[4]);
+    q = {(R[3] - R[1]) / s, (R[2] + R[6]) / s, (R[5] + R[7]) / s, 0.25 * s};
+  }
+  return q;
+}
+
+double percentile(std::vector<double> v, double p) {
+  const std::size_t i = static_cast<std::size_t>(p * (v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + i, v.end());
+  return v[i];
+}
+
+}  // namespace
+
+OrthoGrid footprintGrid(const gaussians::Trainer& trainer, const io::Scene& scene, double gsd,
+                        const std::optional<std::array<double, 4>>& bounds) {
+  if (!(gsd > 0) || !std::isfinite(gsd)) {
+    throw Error("<ortho>", "--gsd", "a ground sample distance > 0 (metres per pixel)",
+                std::to_string(gsd));
+  }
+  const gaussians::GaussianParams g = trainer.parameters();
+  const at::Tensor means = g.means.detach().to(at::kCPU, at::kDouble).contiguous();
+  const at::Tensor opacity = at::sigmoid(g.opacity_logits.detach().to(at::kCPU, at::kDouble));
+  const std::int64_t n = means.size(0);
+  const double* m = means.data_ptr<double>();
+  const double* o = opacity.data_ptr<double>();
+
+  const geo::MapFrame local = geo::localMapFrame(geo::sceneUp(scene));
+  std::vector<double> e, nn;
+  double top = -1e300;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const Vec3 l = local.toLocal({m[3 * i], m[3 * i + 1], m[3 * i + 2]});
+    top = std::max(top, l[2]);
+    if (o[i] < 0.1) continue;
+    e.push_back(l[0]);
+    nn.push_back(l[1]);
+  }
+  if (e.size() < 2) {
+    throw Error("<ortho>", "model", "Gaussians of opacity >= 0.1 to map", std::to_string(e.size()));
+  }
+  double e0 = percentile(e, 0.01), e1 = percentile(e, 0.99);
+  double n0 = percentile(nn, 0.01), n1 = percentile(nn, 0.99);
+  const double margin = 0.02 * std::max(e1 - e0, n1 - n0);
+  e0 -= margin, e1 += margin, n0 -= margin, n1 += margin;
+
+  OrthoGrid grid;
+  grid.gsd = gsd;
+  grid.top = top + 1.0;
+  grid.frame = scene.georeference ? geo::utmMapFrame(*scene.georeference, e0, n0, e1, n1) : local;
+  double x0, y0, x1, y1;
+  if (bounds) {
+    x0 = (*bounds)[0], y0 = (*bounds)[1], x1 = (*bounds)[2], y1 = (*bounds)[3];
+    if (!(x1 > x0 && y1 > y0)) {
+      throw Error("<ortho>", "--bounds", "xmin,ymin,xmax,ymax with xmax > xmin and ymax > ymin",
+                  std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(x1) + "," +
+                      std::to_string(y1));
+    }
+  } else {
+    x0 = y0 = 1e300, x1 = y1 = -1e300;
+    for (double a : {e0, e1}) {
+      for (double b : {n0, n1}) {
+        // The local frame's z is the map's up: corners of the footprint on the map.
+        const double E = grid.frame.k * (grid.frame.c * a - grid.frame.s * b) + grid.frame.bE;
+        const double N = grid.frame.k * (grid.frame.s * a + grid.frame.c * b) + grid.frame.bN;
+        x0 = std::min(x0, E), x1 = std::max(x1, E), y0 = std::min(y0, N), y1 = std::max(y1, N);
+      }
+    }
+    x0 = std::floor(x0 / gsd) * gsd, y0 = std::floor(y0 / gsd) * gsd;
+    x1 = std::ceil(x1 / gsd) * gsd, y1 = std::ceil(y1 / gsd) * gsd;
+  }
+  const double w = std::ceil((x1 - x0) / gsd - 1e-9), h = std::ceil((y1 - y0) / gsd - 1e-9);
+  if (!(w <= 40000 && h <= 40000)) {
+    throw Error("<ortho>", "--gsd",
+                "a grid of at most 40000 pixels a side (a larger ground sample distance)",
+                std::to_string(static_cast<long long>(w)) + " x " +
+                    std::to_string(static_cast<long long>(h)) + " pixels at " +
+                    std::to_string(gsd) + " m");
+  }
+  grid.x0 = x0;
+  grid.y0 = y1;
+  grid.width = std::max(1, static_cast<int>(w));
+  grid.height = std::max(1, static_cast<int>(h));
+  return grid;
+}
+
+double orthoTop(const gaussians::Trainer& trainer, const geo::MapFrame& frame) {
+  const at::Tensor means = trainer.parameters().means.detach().to(at::kCPU, at::kDouble);
+  const auto& L = frame.scene_to_local;
+  const at::Tensor up = at::tensor({L[6], L[7], L[8]}, means.options());
+  return means.numel() ? (means.matmul(up)).max().item<double>() + 1.0 : 1.0;
+}
+
+gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off, int w, int h) {
+  const geo::MapFrame& f = grid.frame;
+  const auto& L = f.scene_to_local;
+  // Camera x = map east, y = map south, z = down; pixel = (k / gsd) (x, y) + (cx, cy).
+  std::array<double, 9> R{};
+  for (int j = 0; j < 3; ++j) {
+    R[j] = f.c * L[j] - f.s * L[3 + j];
+    R[3 + j] = -f.s * L[j] - f.c * L[3 + j];
+    R[6 + j] = -L[6 + j];
+  }
+  gaussians::RasterCamera cam;
+  cam.orthographic = true;
+  cam.width = w;
+  cam.height = h;
+  cam.fx = cam.fy = f.k / grid.gsd;
+  cam.cx = (f.bE - grid.x0) / grid.gsd - x_off;
+  cam.cy = (grid.y0 - f.bN) / grid.gsd - y_off;
+  cam.qvec = quaternionOf(R);
+  cam.tvec = {0, 0, grid.top};
+  return cam;
+}
+
+OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                        std::ostream* progress, int tile) {
+  OrthoImages out;
+  out.width = grid.width;
+  out.height = grid.height;
+  const std::size_t pixels = static_cast<std::size_t>(grid.width) * grid.height;
+  out.rgb.assign(3 * pixels, 0);
+  out.covered.assign(pixels, 0);
+  out.classes.assign(pixels, 255);
+  out.elevation.assign(pixels, 0.f);
+  out.confidence.assign(pixels, 0.f);
+  const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
+  int done = 0;
+  for (int ty = 0; ty < tiles_y; ++ty) {
+    for (int tx = 0; tx < tiles_x; ++tx) {
+      const int x_off = tx * tile, y_off = ty * tile;
+      const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
+      const gaussians::RenderResult r = trainer.renderCamera(orthoCamera(grid, x_off, y_off, w, h));
+      const at::Tensor rgb =
+          r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
+      const at::Tensor alpha = r.alpha.to(at::kCPU, at::kFloat).contiguous();
+      const at::Tensor depth = r.depth.to(at::kCPU, at::kFloat).contiguous();
+      at::Tensor cls, conf;
+      if (trainer.numClasses() > 0) {
+        const auto best = trainer.classCosines(r).max(2);
+        conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
+        cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
+      }
+      const auto* prgb = rgb.data_ptr<std::uint8_t>();
+      const float* pa = alpha.data_ptr<float>();
+      const float* pd = depth.data_ptr<float>();
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t s = static_cast<std::size_t>(y) * w + x;
+          const std::size_t d = static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
+          for (int c = 0; c < 3; ++c) out.rgb[3 * d + c] = prgb[3 * s + c];
+          if (pa[s] < 0.5f) continue;
+          out.covered[d] = 1;
+          out.elevation[d] = static_cast<float>(grid.top - pd[s] + grid.frame.height_offset);
+          if (cls.defined()) {
+            out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
+            out.confidence[d] = conf.data_ptr<float>()[s];
+          }
+        }
+      }
+      ++done;
+      if (progress && tiles_x * tiles_y > 1) {
+        *progress << "\r  ortho tile " << done << "/" << tiles_x * tiles_y << std::flush;
+      }
+    }
+  }
+  if (progress && tiles_x * tiles_y > 1) *progress << "\n";
+  return out;
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat
