@@ -13,6 +13,7 @@
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/las.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
@@ -76,6 +77,41 @@ void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& 
   }
   out << "labelled gaussians: " << labelled;
   if (labelled) out << " (class ids up to " << max_label << ")";
+  out << "\n";
+  if (labelled) {
+    std::map<std::uint32_t, std::size_t> histogram;
+    for (const auto& p : cloud) {
+      if (p.label != kUnlabelled) ++histogram[p.label];
+    }
+    out << "gaussians per class id:";
+    for (const auto& [id, count] : histogram) out << " " << id << ":" << count;
+    out << "\n";
+  }
+}
+
+void describeLas(std::ostream& out, const std::string& path) {
+  LasHeader h;
+  const std::vector<LasPoint> points = readLas(path, &h);
+  std::string crs = "none";
+  if (!h.wkt.empty()) {  // the name: the first quoted string of the WKT
+    const std::size_t a = h.wkt.find('"'), b = h.wkt.find('"', a + 1);
+    crs = a != std::string::npos && b != std::string::npos ? h.wkt.substr(a + 1, b - a - 1)
+                                                          : "(WKT without a name)";
+  }
+  out << path << ": LAS 1." << h.version_minor << ", point format " << h.point_format << "\n"
+      << "points: " << points.size() << "\n"
+      << "CRS: " << crs << "\n"
+      << std::fixed << std::setprecision(3) << "bounding box: [" << h.min[0] << ", " << h.min[1]
+      << ", " << h.min[2] << "] .. [" << h.max[0] << ", " << h.max[1] << ", " << h.max[2]
+      << "]\n";
+  std::map<int, std::size_t> histogram;
+  for (const LasPoint& p : points) ++histogram[p.classification];
+  out << "points per ASPRS class:";
+  for (const auto& [code, count] : histogram) {
+    const auto it = asprsClassNames().find(code);
+    out << " " << code << " (" << (it != asprsClassNames().end() ? it->second : "user") << "):"
+        << count;
+  }
   out << "\n";
 }
 
@@ -236,12 +272,14 @@ std::string describeFile(const std::string& path) {
   } else if (ext == ".splat") {
     out << path << ": .splat web-viewer splats (no semantic fields)\n";
     describeGaussians(out, readSplat(path));
+  } else if (ext == ".las") {
+    describeLas(out, path);
   } else if (ext == ".pcd") {
     out << path << ": PCD of GaussianPoint\n";
     describeGaussians(out, loadGaussianPcd(path));
   } else {
     throw Error(path, "file type",
-                "a .ply, .pcd, .splat, .spz or .sog file, a scene cache or a scene directory",
+                "a .ply, .pcd, .splat, .spz, .sog or .las file, a scene cache or a scene directory",
                 ext.empty() ? "no extension" : ext);
   }
   return out.str();
