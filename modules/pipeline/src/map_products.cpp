@@ -16,6 +16,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/runs.h"
+#include "sadsplat/synth/aerial_benchmark.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -369,7 +370,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
     conf_preview.last_band_is_alpha = true;
     for (std::size_t i = 0; i < n; ++i) {
       conf.floats[i] = img.covered[i] ? img.confidence[i] : -1.f;
-      conf_preview.bytes[2 * i] = static_cast<std::uint8_t>(std::lround(255 * std::max(0.f, img.confidence[i])));
+      conf_preview.bytes[2 * i] =
+          static_cast<std::uint8_t>(std::lround(255 * std::max(0.f, img.confidence[i])));
       conf_preview.bytes[2 * i + 1] = img.covered[i] ? 255 : 0;
     }
     geo::writeGeoTiff(o.out + "/confidence.tif", conf, &map);
@@ -451,41 +453,56 @@ std::string orthoRun(const OrthoRunOptions& o) {
 
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in) {
   OpenedRun run = openRun(run_dir);
+  if (run.trainer->numClasses() == 0) {
+    throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
+  }
   std::string truth_json = truth_json_in;
   if (truth_json.empty()) {
     const std::string dir = sceneDirectory(run);
     truth_json = (dir.empty() ? run.scene_path : dir) + "/ortho_truth.json";
   }
-  if (!io::isRegularFile(truth_json)) {
-    throw Error(truth_json, "file",
-                "the map-grid ground truth (ortho_truth.json, written by `sadsplat synth`)",
-                "missing");
-  }
-  nlohmann::json t;
-  try {
-    t = nlohmann::json::parse(io::readWholeFile(truth_json));
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(truth_json, "JSON", "valid JSON", e.what());
-  }
-  for (const char* key : {"gsd", "x0", "y0", "width", "height", "classes_png"}) {
-    if (!t.contains(key)) throw Error(truth_json, key, "a value", "missing");
-  }
-  if (run.trainer->numClasses() == 0) {
-    throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
-  }
-  const std::size_t slash = truth_json.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : truth_json.substr(0, slash);
-  const geo::Raster truth = geo::readByteRaster(dir + "/" + t["classes_png"].get<std::string>());
+  // The truth: the JSON + PNG `sadsplat synth --out` writes, or (a synth scene cache, which
+  // names its world) traced again from the world.
   OrthoGrid grid;
   grid.frame = geo::localMapFrame({0, 0, 1});  // the truth is on the scene frame's x-y plane
-  grid.gsd = t["gsd"].get<double>();
-  grid.x0 = t["x0"].get<double>();
-  grid.y0 = t["y0"].get<double>();
-  grid.width = t["width"].get<int>();
-  grid.height = t["height"].get<int>();
-  if (truth.width != grid.width || truth.height != grid.height) {
-    throw Error(truth_json, "width/height", "the size of " + t["classes_png"].get<std::string>(),
-                std::to_string(grid.width) + "x" + std::to_string(grid.height));
+  std::vector<std::uint8_t> truth;
+  std::string truth_source = truth_json;
+  const std::optional<synth::World> world = truth_json_in.empty() && !io::isRegularFile(truth_json)
+                                                ? synth::worldFromId(run.scene.source)
+                                                : std::nullopt;
+  if (world) {
+    synth::OrthoTruth t = synth::orthoTruth(*world);
+    grid.gsd = t.gsd, grid.x0 = t.x0, grid.y0 = t.y0, grid.width = t.width, grid.height = t.height;
+    truth = std::move(t.classes);
+    truth_source = run.scene.source + " (traced)";
+  } else {
+    if (!io::isRegularFile(truth_json)) {
+      throw Error(truth_json, "file",
+                  "the map-grid ground truth (ortho_truth.json, written by `sadsplat synth`)",
+                  "missing");
+    }
+    nlohmann::json t;
+    try {
+      t = nlohmann::json::parse(io::readWholeFile(truth_json));
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(truth_json, "JSON", "valid JSON", e.what());
+    }
+    for (const char* key : {"gsd", "x0", "y0", "width", "height", "classes_png"}) {
+      if (!t.contains(key)) throw Error(truth_json, key, "a value", "missing");
+    }
+    const std::size_t slash = truth_json.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? "." : truth_json.substr(0, slash);
+    const geo::Raster png = geo::readByteRaster(dir + "/" + t["classes_png"].get<std::string>());
+    grid.gsd = t["gsd"].get<double>();
+    grid.x0 = t["x0"].get<double>();
+    grid.y0 = t["y0"].get<double>();
+    grid.width = t["width"].get<int>();
+    grid.height = t["height"].get<int>();
+    if (png.width != grid.width || png.height != grid.height) {
+      throw Error(truth_json, "width/height", "the size of " + t["classes_png"].get<std::string>(),
+                  std::to_string(grid.width) + "x" + std::to_string(grid.height));
+    }
+    truth = png.bytes;
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
   const OrthoImages img = renderOrtho(*run.trainer, grid);
@@ -495,8 +512,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   std::vector<std::int64_t> pred;
   std::int64_t labelled = 0, uncovered = 0;
   std::vector<std::int64_t> truth_cells(C, 0), predicted_cells(C, 0);
-  for (std::size_t i = 0; i < truth.bytes.size(); ++i) {
-    const std::uint8_t g = truth.bytes[i];
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const std::uint8_t g = truth[i];
     if (g >= C) continue;
     ++labelled;
     ++truth_cells[g];
@@ -511,7 +528,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   confusion.add(gt.data(), pred.data(), gt.size());
   const auto iou = confusion.perClassIou();
   nlohmann::json j;
-  j["truth"] = truth_json;
+  j["truth"] = truth_source;
   j["gsd"] = grid.gsd;
   j["cells"] = labelled;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "sadsplat/common/error.h"
@@ -366,6 +367,48 @@ SynthOptions SynthOptions::cityXl(std::uint64_t seed) {
   return o;
 }
 
+std::string worldId(SceneKind kind, std::uint64_t seed, int tiles) {
+  return std::string("synth:") + sceneKindName(kind) + ":" + std::to_string(seed) + ":" +
+         std::to_string(tiles);
+}
+
+std::optional<World> worldFromId(const std::string& id) {
+  std::istringstream in(id);
+  std::string prefix, kind, seed, tiles;
+  if (!std::getline(in, prefix, ':') || prefix != "synth" || !std::getline(in, kind, ':') ||
+      !std::getline(in, seed, ':') || !std::getline(in, tiles)) {
+    return std::nullopt;
+  }
+  try {
+    return World(parseSceneKind(kind), std::stoull(seed), std::stoi(tiles));
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+OrthoTruth orthoTruth(const World& world, double gsd) {
+  OrthoTruth t;
+  t.gsd = gsd;
+  const double e = world.extent();
+  t.x0 = -e;
+  t.y0 = e;
+  t.width = t.height = static_cast<int>(std::ceil(2 * e / gsd));
+  t.classes.assign(static_cast<std::size_t>(t.width) * t.height, 255);
+  const float down[3] = {0.f, 0.f, -1.f};
+  const float top = world.maxHeight() + 10.f;
+  for (int j = 0; j < t.height; ++j) {
+    for (int i = 0; i < t.width; ++i) {
+      const float origin[3] = {static_cast<float>(t.x0 + (i + 0.5) * gsd),
+                               static_cast<float>(t.y0 - (j + 0.5) * gsd), top};
+      Hit hit;
+      if (world.trace(origin, down, top + 100.f, &hit)) {
+        t.classes[static_cast<std::size_t>(j) * t.width + i] = hit.cls;
+      }
+    }
+  }
+  return t;
+}
+
 SynthScene generate(const SynthOptions& o) {
   if (o.views < 2 || o.width < 16 || o.height < 16) {
     throw Error("<synth>", "views/width/height", "at least 2 views of at least 16x16 pixels",
@@ -407,6 +450,8 @@ SynthScene generate(const SynthOptions& o) {
     scene.views.push_back(std::move(view));
   }
   samplePoints(o, poses, &scene);
+  scene.ortho = orthoTruth(world);
+  scene.world = worldId(o.kind, o.seed, o.tiles);
   for (int i = 0; i < o.views; ++i) {
     const bool test = std::find(o.test.begin(), o.test.end(), i) != o.test.end();
     if (test) {
@@ -424,7 +469,7 @@ SynthScene generate(const SynthOptions& o) {
 
 io::Scene toScene(const SynthScene& synth) {
   io::Scene scene;
-  scene.source = "synth";
+  scene.source = synth.world.empty() ? "synth" : synth.world;
   scene.classes = synth.classes;
   const std::set<std::string> train(synth.split.train.begin(), synth.split.train.end());
   const std::set<std::string> test(synth.split.test.begin(), synth.split.test.end());

@@ -1,5 +1,8 @@
 #include "sadsplat/synth/scene_writer.h"
 
+#include <iomanip>
+#include <sstream>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -116,6 +119,21 @@ void writeScene(const SynthScene& scene, const std::string& dir, ColmapFormat co
   }
   io::writeClassesJson(dir + "/classes.json", scene.classes);
   io::writeSplitJson(dir + "/split.json", scene.split);
+  if (!scene.ortho.classes.empty()) {
+    const OrthoTruth& t = scene.ortho;
+    cv::Mat truth(t.height, t.width, CV_8UC1, const_cast<std::uint8_t*>(t.classes.data()));
+    writePng(dir + "/ortho_truth.png", truth);
+    std::ostringstream json;
+    json
+        << std::setprecision(17)
+        << "{\n  \"frame\": \"scene (metres, z up)\",\n  \"gsd\": " << t.gsd
+        << ",\n  \"x0\": " << t.x0 << ",\n  \"y0\": " << t.y0 << ",\n  \"width\": " << t.width
+        << ",\n  \"height\": " << t.height
+        << ",\n  \"classes_png\": \"ortho_truth.png\",\n  \"note\": \"class of the topmost surface "
+           "at each cell centre, 255 = outside the labelled area\"\n}\n";
+    io::writeFileAtomically(dir + "/ortho_truth.json",
+                            [&](std::ostream& out) { out << json.str(); });
+  }
 }
 
 void writeContactSheet(const SynthScene& scene, const std::string& png_path) {

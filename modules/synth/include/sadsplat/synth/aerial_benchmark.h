@@ -5,6 +5,7 @@
 /// directory (images/, labels/, depth/, sparse/0/, classes.json, split.json).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,12 +57,34 @@ struct SynthPoint {
   std::vector<std::pair<int, std::array<float, 2>>> track;  ///< (view index, pixel position)
 };
 
+/// \brief The class of the topmost surface of every ground cell, looking straight down: the
+/// ground truth of a semantic orthophoto (a true ortho: roofs and tree crowns, not the ground under
+/// them). Cell (i, j) covers x in [x0 + i gsd, x0 + (i + 1) gsd], y in [y0 - (j + 1) gsd,
+/// y0 - j gsd] of the world frame (metres, z up); its class is the one at the cell centre.
+struct OrthoTruth {
+  double gsd = 0.25;
+  double x0 = 0, y0 = 0;
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> classes;  ///< row-major, 255 = outside the labelled area
+};
+
+/// \brief "synth:KIND:SEED:TILES": names a generated world; toScene stores it as the scene's
+/// source, so a scene cache knows the world its map-grid truth comes from.
+std::string worldId(SceneKind kind, std::uint64_t seed, int tiles);
+/// \brief The world a worldId names, or nothing for any other text.
+std::optional<World> worldFromId(const std::string& id);
+
+/// \brief Traces the world top-down over its labelled area at `gsd` metres per cell.
+OrthoTruth orthoTruth(const World& world, double gsd = 0.25);
+
 /// \brief A whole generated benchmark scene in memory.
 struct SynthScene {
   std::vector<ClassInfo> classes;
   std::vector<SynthView> views;
   std::vector<SynthPoint> points;
   io::SplitInfo split;
+  OrthoTruth ortho;    ///< the map-grid ground truth (`sadsplat eval --ortho`)
+  std::string world;   ///< worldId() of the generating world (a cache's source)
   double seconds = 0;  ///< generation time
 };
 
