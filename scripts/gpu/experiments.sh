@@ -14,7 +14,8 @@
 #   bash scripts/gpu/experiments.sh scene SCENE JOBS DEADLINE_S 'NAME:train flags' ...
 #       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
-#       at once; ITERATIONS (7000); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs)
+#       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
+#       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs)
 #
 # RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
 #   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set
@@ -262,7 +263,9 @@ mode_scene() {
       # shellcheck disable=SC2086
       run_until_deadline "$bin" train "$cache" --device cuda --iterations "${ITERATIONS:-7000}" \
         --out "$work/run_$name" $flags > "$work/results/train_$name.log" 2>&1 &&
-        "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" ||
+        "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" &&
+        { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho \
+            > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } ||
         echo "$name: stopped (rc $?)"
     ) &
   done
@@ -273,6 +276,8 @@ mode_scene() {
     local name="${spec%%:*}"
     f="$work/results/metrics_$name.json"
     [ -s "$f" ] && metrics_line "$name" "$f" >> "$summary"
+    f="$work/results/ortho_$name.json"
+    [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
     echo "    flags: ${spec#*:}; $(train_summary "$work/results/train_$name.log"); drops: $(tr '\r' '\n' < "$work/results/train_$name.log" | grep -c '^\[drop\]')" >> "$summary"
   done
   tar -czf "$OUT/scene_$tag.tgz" -C "$work" results
