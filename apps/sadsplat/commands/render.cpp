@@ -19,14 +19,14 @@ class RenderCommand : public Command {
     c->add_option("--out", o_.out, "output directory (one folder per output)")->required();
     c->add_option("--views", o_.views, "all, train, test, or image names separated by commas")
         ->capture_default_str();
-    c->add_option("--size", size_, "WxH of every image (default: each photo's original size)");
-    c->add_option("--scale", o_.scale, "factor of the imported image size instead");
+    CLI::Option* size =
+        c->add_option("--size", size_, "WxH of every image (default: each photo's original size)");
+    c->add_option("--scale", o_.scale, "factor of the imported image size instead")->excludes(size);
     c->add_option("--outputs", o_.outputs,
                   "any of class, colour, rgb, depth, confidence (comma-separated)")
         ->delimiter(',')
         ->capture_default_str();
     c->add_option("--path", o_.path, "orbit:N: N novel views on a circle around the scene");
-    c->excludes(c->get_option("--scale"))->excludes(c->get_option("--size"));
     return c;
   }
   int run(const Invocation&) override {

@@ -321,6 +321,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
   }
+  io::makeDirectory(o.out);  // an unwritable output fails before the work
   OpenedRun run = openRun(o.run);
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
@@ -329,7 +330,6 @@ std::string orthoRun(const OrthoRunOptions& o) {
                 << grid.frame.crs_name << "\n";
   }
   const OrthoImages img = renderOrtho(*run.trainer, grid, o.progress);
-  io::makeDirectory(o.out);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
 

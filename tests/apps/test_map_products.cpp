@@ -1,0 +1,257 @@
+// The GIS outputs through the CLI, on a small synth scene trained for a few iterations: `render`
+// (class ids per view, sizes, orbit), `ortho` (GeoTIFFs read back by GDAL's gdalinfo, classes.csv),
+// `eval --ortho`, LAS from `convert`, and the one-line errors of bad options.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/geo/map_frame.h"
+#include "sadsplat/geo/raster_files.h"
+#include "sadsplat/io/cloud_files.h"
+#include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/georeference.h"
+#include "sadsplat/io/las.h"
+#include "sadsplat/io/scene.h"
+#include "sadsplat/io/scene_import.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+using test::kCli;
+
+class MapProducts : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!io::haveSceneImport() || !geo::haveGdal()) return;
+    dir_ = new test::TempDir();
+    std::string out;
+    const std::string scene = dir_->file("scene");
+    ASSERT_EQ(test::runCommand(kCli + " synth --kind city --views 16 --width 160 --height 90 " +
+                                   "--points 2000 --labelled 0,7 --out " + scene,
+                               &out),
+              0)
+        << out;
+    // The same scene, placed on the Earth (its frame read as east-north-up metres).
+    test::copyTree(scene, dir_->file("geo_scene"));
+    io::Georeference g;
+    g.origin = {46.843, -91.994, 200.0};
+    g.epsg_utm = io::utmEpsg(g.origin);
+    test::writeFile(dir_->file("geo_scene/georeference.json"), io::georeferenceToJson(g));
+    for (const char* name : {"scene", "geo_scene"}) {
+      ASSERT_EQ(
+          test::runCommand(kCli + " train " + dir_->file(name) + " --scale 1 " +
+                               "--iterations 40 --out " + dir_->file(std::string(name) + "_run"),
+                           &out),
+          0)
+          << out;
+    }
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  void SetUp() override {
+    if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+    if (!geo::haveGdal()) GTEST_SKIP() << "built without GDAL";
+    if (test::runCommand("gdalinfo --version") != 0) GTEST_SKIP() << "no gdalinfo (gdal-bin)";
+  }
+  static std::string run() { return dir_->file("scene_run"); }
+  static std::string geoRun() { return dir_->file("geo_scene_run"); }
+  static test::TempDir* dir_;
+};
+test::TempDir* MapProducts::dir_ = nullptr;
+
+std::vector<ClassInfo> classesOf(const std::string& run) {
+  return io::readClassesJson(run + "/classes.json");
+}
+
+TEST_F(MapProducts, RenderWritesAClassIdImageForEveryViewWithItsPaletteAndConfidence) {
+  std::string out;
+  const std::string dir = dir_->file("render_all");
+  ASSERT_EQ(test::runCommand(kCli + " render " + run() + " --out " + dir, &out), 0) << out;
+  EXPECT_NE(out.find("wrote 16 views"), std::string::npos) << out;
+  const auto classes = classesOf(run());
+  int files = 0;
+  for (int i = 0; i < 16; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "view_%03d", i);
+    const geo::Raster ids = geo::readByteRaster(dir + "/class/" + name + ".png");
+    const geo::Raster conf = geo::readByteRaster(dir + "/confidence/" + name + ".png");
+    ASSERT_EQ(ids.width, 160);  // the photos' own size
+    ASSERT_EQ(ids.height, 90);
+    std::set<int> seen;
+    for (std::size_t p = 0; p < ids.bytes.size(); ++p) {
+      const int id = ids.bytes[p];
+      ASSERT_TRUE(id < static_cast<int>(classes.size()) || id == 255) << name << " " << id;
+      if (id == 255) {
+        ASSERT_EQ(conf.bytes[p], 0);
+      }
+      seen.insert(id);
+    }
+    EXPECT_GE(seen.size(), 2u) << name;  // a city view shows several classes
+    ++files;
+  }
+  EXPECT_EQ(files, 16);
+  // The colour image is the class image through the palette (checked on one view, via GDAL's
+  // reader of the RGB PNG: band 1 = red).
+  const geo::Raster ids = geo::readByteRaster(dir + "/class/view_003.png");
+  const geo::Raster red = geo::readByteRaster(dir + "/colour/view_003.png");
+  for (std::size_t p = 0; p < ids.bytes.size(); p += 97) {
+    if (ids.bytes[p] == 255) continue;
+    EXPECT_EQ(red.bytes[p], classes[ids.bytes[p]].color[0]);
+  }
+  std::string info;
+  ASSERT_EQ(test::runCommand("gdalinfo " + dir + "/depth/view_003.tif", &info), 0);
+  EXPECT_NE(info.find("Type=Float32"), std::string::npos) << info;
+}
+
+TEST_F(MapProducts, RenderSizesNamesAndOrbit) {
+  std::string out;
+  const std::string dir = dir_->file("render_some");
+  ASSERT_EQ(test::runCommand(kCli + " render " + run() + " --out " + dir +
+                                 " --views view_014,view_002.png --size 64x36 --outputs class,rgb",
+                             &out),
+            0)
+      << out;
+  const auto size = geo::imageFileSize(dir + "/rgb/view_014.png");
+  ASSERT_TRUE(size.has_value());
+  EXPECT_EQ((*size)[0], 64);
+  EXPECT_EQ((*size)[1], 36);
+  EXPECT_TRUE(io::pathExists(dir + "/class/view_002.png"));
+  EXPECT_FALSE(io::pathExists(dir + "/depth"));
+  ASSERT_EQ(test::runCommand(kCli + " render " + run() + " --out " + dir +
+                                 "_orbit --path orbit:3 " + "--scale 0.5",
+                             &out),
+            0)
+      << out;
+  for (const char* n : {"orbit_000", "orbit_001", "orbit_002"}) {
+    const auto s = geo::imageFileSize(dir + "_orbit/class/" + n + ".png");
+    ASSERT_TRUE(s.has_value()) << n;
+    EXPECT_EQ((*s)[0], 80);
+  }
+}
+
+std::string gdalinfo(const std::string& path) {
+  std::string info;
+  EXPECT_EQ(test::runCommand("gdalinfo " + path, &info), 0) << info;
+  return info;
+}
+
+TEST_F(MapProducts, OrthoWritesGeoTiffsGdalReadsWithTheGridAndLocalCrs) {
+  std::string out;
+  const std::string dir = dir_->file("ortho");
+  ASSERT_EQ(test::runCommand(kCli + " ortho " + run() + " --gsd 1.5 --out " + dir, &out), 0) << out;
+  std::ifstream json(dir + "/ortho.json");
+  std::stringstream text;
+  text << json.rdbuf();
+  const std::string j = text.str();
+  for (const char* f : {"orthophoto.tif", "classes.tif", "dsm.tif", "confidence.tif"}) {
+    const std::string info = gdalinfo(dir + "/" + f);
+    EXPECT_NE(info.find("Pixel Size = (1.500000000000000,-1.500000000000000)"), std::string::npos)
+        << f << "\n"
+        << info;
+    EXPECT_NE(info.find("sadsplat local metres"), std::string::npos) << f;
+  }
+  const std::string classes = gdalinfo(dir + "/classes.tif");
+  EXPECT_NE(classes.find("ColorInterp=Palette"), std::string::npos) << classes;
+  EXPECT_NE(classes.find("NoData Value=255"), std::string::npos) << classes;
+  EXPECT_NE(gdalinfo(dir + "/dsm.tif").find("NoData Value=-9999"), std::string::npos);
+  EXPECT_NE(gdalinfo(dir + "/orthophoto.tif").find("ColorInterp=Alpha"), std::string::npos);
+  // classes.csv: areas are pixels x gsd^2, shares sum to 1, and the pixel counts are those of
+  // classes.tif.
+  const geo::Raster ids = geo::readByteRaster(dir + "/classes.tif");
+  std::map<int, long> counted;
+  for (std::uint8_t v : ids.bytes) ++counted[v];
+  std::ifstream csv(dir + "/classes.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "class_id,name,pixels,area_m2,share");
+  double share_sum = 0;
+  while (std::getline(csv, line)) {
+    std::stringstream row(line);
+    std::string id, name, pixels, area, share;
+    std::getline(row, id, ',');
+    std::getline(row, name, ',');
+    std::getline(row, pixels, ',');
+    std::getline(row, area, ',');
+    std::getline(row, share, ',');
+    EXPECT_EQ(std::stol(pixels), counted[std::stoi(id)]) << line;
+    EXPECT_NEAR(std::stod(area), std::stol(pixels) * 2.25, 0.01) << line;
+    if (!share.empty()) share_sum += std::stod(share);
+  }
+  EXPECT_NEAR(share_sum, 1.0, 1e-4);
+}
+
+TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
+  std::string out;
+  const std::string dir = dir_->file("geo_ortho");
+  ASSERT_EQ(test::runCommand(kCli + " ortho " + geoRun() + " --gsd 2 --out " + dir, &out), 0)
+      << out;
+  const std::string info = gdalinfo(dir + "/classes.tif");
+  EXPECT_NE(info.find("WGS 84 / UTM zone 15N"), std::string::npos) << info;
+  EXPECT_NE(info.find("ID[\"EPSG\",32615]"), std::string::npos) << info;
+  // The grid holds the origin's UTM position (the scene's frame is centred near its origin).
+  const auto origin_utm = geo::enuToUtm(
+      io::georeferenceFromJson(test::readFile(geoRun() + "/georeference.json"), "g"), {{0, 0, 0}});
+  std::string located;
+  ASSERT_EQ(test::runCommand("gdallocationinfo -geoloc -valonly " + dir + "/classes.tif " +
+                                 std::to_string(origin_utm[0][0]) + " " +
+                                 std::to_string(origin_utm[0][1]),
+                             &located),
+            0)
+      << located;
+  EXPECT_FALSE(located.empty());
+  // The LAS of the model: the same points, classes and CRS as the model.
+  ASSERT_EQ(
+      test::runCommand(kCli + " convert " + geoRun() + "/model.ply " + dir + "/model.las", &out), 0)
+      << out;
+  io::LasHeader header;
+  const auto points = io::readLas(dir + "/model.las", &header);
+  const auto model = io::readGaussians(geoRun() + "/model.ply");
+  ASSERT_EQ(points.size(), model.size());
+  EXPECT_NE(header.wkt.find("UTM zone 15N"), std::string::npos);
+  const auto classes = classesOf(geoRun());
+  std::vector<std::string> names;
+  for (const auto& c : classes) names.push_back(c.name);
+  const auto codes = io::asprsCodes(names);
+  for (std::size_t i = 0; i < points.size(); i += 37) {
+    ASSERT_LT(model[i].label, codes.size());
+    EXPECT_EQ(points[i].classification, codes[model[i].label]);
+    EXPECT_NEAR(points[i].z, model[i].z + 200.0, 0.05);  // origin altitude + up
+  }
+  EXPECT_NEAR(points[0].x, origin_utm[0][0] + model[0].x, 2.0);  // ENU ~ UTM, within 1 km
+}
+
+TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " eval " + run() + " --ortho", &out), 0) << out;
+  EXPECT_NE(out.find("\"cells\": 640000"), std::string::npos) << out;  // 200 m at 0.25 m
+  EXPECT_NE(out.find("\"miou\""), std::string::npos) << out;
+  EXPECT_TRUE(io::pathExists(run() + "/ortho_metrics.json"));
+}
+
+TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
+  auto expectError = [&](const std::string& args, const std::string& needle) {
+    std::string out;
+    EXPECT_EQ(test::runCommand(kCli + " " + args, &out), 1) << args << "\n" << out;
+    EXPECT_NE(out.find(needle), std::string::npos) << args << "\n" << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  };
+  expectError("ortho " + run() + " --gsd 0 --out " + dir_->file("x"), "--gsd");
+  expectError("ortho " + run() + " --gsd -2 --out " + dir_->file("x"), "--gsd");
+  expectError("ortho " + run() + " --gsd 0.0001 --out " + dir_->file("x"), "40000");
+  expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
+  expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");
+  expectError("render " + run() + " --size 0x5 --out " + dir_->file("x"), "--size");
+  expectError("render " + run() + " --path spiral --out " + dir_->file("x"), "--path");
+  expectError("ortho " + run() + " --gsd 2 --out /proc/sadsplat_cannot_write", "/proc/");
+}
+
+}  // namespace
+}  // namespace sadsplat
