@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <iomanip>
 #include <map>
@@ -40,7 +41,17 @@ void writeTextFile(const std::string& path, const std::string& text) {
 // The directory a scene was imported from (original photos in its images/), or "".
 std::string sceneDirectory(const OpenedRun& run) {
   if (io::isDirectory(run.scene_path)) return run.scene_path;
-  if (!run.scene.source.empty() && io::isDirectory(run.scene.source)) return run.scene.source;
+  const std::string& source = run.scene.source;
+  if (source.empty()) return "";
+  if (io::isDirectory(source)) return source;
+  // A relative path is the one `import` was given, from the directory it ran in: usually an
+  // ancestor of the cache's folder.
+  if (source[0] != '/') {
+    std::filesystem::path dir = std::filesystem::absolute(run.scene_path).parent_path();
+    for (; !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
+      if (io::isDirectory((dir / source).string())) return (dir / source).string();
+    }
+  }
   return "";
 }
 
