@@ -262,6 +262,31 @@ TEST(Rasterizer, OrthographicCameraCullsBehindItself) {
   EXPECT_EQ(r.alpha.abs().max().item<double>(), 0.0);
 }
 
+// setRotation inverts the quaternion -> matrix map (up to the quaternion's sign), in every
+// branch of Shepperd's method (w, x, y or z the largest component).
+TEST(Rasterizer, CameraRotationFromAMatrixRoundTrips) {
+  const double qs[][4] = {{0.9, 0.1, -0.2, 0.3},
+                          {0.1, 0.9, 0.2, -0.3},
+                          {0.05, -0.2, 0.95, 0.1},
+                          {-0.1, 0.2, 0.1, 0.96},
+                          {0.0, 0.0, 0.0, 1.0}};
+  for (const auto& q0 : qs) {
+    const double n = std::sqrt(q0[0] * q0[0] + q0[1] * q0[1] + q0[2] * q0[2] + q0[3] * q0[3]);
+    const double q[4] = {q0[0] / n, q0[1] / n, q0[2] / n, q0[3] / n};
+    double R[9];
+    gaussians::raster::quatToRotation(q, R);
+    RasterCamera cam;
+    std::array<double, 9> Ra;
+    for (int i = 0; i < 9; ++i) Ra[i] = R[i];
+    cam.setRotation(Ra);
+    const double sign =
+        (cam.qvec[0] * q[0] + cam.qvec[1] * q[1] + cam.qvec[2] * q[2] + cam.qvec[3] * q[3]) < 0
+            ? -1.0
+            : 1.0;
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(sign * cam.qvec[k], q[k], 1e-12) << k;
+  }
+}
+
 TEST(Rasterizer, CulledAndDegenerateGaussiansGiveZerosNotNaNs) {
   const RasterCamera cam = frontCamera(20, 20, 20.0);
   const auto opts = at::TensorOptions().dtype(at::kFloat);

@@ -282,6 +282,24 @@ std::array<double, 3> RasterCamera::centre() const {
   return c;
 }
 
+void RasterCamera::setRotation(const std::array<double, 9>& R) {
+  // Shepperd's method: the largest of w, x, y, z first, for accuracy.
+  const double tr = R[0] + R[4] + R[8];
+  if (tr > 0) {
+    const double s = 2 * std::sqrt(1 + tr);
+    qvec = {0.25 * s, (R[7] - R[5]) / s, (R[2] - R[6]) / s, (R[3] - R[1]) / s};
+  } else if (R[0] > R[4] && R[0] > R[8]) {
+    const double s = 2 * std::sqrt(1 + R[0] - R[4] - R[8]);
+    qvec = {(R[7] - R[5]) / s, 0.25 * s, (R[1] + R[3]) / s, (R[2] + R[6]) / s};
+  } else if (R[4] > R[8]) {
+    const double s = 2 * std::sqrt(1 + R[4] - R[0] - R[8]);
+    qvec = {(R[2] - R[6]) / s, (R[1] + R[3]) / s, 0.25 * s, (R[5] + R[7]) / s};
+  } else {
+    const double s = 2 * std::sqrt(1 + R[8] - R[0] - R[4]);
+    qvec = {(R[3] - R[1]) / s, (R[2] + R[6]) / s, (R[5] + R[7]) / s, 0.25 * s};
+  }
+}
+
 std::array<double, 3> RasterCamera::shViewpoint() const {
   if (!orthographic) return centre();
   // Every ray of an orthographic camera runs along its z axis (row 2 of R): a viewpoint far back

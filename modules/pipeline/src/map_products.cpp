@@ -69,25 +69,6 @@ std::array<double, 9> lookAt(const Vec3& eye, const Vec3& target, const Vec3& up
   return {right[0], right[1], right[2], down[0], down[1], down[2], f[0], f[1], f[2]};
 }
 
-std::array<double, 4> quaternionOfRotation(const std::array<double, 9>& R) {
-  // Through the orthographic camera's helper: same convention (w, x, y, z).
-  const double tr = R[0] + R[4] + R[8];
-  if (tr > 0) {
-    const double s = 2 * std::sqrt(1 + tr);
-    return {0.25 * s, (R[7] - R[5]) / s, (R[2] - R[6]) / s, (R[3] - R[1]) / s};
-  }
-  if (R[0] > R[4] && R[0] > R[8]) {
-    const double s = 2 * std::sqrt(1 + R[0] - R[4] - R[8]);
-    return {(R[7] - R[5]) / s, 0.25 * s, (R[1] + R[3]) / s, (R[2] + R[6]) / s};
-  }
-  if (R[4] > R[8]) {
-    const double s = 2 * std::sqrt(1 + R[4] - R[0] - R[8]);
-    return {(R[2] - R[6]) / s, (R[1] + R[3]) / s, 0.25 * s, (R[5] + R[7]) / s};
-  }
-  const double s = 2 * std::sqrt(1 + R[8] - R[0] - R[4]);
-  return {(R[3] - R[1]) / s, (R[2] + R[6]) / s, (R[5] + R[7]) / s, 0.25 * s};
-}
-
 struct NamedCamera {
   std::string name;
   gaussians::RasterCamera camera;
@@ -121,7 +102,7 @@ std::vector<NamedCamera> orbitCameras(const OpenedRun& run, int n, const io::Vie
     for (int j = 0; j < 3; ++j) eye[j] = centre[j] + e * L[j] + no * L[3 + j] + height * up[j];
     const auto R = lookAt(eye, centre, up);
     gaussians::RasterCamera cam = gaussians::RasterCamera::fromPinhole(like.camera);
-    cam.qvec = quaternionOfRotation(R);
+    cam.setRotation(R);
     for (int r = 0; r < 3; ++r) {
       cam.tvec[r] = -(R[3 * r] * eye[0] + R[3 * r + 1] * eye[1] + R[3 * r + 2] * eye[2]);
     }

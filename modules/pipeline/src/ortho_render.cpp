@@ -11,26 +11,6 @@ namespace {
 
 using Vec3 = std::array<double, 3>;
 
-// The quaternion (w, x, y, z) of a row-major rotation matrix (Shepperd's method).
-std::array<double, 4> quaternionOf(const std::array<double, 9>& R) {
-  const double tr = R[0] + R[4] + R[8];
-  std::array<double, 4> q{};
-  if (tr > 0) {
-    const double s = 2 * std::sqrt(1 + tr);
-    q = {0.25 * s, (R[7] - R[5]) / s, (R[2] - R[6]) / s, (R[3] - R[1]) / s};
-  } else if (R[0] > R[4] && R[0] > R[8]) {
-    const double s = 2 * std::sqrt(1 + R[0] - R[4] - R[8]);
-    q = {(R[7] - R[5]) / s, 0.25 * s, (R[1] + R[3]) / s, (R[2] + R[6]) / s};
-  } else if (R[4] > R[8]) {
-    const double s = 2 * std::sqrt(1 + R[4] - R[0] - R[8]);
-    q = {(R[2] - R[6]) / s, (R[1] + R[3]) / s, 0.25 * s, (R[5] + R[7]) / s};
-  } else {
-    const double s = 2 * std::sqrt(1 + R[8] - R[0] - R[4]);
-    q = {(R[3] - R[1]) / s, (R[2] + R[6]) / s, (R[5] + R[7]) / s, 0.25 * s};
-  }
-  return q;
-}
-
 double percentile(std::vector<double> v, double p) {
   const std::size_t i = static_cast<std::size_t>(p * (v.size() - 1));
   std::nth_element(v.begin(), v.begin() + i, v.end());
@@ -134,7 +114,7 @@ gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off,
   cam.fx = cam.fy = f.k / grid.gsd;
   cam.cx = (f.bE - grid.x0) / grid.gsd - x_off;
   cam.cy = (grid.y0 - f.bN) / grid.gsd - y_off;
-  cam.qvec = quaternionOf(R);
+  cam.setRotation(R);
   cam.tvec = {0, 0, grid.top};
   return cam;
 }

@@ -36,6 +36,8 @@ struct RasterCamera {
   /// \brief Where the spherical harmonics are seen from: the centre (pinhole), or a point far back
   /// along the viewing axis (orthographic: one view direction for every Gaussian).
   std::array<double, 3> shViewpoint() const;
+  /// \brief Sets qvec from a row-major world-to-camera rotation matrix.
+  void setRotation(const std::array<double, 9>& R);
 };
 
 /// \brief What to render.
