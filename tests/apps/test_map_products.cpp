@@ -228,6 +228,29 @@ TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   EXPECT_NEAR(points[0].x, origin_utm[0][0] + model[0].x, 2.0);  // ENU ~ UTM, within 1 km
 }
 
+TEST_F(MapProducts, ExtractWritesOneClassAsLasWithAMapOverride) {
+  std::string out;
+  test::writeFile(dir_->file("map.json"), "{\"road\": 77}");
+  ASSERT_EQ(test::runCommand(kCli + " extract " + run() + " --class road --out " +
+                                 dir_->file("roads.las") + " --classification-map " +
+                                 dir_->file("map.json"),
+                             &out),
+            0)
+      << out;
+  io::LasHeader header;
+  const auto points = io::readLas(dir_->file("roads.las"), &header);
+  ASSERT_FALSE(points.empty());
+  for (const auto& p : points) ASSERT_EQ(p.classification, 77);
+  EXPECT_NE(header.wkt.find("LOCAL_CS"), std::string::npos);  // no georeference: local metres
+  // A map naming a class the model does not have is an error naming the map file.
+  test::writeFile(dir_->file("bad_map.json"), "{\"boat\": 70}");
+  EXPECT_EQ(test::runCommand(kCli + " convert " + run() + "/model.ply " + dir_->file("x.las") +
+                                 " --classification-map " + dir_->file("bad_map.json"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("bad_map.json"), std::string::npos) << out;
+}
+
 TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   std::string out;
   ASSERT_EQ(test::runCommand(kCli + " eval " + run() + " --ortho", &out), 0) << out;
