@@ -180,8 +180,8 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   EXPECT_NE(out.find("--device"), std::string::npos) << out;
   // The same value in a --config file is an error naming the file and the key (exit 1).
   test::writeFile(dir.file("tpu.json"), "{\"device\": \"tpu\"}");
-  EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r3") +
-                                 " --config " + dir.file("tpu.json"),
+  EXPECT_EQ(test::runCommand(kCli + " train " + kScene + " --out " + dir.file("r3") + " --config " +
+                                 dir.file("tpu.json"),
                              &out),
             1);
   EXPECT_NE(out.find("device: expected cpu,cuda, got tpu"), std::string::npos) << out;
@@ -215,10 +215,25 @@ TEST(Cli, AnRgbOnlySceneTrainsEvaluatesAndSaysWhyThereIsNoMiou) {
   ASSERT_EQ(test::runCommand(kCli + " info " + run, &out), 0) << out;
   EXPECT_NE(out.find("run directory"), std::string::npos) << out;
   EXPECT_NE(out.find("georeference: none"), std::string::npos) << out;
-  EXPECT_EQ(test::runCommand(kCli + " extract " + run + " --class road --out " + dir.file("r.pcd"),
-                             &out),
-            1);
+  EXPECT_EQ(
+      test::runCommand(kCli + " extract " + run + " --class road --out " + dir.file("r.pcd"), &out),
+      1);
   EXPECT_NE(out.find("no classes to extract"), std::string::npos) << out;
+  // Maps of a plain 3DGS model: RGB and depth, no class images, a LAS of code 0.
+  if (test::runCommand("gdalinfo --version") != 0) return;  // built or installed without GDAL
+  ASSERT_EQ(test::runCommand(kCli + " render " + run + " --views all --out " + dir.file("r"), &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("no classes"), std::string::npos) << out;
+  EXPECT_TRUE(io::pathExists(dir.file("r/rgb")));
+  EXPECT_FALSE(io::pathExists(dir.file("r/class")));
+  ASSERT_EQ(test::runCommand(kCli + " ortho " + run + " --gsd 0.2 --out " + dir.file("o"), &out), 0)
+      << out;
+  EXPECT_TRUE(io::pathExists(dir.file("o/orthophoto.tif")));
+  EXPECT_FALSE(io::pathExists(dir.file("o/classes.tif")));
+  ASSERT_EQ(test::runCommand(kCli + " convert " + run + "/model.ply " + dir.file("m.las"), &out), 0)
+      << out;
+  EXPECT_NE(out.find(" 0 (created, never classified)"), std::string::npos) << out;
 }
 
 TEST(Cli, EvalFindsTheSceneOfARunFromAnyDirectory) {

@@ -188,6 +188,19 @@ TEST_F(MapProducts, OrthoWritesGeoTiffsGdalReadsWithTheGridAndLocalCrs) {
   EXPECT_NEAR(share_sum, 1.0, 1e-4);
 }
 
+TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
+  std::string out;
+  const std::string dir = dir_->file("ortho_bounds");
+  ASSERT_EQ(test::runCommand(
+                kCli + " ortho " + run() + " --gsd 0.5 --bounds -20,-10,30,15 --out " + dir, &out),
+            0)
+      << out;
+  const std::string info = gdalinfo(dir + "/classes.tif");
+  EXPECT_NE(info.find("Size is 100, 50"), std::string::npos) << info;
+  EXPECT_NE(info.find("Origin = (-20.000000000000000,15.000000000000000)"), std::string::npos)
+      << info;
+}
+
 TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   std::string out;
   const std::string dir = dir_->file("geo_ortho");
@@ -269,6 +282,9 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --gsd 0 --out " + dir_->file("x"), "--gsd");
   expectError("ortho " + run() + " --gsd -2 --out " + dir_->file("x"), "--gsd");
   expectError("ortho " + run() + " --gsd 0.0001 --out " + dir_->file("x"), "40000");
+  expectError("ortho " + run() + " --bounds 5000,5000,5100,5100 --out " + dir_->file("x"),
+              "footprint");
+  expectError("ortho " + run() + " --bounds 10,10,0,20 --out " + dir_->file("x"), "--bounds");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");
   expectError("render " + run() + " --size 0x5 --out " + dir_->file("x"), "--size");

@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <map>
 #include <set>
@@ -224,8 +224,14 @@ int renderRun(const RenderRunOptions& o) {
   OpenedRun run = openRun(o.run);
   if (run.trainer->numClasses() == 0 &&
       (outputs.count("class") || outputs.count("colour") || outputs.count("confidence"))) {
-    if (o.progress)
+    for (const char* x : {"class", "colour", "confidence"}) outputs.erase(x);
+    if (o.progress) {
       *o.progress << "note: the model has no classes: no class, colour or confidence images\n";
+    }
+    if (outputs.empty()) {
+      throw Error(o.run, "--outputs", "rgb or depth (the model has no classes)",
+                  "class outputs only");
+    }
   }
   std::vector<const io::View*> views;
   if (o.views == "all" || o.views == "train" || o.views == "test") {

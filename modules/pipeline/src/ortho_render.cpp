@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "sadsplat/common/error.h"
 
@@ -54,26 +56,37 @@ OrthoGrid footprintGrid(const gaussians::Trainer& trainer, const io::Scene& scen
   grid.gsd = gsd;
   grid.top = top + 1.0;
   grid.frame = scene.georeference ? geo::utmMapFrame(*scene.georeference, e0, n0, e1, n1) : local;
+  // The footprint on the map (the local frame's z is the map's up).
+  double fx0 = 1e300, fy0 = 1e300, fx1 = -1e300, fy1 = -1e300;
+  for (double a : {e0, e1}) {
+    for (double b : {n0, n1}) {
+      const double E = grid.frame.k * (grid.frame.c * a - grid.frame.s * b) + grid.frame.bE;
+      const double N = grid.frame.k * (grid.frame.s * a + grid.frame.c * b) + grid.frame.bN;
+      fx0 = std::min(fx0, E), fx1 = std::max(fx1, E), fy0 = std::min(fy0, N),
+      fy1 = std::max(fy1, N);
+    }
+  }
   double x0, y0, x1, y1;
   if (bounds) {
     x0 = (*bounds)[0], y0 = (*bounds)[1], x1 = (*bounds)[2], y1 = (*bounds)[3];
+    const auto text = [](double a, double b, double c, double d) {
+      std::ostringstream t;
+      t << std::fixed << std::setprecision(2) << a << "," << b << "," << c << "," << d;
+      return t.str();
+    };
     if (!(x1 > x0 && y1 > y0)) {
       throw Error("<ortho>", "--bounds", "xmin,ymin,xmax,ymax with xmax > xmin and ymax > ymin",
-                  std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(x1) + "," +
-                      std::to_string(y1));
+                  text(x0, y0, x1, y1));
+    }
+    if (x1 <= fx0 || x0 >= fx1 || y1 <= fy0 || y0 >= fy1) {
+      throw Error("<ortho>", "--bounds",
+                  "a rectangle overlapping the model's footprint " + text(fx0, fy0, fx1, fy1) +
+                      " (" + grid.frame.crs_name + ")",
+                  text(x0, y0, x1, y1));
     }
   } else {
-    x0 = y0 = 1e300, x1 = y1 = -1e300;
-    for (double a : {e0, e1}) {
-      for (double b : {n0, n1}) {
-        // The local frame's z is the map's up: corners of the footprint on the map.
-        const double E = grid.frame.k * (grid.frame.c * a - grid.frame.s * b) + grid.frame.bE;
-        const double N = grid.frame.k * (grid.frame.s * a + grid.frame.c * b) + grid.frame.bN;
-        x0 = std::min(x0, E), x1 = std::max(x1, E), y0 = std::min(y0, N), y1 = std::max(y1, N);
-      }
-    }
-    x0 = std::floor(x0 / gsd) * gsd, y0 = std::floor(y0 / gsd) * gsd;
-    x1 = std::ceil(x1 / gsd) * gsd, y1 = std::ceil(y1 / gsd) * gsd;
+    x0 = std::floor(fx0 / gsd) * gsd, y0 = std::floor(fy0 / gsd) * gsd;
+    x1 = std::ceil(fx1 / gsd) * gsd, y1 = std::ceil(fy1 / gsd) * gsd;
   }
   const double w = std::ceil((x1 - x0) / gsd - 1e-9), h = std::ceil((y1 - y0) / gsd - 1e-9);
   if (!(w <= 40000 && h <= 40000)) {
