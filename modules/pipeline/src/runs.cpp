@@ -385,6 +385,22 @@ OpenedRun openRun(const std::string& run_dir, const std::string& scene_override,
   return o;
 }
 
+std::string sceneDirectoryOf(const OpenedRun& run) {
+  if (io::isDirectory(run.scene_path)) return run.scene_path;
+  const std::string& source = run.scene.source;
+  if (source.empty()) return "";
+  if (io::isDirectory(source)) return source;
+  // A relative path is the one `import` was given, from the directory it ran in: usually an
+  // ancestor of the cache's folder.
+  if (source[0] != '/') {
+    std::filesystem::path dir = std::filesystem::absolute(run.scene_path).parent_path();
+    for (; !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
+      if (io::isDirectory((dir / source).string())) return (dir / source).string();
+    }
+  }
+  return "";
+}
+
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
   const OpenedRun run = openRun(run_dir, scene_override, scale);
   makeDirectory(run_dir + "/panels");

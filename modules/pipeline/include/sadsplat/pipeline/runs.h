@@ -83,6 +83,11 @@ struct OpenedRun {
 OpenedRun openRun(const std::string& run_dir, const std::string& scene_override = "",
                   double scale = 0.5);
 
+/// \brief The scene directory a run's scene was imported from (its images/ hold the photos at
+/// their imported-from size), or "" when there is none: the run's scene itself, or a cache's
+/// recorded source (a relative source is looked for from the folders above the cache).
+std::string sceneDirectoryOf(const OpenedRun& run);
+
 /// \brief Evaluates a run directory on its scene (or `scene_override`): writes metrics.json and
 /// panels/, returns the metrics.json text.
 std::string evalRun(const std::string& run_dir, const std::string& scene_override = "",
