@@ -1,10 +1,9 @@
 #include "sadsplat/geo/raster_files.h"
 
-#include <cstdio>
 #include <memory>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/atomic_file.h"
 
 #if SADSPLAT_HAVE_GDAL
 #include <cpl_conv.h>
@@ -110,32 +109,12 @@ void fill(GDALDataset* ds, const Raster& r, const std::string& path) {
   }
 }
 
-// Writes through a temporary file in the target's directory, renamed over it once closed.
-template <typename Write>
-void atomically(const std::string& path, Write write) {
-  io::makeParentDirectory(path);
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
-  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  const std::string tmp = dir + "/." + name + ".partial";
-  try {
-    write(tmp);
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw Error(path, "write", "a path that can be replaced", "rename failed");
-  }
-}
-
 }  // namespace
 
 void writeGeoTiff(const std::string& path, const Raster& r, const MapGrid* grid) {
   r.check(path);
   initGdal();
-  atomically(path, [&](const std::string& tmp) {
+  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
     GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
     CPLStringList options;
     options.SetNameValue("COMPRESS", "DEFLATE");
@@ -166,7 +145,7 @@ void writePng(const std::string& path, const Raster& r) {
     throw Error(path, "raster", "8- or 16-bit samples for a PNG", "float32");
   }
   initGdal();
-  atomically(path, [&](const std::string& tmp) {
+  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
     GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
     Dataset ds(mem->Create("", r.width, r.height, r.bands, gdalType(r.type), nullptr));
     if (!ds) gdalFailed(path, "create");

@@ -25,11 +25,11 @@ namespace pipeline {
 namespace {
 
 using Vec3 = std::array<double, 3>;
+
 void writeTextFile(const std::string& path, const std::string& text) {
   io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
-// The directory a scene was imported from (original photos in its images/), or "".
 // Median over the training views of (camera height above the model's median ground) / focal
 // length: the photos' ground sample distance at the imported resolution, in scene units.
 double photoGsd(const OpenedRun& run) {
