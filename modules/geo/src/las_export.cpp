@@ -41,9 +41,9 @@ std::string finish(const std::string& path, std::vector<io::LasPoint>& points,
       points[i].y = map[i][1];
       points[i].z = map[i][2];
     }
-    const MapFrame f = utmMapFrame(*o.georeference, 0, 0, 1, 1);
-    header.wkt = f.wkt;
-    crs = f.crs_name;
+    const Crs utm = crsOfEpsg(o.georeference->epsg_utm);
+    header.wkt = utm.wkt;
+    crs = utm.name;
   } else {
     for (std::size_t i = 0; i < points.size(); ++i) {
       points[i].x = scene_xyz[i][0];

@@ -76,9 +76,14 @@ Vec3 MapFrame::toLocal(const Vec3& p) const {
           R[6] * p[0] + R[7] * p[1] + R[8] * p[2]};
 }
 
+std::array<double, 2> MapFrame::planeToMap(double e, double n) const {
+  return {k * (c * e - s * n) + bE, k * (s * e + c * n) + bN};
+}
+
 Vec3 MapFrame::toMap(const Vec3& p) const {
   const Vec3 l = toLocal(p);
-  return {k * (c * l[0] - s * l[1]) + bE, k * (s * l[0] + c * l[1]) + bN, l[2] + height_offset};
+  const auto m = planeToMap(l[0], l[1]);
+  return {m[0], m[1], l[2] + height_offset};
 }
 
 Vec3 sceneUp(const io::Scene& scene) {
@@ -112,6 +117,22 @@ std::string localCrsWkt() {
          "AXIS[\"Northing\",NORTH]]";
 }
 
+Crs crsOfEpsg(int epsg) {
+#if SADSPLAT_HAVE_GDAL
+  const OGRSpatialReference reference = utmReference(epsg);
+  Crs crs;
+  crs.name = reference.GetName() ? reference.GetName() : "EPSG:" + std::to_string(epsg);
+  char* wkt = nullptr;
+  reference.exportToWkt(&wkt);
+  crs.wkt = wkt ? wkt : "";
+  CPLFree(wkt);
+  return crs;
+#else
+  (void)epsg;
+  noGdal("map projection");
+#endif
+}
+
 std::vector<Vec3> enuToUtm(const io::Georeference& g, const std::vector<Vec3>& enu) {
 #if SADSPLAT_HAVE_GDAL
   const Transform t = wgs84ToUtm(g.epsg_utm);
@@ -142,12 +163,9 @@ MapFrame utmMapFrame(const io::Georeference& g, double e0, double n0, double e1,
   MapFrame f;
   f.georeferenced = true;
   f.epsg = g.epsg_utm;
-  OGRSpatialReference utm = utmReference(g.epsg_utm);
-  f.crs_name = utm.GetName() ? utm.GetName() : "EPSG:" + std::to_string(g.epsg_utm);
-  char* wkt = nullptr;
-  utm.exportToWkt(&wkt);
-  f.wkt = wkt ? wkt : "";
-  CPLFree(wkt);
+  const Crs crs = crsOfEpsg(g.epsg_utm);
+  f.crs_name = crs.name;
+  f.wkt = crs.wkt;
   f.height_offset = g.origin.altitude;
   // Least squares for E = a e - b n + tx, N = b e + a n + ty on a 5 x 5 grid (at height 0).
   std::vector<Vec3> samples;

@@ -60,10 +60,9 @@ OrthoGrid footprintGrid(const gaussians::Trainer& trainer, const io::Scene& scen
   double fx0 = 1e300, fy0 = 1e300, fx1 = -1e300, fy1 = -1e300;
   for (double a : {e0, e1}) {
     for (double b : {n0, n1}) {
-      const double E = grid.frame.k * (grid.frame.c * a - grid.frame.s * b) + grid.frame.bE;
-      const double N = grid.frame.k * (grid.frame.s * a + grid.frame.c * b) + grid.frame.bN;
-      fx0 = std::min(fx0, E), fx1 = std::max(fx1, E), fy0 = std::min(fy0, N),
-      fy1 = std::max(fy1, N);
+      const auto m = grid.frame.planeToMap(a, b);
+      fx0 = std::min(fx0, m[0]), fx1 = std::max(fx1, m[0]);
+      fy0 = std::min(fy0, m[1]), fy1 = std::max(fy1, m[1]);
     }
   }
   double x0, y0, x1, y1;

@@ -39,6 +39,8 @@ struct MapFrame {
 
   /// \brief Local (e, n, up) of a scene point.
   std::array<double, 3> toLocal(const std::array<double, 3>& scene_point) const;
+  /// \brief Map (E, N) of a point (e, n) of the local plane (the similarity).
+  std::array<double, 2> planeToMap(double e, double n) const;
   /// \brief Map (E, N, height) of a scene point (through the similarity).
   std::array<double, 3> toMap(const std::array<double, 3>& scene_point) const;
   /// \brief Ground metres per map unit squared: 1 / k^2 (UTM's scale factor is ~0.9996).
@@ -58,6 +60,16 @@ MapFrame localMapFrame(const std::array<double, 3>& up);
 /// \throws sadsplat::Error without GDAL, or when PROJ cannot make the transformation
 MapFrame utmMapFrame(const io::Georeference& georeference, double e0, double n0, double e1,
                      double n1);
+
+/// \brief A projected CRS: its name and OGC WKT.
+struct Crs {
+  std::string name;
+  std::string wkt;
+};
+
+/// \brief The CRS of an EPSG code (e.g. a UTM zone's 326zz), from PROJ's database.
+/// \throws sadsplat::Error without GDAL, or for a code PROJ does not know
+Crs crsOfEpsg(int epsg);
 
 /// \brief Exact map coordinates (E, N, height) of ENU points of a georeferenced scene: through
 /// WGS84 and PROJ's UTM, point by point.
