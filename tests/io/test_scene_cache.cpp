@@ -191,13 +191,59 @@ TEST(SceneCache, ChecksumIsFnv1a64AndVersion1FilesStillRead) {
   EXPECT_EQ(io::sceneCacheVersion(v1), 1u);
   const io::Scene scene = io::readSceneCache(v1);
   test::TempDir dir;
-  io::writeSceneCache(dir.file("v2.cache"), scene);
-  EXPECT_EQ(io::sceneCacheVersion(dir.file("v2.cache")), 2u);
-  const std::string bytes = test::readFile(dir.file("v2.cache"));
+  io::writeSceneCache(dir.file("v3.cache"), scene);
+  EXPECT_EQ(io::sceneCacheVersion(dir.file("v3.cache")), 3u);
+  const std::string bytes = test::readFile(dir.file("v3.cache"));
   std::uint64_t stored;
   std::memcpy(&stored, bytes.data() + 24, 8);
   EXPECT_EQ(stored, io::fnv1a64(bytes.data() + 32, bytes.size() - 32));
-  EXPECT_EQ(io::readSceneCache(dir.file("v2.cache")).views.size(), scene.views.size());
+  EXPECT_EQ(io::readSceneCache(dir.file("v3.cache")).views.size(), scene.views.size());
+}
+
+// Version 3 stores the images losslessly compressed: the fixture's rendered views (a version-1
+// file of raw planes) come back pixel for pixel from a file well under half the size.
+TEST(SceneCache, CompressedImagesAreLosslessAndSmaller) {
+  const std::string v1 = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  const io::Scene scene = io::readSceneCache(v1);
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("v3.cache"), scene);
+  const io::Scene back = io::readSceneCache(dir.file("v3.cache"));
+  ASSERT_EQ(back.views.size(), scene.views.size());
+  for (std::size_t i = 0; i < scene.views.size(); ++i) {
+    EXPECT_EQ(back.views[i].rgb.pixels, scene.views[i].rgb.pixels);
+    EXPECT_EQ(back.views[i].mask.pixels, scene.views[i].mask.pixels);
+    EXPECT_EQ(back.views[i].labels.pixels, scene.views[i].labels.pixels);
+  }
+  const double ratio = double(test::readFile(dir.file("v3.cache")).size()) / test::readFile(v1).size();
+  EXPECT_LT(ratio, 0.5) << ratio;
+}
+
+// A compressed image whose stream is damaged (the checksum made valid again) is an error naming
+// the view's image, not garbage pixels or a crash.
+TEST(SceneCache, DamagedCompressedImagesAreErrors) {
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("s.cache"), syntheticScene());
+  std::string bytes = test::readFile(dir.file("s.cache"));
+  // The first VIEW chunk: tag, size, name "v0.png", width, height, 4 + 4 + 3 doubles, roles,
+  // has-labels, then the rgb block's size and bytes.
+  const std::size_t view = bytes.find("VIEW");
+  ASSERT_NE(view, std::string::npos);
+  const std::size_t block = view + 4 + 8 + 4 + 6 + 8 + 11 * 8 + 2;
+  std::uint64_t size;
+  std::memcpy(&size, &bytes[block], 8);
+  ASSERT_GT(size, 0u);
+  ASSERT_LT(block + 8 + size, bytes.size());
+  std::string zeroed = bytes;
+  std::memset(&zeroed[block + 8], 0, size);  // a stored deflate block with LEN != ~NLEN
+  fixChecksum(zeroed);
+  test::writeFile(dir.file("zeroed.cache"), zeroed);
+  expectCacheError(dir.file("zeroed.cache"), "rgb");
+  std::string huge = bytes;
+  const std::uint64_t big = 1ull << 40;
+  std::memcpy(&huge[block], &big, 8);
+  fixChecksum(huge);
+  test::writeFile(dir.file("huge.cache"), huge);
+  expectCacheError(dir.file("huge.cache"), "truncated or corrupt");
 }
 
 }  // namespace

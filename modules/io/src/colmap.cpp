@@ -15,10 +15,10 @@ namespace sadsplat {
 namespace io {
 namespace {
 
-bool knownModel(int id) { return id >= 0 && id <= 4; }
+bool knownModel(int id) { return id >= 0 && id <= 6; }
 
 bool modelFromName(const std::string& name, CameraModel* model) {
-  for (int id = 0; id <= 4; ++id) {
+  for (int id = 0; id <= 6; ++id) {
     if (name == cameraModelName(static_cast<CameraModel>(id))) {
       *model = static_cast<CameraModel>(id);
       return true;
@@ -46,8 +46,7 @@ void validateCamera(const ColmapCamera& c, const std::string& file, const std::s
     requireFinite(c.params[i], file, where + " param " + std::to_string(i));
   }
   if (c.params[0] <= 0 ||
-      (c.model == CameraModel::kPinhole || c.model == CameraModel::kOpenCV ? c.params[1] <= 0
-                                                                           : false)) {
+      (cameraModelHasFy(c.model) ? c.params[1] <= 0 : false)) {
     throw Error(file, where + " focal length", "positive", std::to_string(c.params[0]));
   }
 }
@@ -133,7 +132,8 @@ std::vector<ColmapCamera> readCamerasText(const std::string& path) {
     const std::string model = parseField<std::string>(in, lines, "MODEL");
     if (!modelFromName(model, &c.model)) {
       throw Error(path, lines.where() + " MODEL",
-                  "one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV", model);
+                  "one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, OPENCV_FISHEYE, "
+                  "FULL_OPENCV", model);
     }
     c.width = parseField<std::uint64_t>(in, lines, "WIDTH");
     c.height = parseField<std::uint64_t>(in, lines, "HEIGHT");
@@ -264,7 +264,8 @@ std::vector<ColmapCamera> readCamerasBinary(const std::string& path) {
     const int model = r.read<std::int32_t>(where + " model_id");
     if (!knownModel(model)) {
       throw Error(path, where + " model_id",
-                  "0..4 (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV)",
+                  "0..6 (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, "
+                  "OPENCV_FISHEYE, FULL_OPENCV)",
                   std::to_string(model));
     }
     c.model = static_cast<CameraModel>(model);
@@ -372,6 +373,10 @@ const char* cameraModelName(CameraModel model) {
       return "RADIAL";
     case CameraModel::kOpenCV:
       return "OPENCV";
+    case CameraModel::kOpenCVFisheye:
+      return "OPENCV_FISHEYE";
+    case CameraModel::kFullOpenCV:
+      return "FULL_OPENCV";
   }
   return "UNKNOWN";
 }
@@ -387,9 +392,17 @@ int cameraModelNumParams(CameraModel model) {
     case CameraModel::kRadial:
       return 5;
     case CameraModel::kOpenCV:
+    case CameraModel::kOpenCVFisheye:
       return 8;
+    case CameraModel::kFullOpenCV:
+      return 12;
   }
   return 0;
+}
+
+bool cameraModelHasFy(CameraModel model) {
+  return model == CameraModel::kPinhole || model == CameraModel::kOpenCV ||
+         model == CameraModel::kOpenCVFisheye || model == CameraModel::kFullOpenCV;
 }
 
 ColmapModel readColmapModel(const std::string& dir) {

@@ -76,6 +76,28 @@ std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data
   return out;
 }
 
+std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t* data,
+                                     std::size_t size, int level) {
+  // One call: zlib's counters are 32-bit, and a plane of the scene cache is far below 1 GiB.
+  if (size > (std::size_t(1) << 30)) {
+    throw Error(path, "deflate", "a block of at most 1 GiB", std::to_string(size) + " bytes");
+  }
+  z_stream s{};
+  if (deflateInit2(&s, level, Z_DEFLATED, -MAX_WBITS, 9, Z_DEFAULT_STRATEGY) != Z_OK) {
+    throw Error(path, "deflate", "zlib to initialise", "an initialisation failure");
+  }
+  std::vector<std::uint8_t> out(deflateBound(&s, size) + 64);
+  s.next_in = const_cast<Bytef*>(data);
+  s.avail_in = static_cast<uInt>(size);
+  s.next_out = out.data();
+  s.avail_out = static_cast<uInt>(out.size());
+  const int rc = deflate(&s, Z_FINISH);
+  deflateEnd(&s);
+  if (rc != Z_STREAM_END) throw Error(path, "deflate", "the data compressed", "a zlib error");
+  out.resize(out.size() - s.avail_out);
+  return out;
+}
+
 std::vector<std::uint8_t> gunzip(
     const std::string& path, const std::uint8_t* data, std::size_t size,
     const std::function<std::size_t(const std::vector<std::uint8_t>&)>& limit_of) {

@@ -7,12 +7,13 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "plane_codec.h"
 
 namespace sadsplat {
 namespace io {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'A', 'D', 'S', 'C', 'E', 'N', 'E'};
+constexpr char kSceneMagic[8] = {'S', 'A', 'D', 'S', 'C', 'E', 'N', 'E'};
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8;
 
 // Little-endian writer into a byte string (x86-64 and ARM hosts are little endian).
@@ -32,6 +33,11 @@ class ByteWriter {
   }
   void putBytes(const std::vector<std::uint8_t>& v) {
     bytes_.append(reinterpret_cast<const char*>(v.data()), v.size());
+  }
+  // A block: u64 byte count, the bytes.
+  void putBlock(const std::vector<std::uint8_t>& v) {
+    put<std::uint64_t>(v.size());
+    putBytes(v);
   }
   // Chunk: 4-byte tag, u64 size, content.
   void putChunk(const char tag[4], const ByteWriter& content) {
@@ -87,6 +93,14 @@ class ByteReader {
     pos_ += n * sizeof(T);
     return v;
   }
+  // A block written by ByteWriter::putBlock: its bytes, in place.
+  std::pair<const std::uint8_t*, std::size_t> getBlock(const char* field) {
+    const auto n = get<std::uint64_t>(field);
+    need(n, field);
+    const auto* begin = reinterpret_cast<const std::uint8_t*>(data_ + pos_);
+    pos_ += n;
+    return {begin, static_cast<std::size_t>(n)};
+  }
   ByteReader subReader(std::size_t n, const std::string& context) {
     need(n, "chunk");
     ByteReader sub(path_, data_ + pos_, n, context);
@@ -94,6 +108,7 @@ class ByteReader {
     return sub;
   }
   bool atEnd() const { return pos_ == size_; }
+  const std::string& path() const { return path_; }
   std::size_t remaining() const { return size_ - pos_; }
   const std::string& context() const { return context_; }
 
@@ -111,7 +126,12 @@ class ByteReader {
   std::string context_;
 };
 
-Image8 readImage(ByteReader& r, int w, int h, int channels, const char* field) {
+Image8 readImage(ByteReader& r, std::uint32_t version, int w, int h, int channels,
+                 const char* field) {
+  if (version >= 3) {
+    const auto [data, size] = r.getBlock(field);
+    return planes::decodeImage(r.path(), r.context() + " " + field, data, size, w, h, channels);
+  }
   Image8 image;
   image.width = w;
   image.height = h;
@@ -180,9 +200,11 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
     const std::uint8_t roles = (v.train ? 1 : 0) | (v.test ? 2 : 0) | (v.labelled ? 4 : 0);
     c.put<std::uint8_t>(roles);
     c.put<std::uint8_t>(v.labels.empty() ? 0 : 1);
-    c.putBytes(v.rgb.pixels);
-    c.putBytes(v.mask.pixels);
-    if (!v.labels.empty()) c.putBytes(v.labels.pixels);
+    // Version 3: each image as deflated prediction residuals (plane_codec.h), its size first.
+    for (const Image8* image : {&v.rgb, &v.mask, &v.labels}) {
+      if (image->empty()) continue;
+      c.putBlock(planes::encodeImage(path, *image));
+    }
     payload.putChunk("VIEW", c);
     if (!v.pseudo.empty()) {
       // Pseudo-labels follow their view as a chunk of their own, so readers that predate them
@@ -195,7 +217,7 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
       q.put<std::uint32_t>(static_cast<std::uint32_t>(p.num_targets));
       q.put<std::uint32_t>(static_cast<std::uint32_t>(p.num_classes));
       q.put<std::uint32_t>(static_cast<std::uint32_t>(p.feature_dim));
-      q.putArray(p.region);
+      q.putBlock(planes::encodeRegions(path, p.region, v.camera.width));
       q.putArray(p.scores);
       q.putArray(p.features);
       q.putBytes(p.kept);
@@ -219,7 +241,7 @@ void writeSceneCache(const std::string& path, const Scene& scene) {
   }
   const std::string& body = payload.bytes();
   ByteWriter header;
-  for (char ch : kMagic) header.put<char>(ch);
+  for (char ch : kSceneMagic) header.put<char>(ch);
   header.put<std::uint32_t>(kSceneCacheVersion);
   header.put<std::uint32_t>(0);  // flags, reserved
   header.put<std::uint64_t>(body.size());
@@ -234,12 +256,12 @@ bool isSceneCache(const std::string& path) {
   if (!isRegularFile(path)) return false;  // a FIFO would block the read below
   std::ifstream in(path, std::ios::binary);
   char magic[8] = {};
-  return in.read(magic, 8) && std::memcmp(magic, kMagic, 8) == 0;
+  return in.read(magic, 8) && std::memcmp(magic, kSceneMagic, 8) == 0;
 }
 
 std::uint32_t sceneCacheVersion(const std::string& path) {
   const std::string head = readFileStart(path, 12);
-  if (head.size() < 12 || std::memcmp(head.data(), kMagic, 8) != 0) {
+  if (head.size() < 12 || std::memcmp(head.data(), kSceneMagic, 8) != 0) {
     throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"",
                 "other bytes");
   }
@@ -251,15 +273,16 @@ std::uint32_t sceneCacheVersion(const std::string& path) {
 Scene readSceneCache(const std::string& path) {
   const std::string bytes = readWholeFile(path);
   ByteReader head(path, bytes.data(), bytes.size(), "header");
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kSceneMagic, 8) != 0) {
     throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"",
                 "other bytes");
   }
   head.getBytes(8, "magic");
   const auto version = head.get<std::uint32_t>("version");
-  if (version != kSceneCacheVersion && version != 1) {
+  if (version < 1 || version > kSceneCacheVersion) {
     throw Error(path, "version",
-                "1 or " + std::to_string(kSceneCacheVersion) + " (re-import the scene)",
+                "1 to " + std::to_string(kSceneCacheVersion) +
+                    " (a newer sadsplat wrote it, or it is damaged: re-import the scene)",
                 std::to_string(version));
   }
   head.get<std::uint32_t>("flags");
@@ -331,10 +354,10 @@ Scene readSceneCache(const std::string& path) {
       if (!(qnorm2 > 1e-12)) {
         throw Error(path, "view " + v.name + " qvec", "a non-zero rotation quaternion", "zero");
       }
-      v.rgb = readImage(c, w, h, 3, "rgb");
-      v.mask = readImage(c, w, h, 1, "mask");
+      v.rgb = readImage(c, version, w, h, 3, "rgb");
+      v.mask = readImage(c, version, w, h, 1, "mask");
       if (has_labels) {
-        v.labels = readImage(c, w, h, 1, "labels");
+        v.labels = readImage(c, version, w, h, 1, "labels");
         if (!have_classes) {
           throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
         }
@@ -378,7 +401,13 @@ Scene readSceneCache(const std::string& path) {
       p.num_classes = static_cast<int>(c.get<std::uint32_t>("class count"));
       p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
       const std::size_t pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
-      p.region = c.getArray<std::int32_t>(pixels, "region map");
+      if (version >= 3) {
+        const auto [data, size] = c.getBlock("region map");
+        p.region = planes::decodeRegions(path, "chunk PSLB region map of view " + name, data, size,
+                                         pixels, v.camera.width);
+      } else {
+        p.region = c.getArray<std::int32_t>(pixels, "region map");
+      }
       p.scores =
           c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
       p.features =

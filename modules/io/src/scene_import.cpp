@@ -10,9 +10,11 @@
 #include "sadsplat/io/annotations.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/transforms_json.h"
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/types.hpp>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -23,17 +25,44 @@ namespace io {
 
 bool haveSceneImport() { return SADSPLAT_HAVE_OPENCV != 0; }
 
-std::string findColmapModel(const std::string& dir) {
+namespace {
+
+std::string colmapModelIn(const std::string& dir) {
   // COLMAP's mapper writes sparse/0, 1, ...; its image_undistorter writes sparse/ itself.
   for (const std::string sub : {"/sparse/0", "/sparse"}) {
     for (const char* file : {"/cameras.bin", "/cameras.txt"}) {
       if (pathExists(dir + sub + file)) return dir + sub;
     }
   }
+  return "";
+}
+
+}  // namespace
+
+std::string findColmapModel(const std::string& dir) {
+  const std::string found = colmapModelIn(dir);
+  if (!found.empty()) return found;
   throw Error(dir + "/sparse", "COLMAP model",
               "cameras, images and points3D (.bin or .txt) in sparse/0/ (COLMAP's mapper) or "
-              "sparse/ (its image_undistorter); `sadsplat sfm PHOTOS --out SCENE` makes one",
+              "sparse/ (its image_undistorter), or a transforms.json (nerfstudio, instant-ngp); "
+              "`sadsplat sfm PHOTOS --out SCENE` makes one",
               pathExists(dir + "/sparse") ? "no cameras.bin or cameras.txt there" : "missing");
+}
+
+PosedImages readPosedImages(const std::string& dir, const ImageSizeOf& image_size) {
+  PosedImages posed;
+  const std::string colmap = colmapModelIn(dir);
+  if (colmap.empty() && isRegularFile(dir + "/transforms.json")) {
+    TransformsJson t = readTransformsJson(dir + "/transforms.json", image_size);
+    posed.model = std::move(t.model);
+    posed.image_dir = std::move(t.image_dir);
+    posed.origin = dir + "/transforms.json";
+    return posed;
+  }
+  posed.origin = findColmapModel(dir);
+  posed.model = readColmapModel(posed.origin);
+  posed.image_dir = dir + "/images";
+  return posed;
 }
 
 SplitInfo defaultSplit(const ColmapModel& model, int test_every) {
@@ -99,10 +128,17 @@ void opencvIntrinsics(const ColmapCamera& c, cv::Mat* K, cv::Mat* dist, PinholeC
       d[1] = p[4];
       break;
     case CameraModel::kOpenCV:
+    case CameraModel::kOpenCVFisheye:  // k1..k4 of cv::fisheye
       fy = p[1];
       cx = p[2];
       cy = p[3];
       d = {p[4], p[5], p[6], p[7]};
+      break;
+    case CameraModel::kFullOpenCV:  // OpenCV's rational model: k1 k2 p1 p2 k3 k4 k5 k6
+      fy = p[1];
+      cx = p[2];
+      cy = p[3];
+      d.assign(p.begin() + 4, p.end());
       break;
   }
   *K = (cv::Mat_<double>(3, 3) << fx, 0, cx - 0.5, 0, fy, cy - 0.5, 0, 0, 1);
@@ -114,8 +150,18 @@ void opencvIntrinsics(const ColmapCamera& c, cv::Mat* K, cv::Mat* dist, PinholeC
 }
 
 bool isDistorted(const ColmapCamera& c) {
-  return c.model == CameraModel::kSimpleRadial || c.model == CameraModel::kRadial ||
-         c.model == CameraModel::kOpenCV;
+  return c.model != CameraModel::kSimplePinhole && c.model != CameraModel::kPinhole;
+}
+
+// Maps from the undistorted pinhole image (same K, same size) into the distorted photo.
+void undistortionMaps(const ColmapCamera& c, const cv::Mat& K, const cv::Mat& dist,
+                      const cv::Size& size, cv::Mat* map1, cv::Mat* map2) {
+  if (c.model == CameraModel::kOpenCVFisheye) {
+    cv::fisheye::initUndistortRectifyMap(K, dist, cv::Mat::eye(3, 3, CV_64F), K, size, CV_32FC1,
+                                         *map1, *map2);
+  } else {
+    cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, size, CV_32FC1, *map1, *map2);
+  }
 }
 
 cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
@@ -218,7 +264,13 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   scene.source = dir;
   // Without classes.json the scene trains as plain 3DGS (no semantic head).
   if (pathExists(dir + "/classes.json")) scene.classes = readClassesJson(dir + "/classes.json");
-  const ColmapModel model = readColmapModel(findColmapModel(dir));
+  const PosedImages posed = readPosedImages(dir, [](const std::string& image_path) {
+    requireRegularFile(image_path);
+    const cv::Mat image = cv::imread(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+    if (image.empty()) throw Error(image_path, "image data", "a readable image", "cannot decode");
+    return std::array<int, 2>{image.cols, image.rows};
+  });
+  const ColmapModel& model = posed.model;
   std::map<std::uint32_t, const ColmapCamera*> cameras;
   for (const auto& c : model.cameras) cameras[c.id] = &c;
 
@@ -237,7 +289,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   for (const auto* list : {&split.train, &split.test}) {
     for (const auto& name : *list) {
       if (!image_names.count(name)) {
-        throw Error(dir + "/split.json", "image " + name, "a name from sparse/0/images", "unknown");
+        throw Error(dir + "/split.json", "image " + name, "an image of " + posed.origin, "unknown");
       }
     }
   }
@@ -282,11 +334,13 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
 
   for (const ColmapImage* im : images) {
     const ColmapCamera& cam = *cameras.at(im->camera_id);
-    const std::string image_path = dir + "/images/" + im->name;
+    const std::string image_path = posed.image_dir + "/" + im->name;
     requireRegularFile(image_path);
-    cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR);
+    // Pixels as stored, as COLMAP and nerfstudio read them: their cameras describe those pixels
+    // (an EXIF orientation tag is not applied; `sadsplat sfm` makes upright copies first).
+    cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
     if (bgr.empty()) {
-      throw Error(image_path, "image data", "a readable image named in sparse/0/images",
+      throw Error(image_path, "image data", "a readable image named in " + posed.origin,
                   pathExists(image_path) ? "cannot decode" : "missing");
     }
     if (bgr.cols != static_cast<int>(cam.width) || bgr.rows != static_cast<int>(cam.height)) {
@@ -333,7 +387,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     opencvIntrinsics(cam, &K, &dist, &view.camera);
     if (isDistorted(cam)) {
       cv::Mat map1, map2;
-      cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, bgr.size(), CV_32FC1, map1, map2);
+      undistortionMaps(cam, K, dist, bgr.size(), &map1, &map2);
       cv::Mat undistorted;
       cv::remap(bgr, undistorted, map1, map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
       bgr = undistorted;

@@ -53,15 +53,24 @@ void writeSemanticPly(const std::string& path, const pcl::PointCloud<pcl::PointX
   });
 }
 
-pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
+namespace {
+
+// A semantic PLY must have every property; a plain point PLY needs only x y z (colour defaults
+// to grey, the label to none).
+pcl::PointCloud<pcl::PointXYZRGBL> readPointPly(const std::string& path, bool semantic) {
   const std::string bytes = readWholeFile(path);
   const ply::PlyHeader header = ply::parseHeader(path, bytes);
   const ply::PlyElement* vertex = findVertex(header);
   if (vertex == nullptr) throw Error(path, "header", "an \"element vertex\" line", "none");
-  for (const char* required : {"x", "y", "z", "red", "green", "blue", "label"}) {
-    if (!hasProperty(*vertex, required)) {
-      throw Error(path, std::string("vertex property ") + required,
-                  "present (a semantic PLY has x y z red green blue label)", "missing");
+  const std::vector<const char*> required =
+      semantic ? std::vector<const char*>{"x", "y", "z", "red", "green", "blue", "label"}
+               : std::vector<const char*>{"x", "y", "z"};
+  for (const char* name : required) {
+    if (!hasProperty(*vertex, name)) {
+      throw Error(path, std::string("vertex property ") + name,
+                  semantic ? "present (a semantic PLY has x y z red green blue label)"
+                           : "present (a point cloud has x y z)",
+                  "missing");
     }
   }
   ply::ValueDecoder decoder(path, bytes, header.data_offset, header.format);
@@ -75,6 +84,8 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
   cloud.is_dense = true;
   for (std::size_t i = 0; i < vertex->count; ++i) {
     auto& point = cloud[i];
+    point.r = point.g = point.b = 128;
+    point.label = kUnlabelled;
     for (const auto& p : vertex->properties) {
       const std::string what = "vertex " + std::to_string(i) + " property " + p.name;
       if (p.is_list) {
@@ -116,6 +127,16 @@ pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
     after = after || &e == vertex;
   }
   return cloud;
+}
+
+}  // namespace
+
+pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path) {
+  return readPointPly(path, true);
+}
+
+pcl::PointCloud<pcl::PointXYZRGBL> readPointCloudPly(const std::string& path) {
+  return readPointPly(path, false);
 }
 
 bool isSemanticPly(const std::string& path) {

@@ -221,8 +221,12 @@ int renderRun(const RenderRunOptions& o) {
       W = std::max(1, static_cast<int>(std::lround(cam.width * o.scale)));
       H = std::max(1, static_cast<int>(std::lround(cam.height * o.scale)));
     } else if (!scene_dir.empty() && !image.empty()) {
-      if (const auto size = geo::imageFileSize(scene_dir + "/images/" + image)) {
-        W = (*size)[0], H = (*size)[1];
+      // COLMAP scenes keep their photos in images/; transforms.json names them from its folder.
+      for (const std::string& folder : {scene_dir + "/images/", scene_dir + "/"}) {
+        if (const auto size = geo::imageFileSize(folder + image)) {
+          W = (*size)[0], H = (*size)[1];
+          break;
+        }
       }
     }
     const double sx = double(W) / cam.width, sy = double(H) / cam.height;

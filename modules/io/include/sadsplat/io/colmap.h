@@ -22,7 +22,12 @@ enum class CameraModel : int {
   kSimpleRadial = 2,   ///< f, cx, cy, k
   kRadial = 3,         ///< f, cx, cy, k1, k2
   kOpenCV = 4,         ///< fx, fy, cx, cy, k1, k2, p1, p2
+  kOpenCVFisheye = 5,  ///< fx, fy, cx, cy, k1, k2, k3, k4 (equidistant, OpenCV's cv::fisheye)
+  kFullOpenCV = 6,     ///< fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6 (rational)
 };
+
+/// \brief Whether a model has separate fx and fy (its params[1] is fy, not cx).
+bool cameraModelHasFy(CameraModel model);
 
 /// \brief COLMAP's name of a model ("PINHOLE", ...).
 const char* cameraModelName(CameraModel model);

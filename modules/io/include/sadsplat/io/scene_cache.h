@@ -11,9 +11,11 @@
 namespace sadsplat {
 namespace io {
 
-/// \brief Format version written by writeSceneCache. readSceneCache also accepts version 1, the
-/// same layout whose checksum used a wrong FNV offset basis (see docs/formats.md).
-constexpr std::uint32_t kSceneCacheVersion = 2;
+/// \brief Format version written by writeSceneCache: 3 stores images and region maps as
+/// deflated prediction residuals (lossless). readSceneCache also accepts version 2 (the same
+/// chunks with raw planes) and version 1 (version 2 whose checksum used a wrong FNV offset basis;
+/// see docs/formats.md).
+constexpr std::uint32_t kSceneCacheVersion = 3;
 
 /// \brief Writes `scene` to `path` (atomically).
 void writeSceneCache(const std::string& path, const Scene& scene);

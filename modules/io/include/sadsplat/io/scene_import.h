@@ -5,7 +5,9 @@
 
 #include <string>
 
+#include "sadsplat/io/colmap.h"
 #include "sadsplat/io/scene.h"
+#include "sadsplat/io/transforms_json.h"
 
 namespace sadsplat {
 namespace io {
@@ -27,14 +29,24 @@ struct ImportOptions {
   std::string annotations;
 };
 
-struct ColmapModel;
-
-/// rief The folder of a scene directory's COLMAP model: `dir`/sparse/0 (COLMAP's mapper) or
+/// \brief The folder of a scene directory's COLMAP model: `dir`/sparse/0 (COLMAP's mapper) or
 /// `dir`/sparse (COLMAP's image_undistorter), whichever holds cameras.bin or cameras.txt.
-/// 	hrows sadsplat::Error naming both layouts when neither exists
+/// \throws sadsplat::Error naming both layouts when neither exists
 std::string findColmapModel(const std::string& dir);
 
-/// rief The split of a scene without split.json (ImportOptions::test_every).
+/// \brief The posed images of a scene directory, whichever tool wrote them.
+struct PosedImages {
+  ColmapModel model;      ///< cameras, images (names relative to image_dir), points
+  std::string image_dir;  ///< the folder the image names are relative to
+  std::string origin;     ///< the COLMAP model folder or the transforms.json (for messages)
+};
+
+/// \brief The COLMAP model of `dir` (findColmapModel) with its images in `dir`/images, or, when
+/// there is none, `dir`/transforms.json (io/transforms_json.h).
+/// \throws sadsplat::Error naming the layouts when there is neither
+PosedImages readPosedImages(const std::string& dir, const ImageSizeOf& image_size);
+
+/// \brief The split of a scene without split.json (ImportOptions::test_every).
 SplitInfo defaultSplit(const ColmapModel& model, int test_every);
 
 /// \brief Whether this build can import scene directories (it has OpenCV).

@@ -23,6 +23,11 @@ void writeSemanticPly(const std::string& path, const pcl::PointCloud<pcl::PointX
 /// \throws sadsplat::Error naming the file and property when it is missing or invalid
 pcl::PointCloud<pcl::PointXYZRGBL> readSemanticPly(const std::string& path);
 
+/// \brief Reads any PLY point cloud: `x y z` required, `red green blue` (grey 128 when absent)
+/// and `label` (-1 when absent) optional; other elements and properties are skipped.
+/// \throws sadsplat::Error naming the file and property when it is missing or invalid
+pcl::PointCloud<pcl::PointXYZRGBL> readPointCloudPly(const std::string& path);
+
 /// \brief Whether the PLY at `path` is a semantic cloud (it has `label` and `red`, but no
 /// `f_dc_0`): the header alone is read.
 /// \throws sadsplat::Error naming the file when it is missing or its header is invalid

@@ -1,0 +1,105 @@
+#include "plane_codec.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "compression.h"
+
+namespace sadsplat {
+namespace io {
+namespace planes {
+namespace {
+
+// zlib level 6: on photos within 1 % of level 9 at about twice the speed.
+constexpr int kLevel = 6;
+
+inline int medPrediction(int left, int up, int up_left) {
+  const int lo = std::min(left, up), hi = std::max(left, up);
+  if (up_left >= hi) return lo;
+  if (up_left <= lo) return hi;
+  return left + up - up_left;
+}
+
+// The MED prediction of pixel (x, y) of plane `p` (row-major, `w` wide) from decoded neighbours;
+// outside the image the neighbours are 0.
+inline int predict(const std::uint8_t* p, int w, int x, int y) {
+  const int left = x > 0 ? p[y * w + x - 1] : (y > 0 ? p[(y - 1) * w] : 0);
+  if (y == 0) return left;
+  const int up = p[(y - 1) * w + x];
+  if (x == 0) return up;
+  return medPrediction(left, up, p[(y - 1) * w + x - 1]);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encodeImage(const std::string& path, const Image8& image) {
+  const int w = image.width, h = image.height, c = image.channels;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  std::vector<std::uint8_t> plane(n), residual(n * c);
+  for (int ch = 0; ch < c; ++ch) {
+    for (std::size_t i = 0; i < n; ++i) plane[i] = image.pixels[i * c + ch];
+    std::uint8_t* out = residual.data() + ch * n;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        out[i] = static_cast<std::uint8_t>(plane[i] - predict(plane.data(), w, x, y));
+      }
+    }
+  }
+  return compression::deflateRaw(path, residual.data(), residual.size(), kLevel);
+}
+
+Image8 decodeImage(const std::string& path, const std::string& field, const std::uint8_t* data,
+                   std::size_t size, int width, int height, int channels) {
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  const std::vector<std::uint8_t> residual =
+      compression::inflateRaw(path, field, data, size, n * channels);
+  Image8 image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  image.pixels.resize(n * channels);
+  std::vector<std::uint8_t> plane(n);
+  for (int ch = 0; ch < channels; ++ch) {
+    const std::uint8_t* in = residual.data() + ch * n;
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * width + x;
+        plane[i] = static_cast<std::uint8_t>(in[i] + predict(plane.data(), width, x, y));
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) image.pixels[i * channels + ch] = plane[i];
+  }
+  return image;
+}
+
+std::vector<std::uint8_t> encodeRegions(const std::string& path,
+                                        const std::vector<std::int32_t>& regions, int width) {
+  std::vector<std::uint32_t> delta(regions.size());
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const std::uint32_t left = i % width == 0 ? 0u : static_cast<std::uint32_t>(regions[i - 1]);
+    delta[i] = static_cast<std::uint32_t>(regions[i]) - left;
+  }
+  return compression::deflateRaw(path, reinterpret_cast<const std::uint8_t*>(delta.data()),
+                                 delta.size() * 4, kLevel);
+}
+
+std::vector<std::int32_t> decodeRegions(const std::string& path, const std::string& field,
+                                        const std::uint8_t* data, std::size_t size,
+                                        std::size_t count, int width) {
+  const std::vector<std::uint8_t> bytes = compression::inflateRaw(path, field, data, size, count * 4);
+  std::vector<std::int32_t> regions(count);
+  std::uint32_t previous = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    std::uint32_t d;
+    std::memcpy(&d, bytes.data() + i * 4, 4);
+    if (i % width == 0) previous = 0;
+    previous += d;
+    regions[i] = static_cast<std::int32_t>(previous);
+  }
+  return regions;
+}
+
+}  // namespace planes
+}  // namespace io
+}  // namespace sadsplat
