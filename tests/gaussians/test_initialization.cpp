@@ -34,6 +34,48 @@ TEST(Initialization, IsSeeded) {
   EXPECT_NE(gaussians::initialCloud(points, other)[0].feature[0], a[0].feature[0]);
 }
 
+// Two cameras 10 apart looking down +z at a plane: every random point lies in front of both and
+// inside both images, the draw is seeded, and cameras that share no view are an error.
+TEST(Initialization, RandomPointsLieInTheCamerasCommonView) {
+  std::vector<io::PinholeCamera> cameras(2);
+  for (int i = 0; i < 2; ++i) {
+    cameras[i].width = 64;
+    cameras[i].height = 48;
+    cameras[i].fx = cameras[i].fy = 40;
+    cameras[i].cx = 32;
+    cameras[i].cy = 24;
+    cameras[i].tvec = {i == 0 ? 5.0 : -5.0, 0.0, 0.0};  // centres at x = -5 and x = +5
+  }
+  const auto points = gaussians::randomPointsInView(cameras, 500, 7);
+  ASSERT_EQ(points.size(), 500u);
+  for (const auto& p : points) {
+    for (const auto& c : cameras) {
+      const double z = p.xyz[2];
+      ASSERT_GT(z, 0.0);
+      const double u = c.fx * (p.xyz[0] + c.tvec[0]) / z + c.cx, v = c.fy * p.xyz[1] / z + c.cy;
+      EXPECT_TRUE(u >= 0 && u < 64 && v >= 0 && v < 48) << u << " " << v;
+    }
+    // Depth along the drawing camera's ray: at most 2 x 1.5 x 5.
+    EXPECT_LE(p.xyz[2], 15.f);
+  }
+  const auto again = gaussians::randomPointsInView(cameras, 500, 7);
+  EXPECT_EQ(again[123].xyz, points[123].xyz);
+  EXPECT_NE(gaussians::randomPointsInView(cameras, 500, 8)[0].xyz, points[0].xyz);
+  // Back to back: no point is seen by both.
+  cameras[1].qvec = {0, 0, 1, 0};  // 180 degrees about y
+  EXPECT_THROW(gaussians::randomPointsInView(cameras, 100, 7), Error);
+  EXPECT_THROW(gaussians::randomPointsInView({}, 100, 7), Error);
+}
+
+TEST(Initialization, TheInitChoice) {
+  EXPECT_FALSE(gaussians::initialisesRandomly("auto", 4));
+  EXPECT_TRUE(gaussians::initialisesRandomly("auto", 3));
+  EXPECT_TRUE(gaussians::initialisesRandomly("random", 1000));
+  EXPECT_FALSE(gaussians::initialisesRandomly("points", 4));
+  EXPECT_THROW(gaussians::initialisesRandomly("points", 0), Error);
+  EXPECT_THROW(gaussians::initialisesRandomly("sfm", 100), Error);
+}
+
 TEST(Initialization, TooFewPointsIsAnError) {
   EXPECT_THROW(gaussians::initialCloud(std::vector<io::ScenePoint>(3)), Error);
 }

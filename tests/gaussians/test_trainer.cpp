@@ -60,6 +60,27 @@ TEST_P(TrainerOnDevice, RgbLossFallsOnTheTinyScene) {
   EXPECT_EQ(trainer.iteration(), 240);
 }
 
+// A scene without sparse points (transforms.json without a point cloud) starts from random points
+// in the cameras' common view and still learns the views.
+TEST_P(TrainerOnDevice, ASceneWithoutPointsTrainsFromRandomPoints) {
+  io::Scene scene = scene_;
+  scene.points.clear();
+  TrainConfig config = small(240);
+  config.init = "points";
+  EXPECT_THROW(Trainer(scene, config), Error);
+  config.init = "auto";
+  config.init_random_count = 3000;
+  Trainer trainer(scene, config);
+  EXPECT_EQ(trainer.numGaussians(), 3000);
+  double first = 0, last = 0;
+  for (int i = 0; i < 240; ++i) {
+    const auto stats = trainer.step();
+    if (i < 30) first += stats.rgb_loss / 30;
+    if (i >= 210) last += stats.rgb_loss / 30;
+  }
+  EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
+}
+
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label
 // map); returns how many views got them.
 int pseudoLabelTheUnlabelledViews(io::Scene& scene) {

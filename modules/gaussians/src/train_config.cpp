@@ -156,6 +156,12 @@ const std::vector<TrainOption> kOptions = {
     {"checkpoint_interval", &C::checkpoint_interval, "iterations between checkpoints (0: none)",
      nullptr, 0, kInf},
     {"seed", &C::seed, "random seed", "--seed"},
+    {"init", &C::init,
+     "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "
+     "auto (points when the scene has at least 4, else random)",
+     "--init", -kInf, kInf, "auto|points|random"},
+    {"init_random_count", &C::init_random_count, "how many random points --init random places",
+     nullptr, 4, kInf},
     {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
     {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
     {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1,

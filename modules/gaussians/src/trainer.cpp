@@ -93,8 +93,17 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
   InitOptions init;
   init.seed = config.seed;
-  const GaussianTensors t =
-      fromCloud(initialCloud(scene.points, init), s.device, s.config.feature_dim);
+  std::vector<io::ScenePoint> random_points;
+  if (initialisesRandomly(config.init, scene.points.size())) {
+    std::vector<io::PinholeCamera> cameras;
+    for (const io::View& v : scene.views) {
+      if (v.train) cameras.push_back(v.camera);
+    }
+    random_points = randomPointsInView(cameras, config.init_random_count, config.seed);
+  }
+  const GaussianTensors t = fromCloud(
+      initialCloud(random_points.empty() ? scene.points : random_points, init), s.device,
+      s.config.feature_dim);
   ParameterStore& p = s.params;
   p.add("means", t.means, config.lr_position_init * s.extent);
   p.add("sh_dc", t.sh_dc, config.lr_sh_dc);

@@ -17,6 +17,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/eval/evaluation.h"
+#include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -204,6 +205,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                 << (pseudo > 0 ? "the pseudo-label backend + ground truth"
                                : "the ground truth only")
                 << "\n";
+  }
+  if (o.progress && !o.resume && gaussians::initialisesRandomly(config.init, scene.points.size())) {
+    *o.progress << "initialisation: up to " << config.init_random_count
+                << " random points in the training cameras' common view"
+                << (config.init == "random" ? "" : " (the scene has no sparse points)") << "\n";
   }
   gaussians::Trainer trainer(scene, config);
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));

@@ -62,6 +62,11 @@ struct TrainConfig {
   int max_screen_radius = 20;
   int checkpoint_interval = 1000;  ///< 0 = none
   std::uint64_t seed = 42;
+  /// Initial Gaussians (gaussians/initialization.h): "auto" = the scene's sparse points, or
+  /// init_random_count random points in the cameras' common view when it has fewer than 4;
+  /// "points"; "random".
+  std::string init = "auto";
+  int init_random_count = 100000;  ///< 3DGS's random initialisation of synthetic scenes
   std::array<float, 3> background{0, 0, 0};
   std::string device = "cpu";   ///< "cpu" or "cuda"
   int max_gaussians = 3000000;  ///< densification stops growing past this
