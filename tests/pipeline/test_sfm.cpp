@@ -17,6 +17,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/exif_orientation.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/georeference.h"
 #include "sadsplat/pipeline/sfm_run.h"
@@ -151,6 +152,59 @@ TEST(Sfm, BadInputsAreOneLineErrors) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("at least 2 photos"), std::string::npos) << e.what();
   }
+}
+
+// A JPEG with an EXIF APP1 segment whose IFD0 holds only Orientation (TIFF 6.0: tag 0x0112,
+// SHORT), written by hand from the specification.
+std::vector<unsigned char> jpegWithOrientation(const std::vector<unsigned char>& jpeg, int value) {
+  const std::vector<unsigned char> app1 = {
+      0xFF, 0xE1, 0, 34, 'E', 'x', 'i', 'f', 0, 0,                 // APP1, length 34, "Exif\0\0"
+      'I',  'I',  42, 0, 8, 0, 0, 0,                               // TIFF little endian, IFD0 at 8
+      1,    0,                                                     // one entry
+      0x12, 0x01, 3, 0, 1, 0, 0, 0, static_cast<unsigned char>(value), 0, 0, 0,  // Orientation
+      0,    0,    0, 0};                                           // no next IFD
+  std::vector<unsigned char> out(jpeg.begin(), jpeg.begin() + 2);  // SOI
+  out.insert(out.end(), app1.begin(), app1.end());
+  out.insert(out.end(), jpeg.begin() + 2, jpeg.end());
+  return out;
+}
+
+TEST(Sfm, PhotosWithAnExifRotationGetUprightCopies) {
+  if (!io::haveExif()) GTEST_SKIP() << "built without libexif";
+  test::TempDir tmp;
+  const std::string photos = tmp.file("photos");
+  io::makeDirectory(photos);
+  cv::Mat stored(20, 40, CV_8UC3);
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 40; ++x) stored.at<cv::Vec3b>(y, x) = cv::Vec3b(x * 6, y * 12, 90);
+  std::vector<unsigned char> jpeg;
+  cv::imencode(".jpg", stored, jpeg);
+  const auto write = [&](const std::string& name, const std::vector<unsigned char>& bytes) {
+    test::writeFile(photos + "/" + name, std::string(bytes.begin(), bytes.end()));
+  };
+  write("a.jpg", jpeg);
+  write("b.jpg", jpegWithOrientation(jpeg, 6));  // shown turned 90 degrees clockwise
+  EXPECT_EQ(io::readExifOrientation(photos + "/a.jpg"), 1);
+  EXPECT_EQ(io::readExifOrientation(photos + "/b.jpg"), 6);
+  // OpenCV, an independent reader, shows b.jpg turned: the hand-made tag is well-formed.
+  EXPECT_EQ(cv::imread(photos + "/b.jpg").cols, 20);
+
+  int rotated = -1;
+  EXPECT_EQ(pipeline::uprightPhotos(photos, {"a.jpg"}, tmp.file("work"), &rotated), photos);
+  EXPECT_EQ(rotated, 0);
+  io::makeDirectory(tmp.file("work"));
+  const std::string upright =
+      pipeline::uprightPhotos(photos, {"a.jpg", "b.jpg"}, tmp.file("work"), &rotated);
+  EXPECT_EQ(rotated, 1);
+  EXPECT_EQ(upright, tmp.file("work") + "/upright");
+  EXPECT_EQ(test::readFile(upright + "/a.jpg"), test::readFile(photos + "/a.jpg"));
+  const cv::Mat b = cv::imread(upright + "/b.jpg", cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+  ASSERT_EQ(b.cols, 20);
+  ASSERT_EQ(b.rows, 40);
+  EXPECT_EQ(io::readExifOrientation(upright + "/b.jpg"), 1);
+  // Orientation 6: the stored top-left corner is the upright image's top-right corner.
+  const cv::Vec3b corner = b.at<cv::Vec3b>(0, 19), origin = stored.at<cv::Vec3b>(0, 0);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(corner[k], origin[k], 12) << k;
 }
 
 }  // namespace

@@ -24,8 +24,13 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/exif_orientation.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/georeference.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#endif
 
 extern char** environ;
 
@@ -120,6 +125,41 @@ void transformModel(io::ColmapModel& model, const io::Similarity& sim) {
 
 }  // namespace
 
+std::string uprightPhotos(const std::string& photos_dir, const std::vector<std::string>& photos,
+                          const std::string& work_dir, int* rotated) {
+  std::vector<int> orientation;
+  for (const auto& p : photos) orientation.push_back(io::readExifOrientation(photos_dir + "/" + p));
+  *rotated = static_cast<int>(
+      std::count_if(orientation.begin(), orientation.end(), [](int o) { return o != 1; }));
+  if (*rotated == 0) return photos_dir;
+#if SADSPLAT_HAVE_OPENCV
+  const std::string dir = work_dir + "/upright";
+  io::makeDirectory(dir);
+  for (std::size_t i = 0; i < photos.size(); ++i) {
+    const std::string from = photos_dir + "/" + photos[i], to = dir + "/" + photos[i];
+    if (orientation[i] == 1) {
+      fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+      continue;
+    }
+    // imread applies the EXIF orientation unless told not to; the copy carries no EXIF, so
+    // COLMAP reads it upright (the GPS is taken from the original).
+    const cv::Mat upright = cv::imread(from, cv::IMREAD_COLOR);
+    if (upright.empty()) throw Error(from, "image data", "a readable photo", "cannot decode");
+    const std::string ext = io::lowerExtension(photos[i]);
+    const bool jpeg = ext == ".jpg" || ext == ".jpeg";
+    if (!cv::imwrite(to, upright, jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 98}
+                                       : std::vector<int>{})) {
+      throw Error(to, "file", "a writable upright copy of " + from, "cannot write");
+    }
+  }
+  return dir;
+#else
+  throw Error(photos_dir, "EXIF orientation",
+              "photos stored upright (this build has no OpenCV to turn them)",
+              std::to_string(*rotated) + " rotated photos");
+#endif
+}
+
 SfmSummary sfmRun(const SfmOptions& o) {
   const auto start = Clock::now();
   std::ostream* log = o.progress;
@@ -173,6 +213,14 @@ SfmSummary sfmRun(const SfmOptions& o) {
   say("sfm: " + std::to_string(photos.size()) + " photos in " + o.photos + ", " +
       std::to_string(gps.size()) + " with GPS" +
       (io::haveExif() ? "" : " (this build reads no EXIF: no georeference)") + "\n");
+  // COLMAP reads pixels as stored: photos with an EXIF rotation get upright copies first, so
+  // that images/, the cameras and annotations drawn on the photos as viewers show them agree.
+  int rotated = 0;
+  const std::string image_path = uprightPhotos(o.photos, photos, work, &rotated);
+  if (rotated > 0) {
+    say("sfm: " + std::to_string(rotated) + " photos carry an EXIF rotation: upright copies in " +
+        image_path + "\n");
+  }
   std::string matcher = o.matcher;
   if (matcher == "auto") {
     matcher = photos.size() <= 40               ? "exhaustive"
@@ -205,7 +253,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
     }
   };
   stage("feature_extractor",
-        {o.colmap, "feature_extractor", "--database_path", db, "--image_path", o.photos,
+        {o.colmap, "feature_extractor", "--database_path", db, "--image_path", image_path,
          "--ImageReader.single_camera", o.single_camera ? "1" : "0",
          "--SiftExtraction.max_image_size", size, "--SiftExtraction.num_threads", threads,
          "--SiftExtraction.use_gpu", "0"});
@@ -224,7 +272,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
   // Models of an earlier, failed run must not be taken for this run's.
   fs::remove_all(work + "/sparse");
   io::makeDirectory(work + "/sparse");
-  stage("mapper", {o.colmap, "mapper", "--database_path", db, "--image_path", o.photos,
+  stage("mapper", {o.colmap, "mapper", "--database_path", db, "--image_path", image_path,
                    "--output_path", work + "/sparse", "--Mapper.num_threads", threads});
   // The mapper may leave several models (sparse/0, 1, ...): the one with most photos.
   std::string best;
@@ -242,7 +290,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
   const std::string undistorted = o.out + "/.undistort";
   fs::remove_all(undistorted);
   stage("image_undistorter",
-        {o.colmap, "image_undistorter", "--image_path", o.photos, "--input_path", best,
+        {o.colmap, "image_undistorter", "--image_path", image_path, "--input_path", best,
          "--output_path", undistorted, "--max_image_size", size});
   io::ColmapModel model = io::readColmapModel(undistorted + "/sparse");
 

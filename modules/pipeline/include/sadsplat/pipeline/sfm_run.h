@@ -42,6 +42,14 @@ struct SfmSummary {
   double seconds = 0;
 };
 
+/// \brief The folder COLMAP should read `photos` from: `photos_dir` itself when every photo is
+/// stored upright, else `work_dir`/upright with every photo, those with an EXIF rotation
+/// (io::readExifOrientation) turned upright (JPEG quality 98, no EXIF) and the others copied.
+/// \param[out] rotated how many photos carried a rotation
+/// \throws sadsplat::Error for an unreadable photo, or rotated photos in a build without OpenCV
+std::string uprightPhotos(const std::string& photos_dir, const std::vector<std::string>& photos,
+                          const std::string& work_dir, int* rotated);
+
 /// \brief Runs the whole reconstruction.
 /// \throws sadsplat::Error naming the missing program (and its Debian package), the photos
 /// folder, a failed stage (with its log), or a reconstruction that registered fewer than 2 photos
