@@ -77,13 +77,14 @@ std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data
 }
 
 std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t* data,
-                                     std::size_t size, int level) {
+                                     std::size_t size, int level, bool huffman_only) {
   // One call: zlib's counters are 32-bit, and a plane of the scene cache is far below 1 GiB.
   if (size > (std::size_t(1) << 30)) {
     throw Error(path, "deflate", "a block of at most 1 GiB", std::to_string(size) + " bytes");
   }
   z_stream s{};
-  if (deflateInit2(&s, level, Z_DEFLATED, -MAX_WBITS, 9, Z_DEFAULT_STRATEGY) != Z_OK) {
+  if (deflateInit2(&s, level, Z_DEFLATED, -MAX_WBITS, 9,
+                   huffman_only ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY) != Z_OK) {
     throw Error(path, "deflate", "zlib to initialise", "an initialisation failure");
   }
   std::vector<std::uint8_t> out(deflateBound(&s, size) + 64);

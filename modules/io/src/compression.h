@@ -24,9 +24,11 @@ std::vector<std::uint8_t> gunzip(
     const std::string& path, const std::uint8_t* data, std::size_t size,
     const std::function<std::size_t(const std::vector<std::uint8_t>&)>& limit_of);
 
-/// Deflates `data` into a raw deflate stream (no zlib or gzip wrapper) at zlib `level` (1-9).
+/// Deflates `data` into a raw deflate stream (no zlib or gzip wrapper) at zlib `level` (1-9);
+/// `huffman_only` skips the string matching (zlib's Z_HUFFMAN_ONLY: for prediction residuals
+/// it compresses better and faster).
 std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t* data,
-                                     std::size_t size, int level);
+                                     std::size_t size, int level, bool huffman_only = false);
 
 /// Inflates a raw deflate stream (ZIP method 8) that must produce exactly `expected` bytes.
 std::vector<std::uint8_t> inflateRaw(const std::string& path, const std::string& field,

@@ -1,9 +1,12 @@
 #pragma once
 // Lossless planes of the scene cache (version 3): images and pseudo-label region maps are stored
-// as prediction residuals, deflated. Images: each channel a plane of its own, every byte replaced
-// by its difference (mod 256) to the median edge detector of LOCO-I / JPEG-LS (the left and upper
-// neighbours' min or max at an edge, else left + up - upper-left). Region maps (int32 per pixel,
-// piecewise constant): the difference to the left neighbour (mod 2^32). Decoding is bounded by
+// as prediction residuals, deflated. Images: each channel a plane of its own (RGB as G, R - G,
+// B - G mod 256: the reversible colour transform that decorrelates the channels), every byte
+// replaced by its difference (mod 256) to the median edge detector of LOCO-I / JPEG-LS (the left
+// and upper neighbours' min or max at an edge, else left + up - upper-left), Huffman-coded by
+// deflate without string matching. On the 800x450 Brighton photos the RGB planes shrink to 0.54
+// of their size (0.78 without the colour transform). Region maps (int32 per pixel, piecewise
+// constant): the difference to the left neighbour (mod 2^32), deflated. Decoding is bounded by
 // the sizes the caller expects, not by what the compressed bytes claim.
 
 #include <cstdint>
