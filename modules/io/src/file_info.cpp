@@ -285,5 +285,21 @@ std::string describeFile(const std::string& path) {
   return out.str();
 }
 
+std::string describeCameras(const std::string& path) {
+  const Scene scene = isDirectory(path) ? importScene(path) : readSceneCache(path);
+  std::ostringstream out;
+  out.precision(17);
+  out << "name,width,height,fx,fy,cx,cy,qw,qx,qy,qz,tx,ty,tz,role\n";
+  for (const View& v : scene.views) {
+    const PinholeCamera& c = v.camera;
+    out << v.name << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << ","
+        << c.cx << "," << c.cy;
+    for (double q : c.qvec) out << "," << q;
+    for (double t : c.tvec) out << "," << t;
+    out << "," << (v.test ? "test" : v.train ? "train" : "none") << "\n";
+  }
+  return out.str();
+}
+
 }  // namespace io
 }  // namespace sadsplat

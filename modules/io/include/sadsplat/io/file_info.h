@@ -12,5 +12,11 @@ namespace io {
 /// \throws sadsplat::Error if the file is of none of these kinds or is invalid
 std::string describeFile(const std::string& path);
 
+/// \brief The cameras of a scene cache or scene directory as CSV, one line per view after a
+/// header: name, width, height, fx, fy, cx, cy (pixels, centres at +0.5), qw qx qy qz and
+/// tx ty tz (world to camera, COLMAP's convention), train / test roles.
+/// \throws sadsplat::Error if `path` is neither or is invalid
+std::string describeCameras(const std::string& path);
+
 }  // namespace io
 }  // namespace sadsplat
