@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/filesystem.h"
@@ -271,6 +272,123 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
   EXPECT_GT(differ, cam.pixels.size() / 50) << "the view from view_002 is not the aerial view";
   EXPECT_EQ(test::runCommand(kCli + " report " + dir.file("nothing"), &out), 1);
   EXPECT_NE(out.find("run directory"), std::string::npos) << out;
+}
+
+// Splat mode (the default): a short run seen through a scene camera is what `sadsplat render`
+// draws for that camera; classes are decoded per pixel; colourings and --mode points change the
+// picture.
+class SplatMode : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+    std::string out;
+    // 30 iterations: an early model whose young Gaussians are still faint (opacity ~0.1).
+    ASSERT_EQ(test::runCommand(kCli + " train " + cache + " --iterations 30 --out " + run(), &out),
+              0)
+        << out;
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string run() { return dir_->file("run"); }
+  static test::TempDir* dir_;
+};
+test::TempDir* SplatMode::dir_ = nullptr;
+
+TEST_F(SplatMode, AViewFromASceneCameraIsTheRunsRenderOfIt) {
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " view " + run() +
+                                 " --view view_002 --color rgb --size 256x192 --background 0,0,0 "
+                                 "--screenshot " + dir_->file("view.png"),
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::runCommand(kCli + " render " + run() + " --views view_002.png --size 256x192 " +
+                                 "--outputs rgb --out " + dir_->file("render"),
+                             &out),
+            0)
+      << out;
+  const Png view = readPng(dir_->file("view.png"));
+  const Png render = readPng(dir_->file("render/rgb/view_002.png"));
+  ASSERT_EQ(view.width, render.width);
+  ASSERT_EQ(view.height, render.height);
+  // Below the title line (the top 30 rows), pixel for pixel.
+  std::size_t n = 0, off = 0;
+  double sum = 0;
+  for (int y = 30; y < view.height; ++y) {
+    for (int x = 0; x < view.width; ++x, ++n) {
+      int d = 0;
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(view.at(x, y)[k] - render.at(x, y)[k]));
+      sum += d;
+      off += d > 2;
+    }
+  }
+  EXPECT_LT(sum / n, 0.5) << "mean difference";
+  EXPECT_LT(static_cast<double>(off) / n, 0.01) << off << " of " << n << " pixels differ by > 2";
+  // The render is not black: the comparison compared something.
+  std::size_t black = 0;
+  for (const auto& p : render.pixels) black += p[0] == 0 && p[1] == 0 && p[2] == 0;
+  EXPECT_LT(black, render.pixels.size() / 2);
+}
+
+TEST_F(SplatMode, ClassColoursCoverTheModelEvenEarlyInTraining) {
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " view " + run() + " --size 320x240 --screenshot " +
+                                 dir_->file("class.png"),
+                             &out),
+            0)
+      << out;
+  const Png png = readPng(dir_->file("class.png"));
+  // tiny_scene's classes (data/tiny_scene/classes.json).
+  const std::array<std::uint8_t, 3> road = {128, 64, 128}, grass = {0, 160, 0},
+                                    building = {220, 20, 60};
+  std::size_t model = 0, coloured = 0;
+  for (int y = 30; y < png.height; ++y) {  // below the title
+    for (int x = 80; x < png.width; ++x) {  // right of the legend
+      const auto& p = png.at(x, y);
+      if (near(p, kBackground, 3)) continue;
+      ++model;
+      coloured += near(p, road, 2) || near(p, grass, 2) || near(p, building, 2);
+    }
+  }
+  const std::size_t area = static_cast<std::size_t>(png.height - 30) * (png.width - 80);
+  EXPECT_GT(model, area / 10) << "the model covers a tenth of the picture";
+  EXPECT_GT(coloured, model * 95 / 100) << coloured << " of " << model;
+}
+
+TEST_F(SplatMode, ColouringsAndModesChangeThePicture) {
+  std::string out;
+  std::map<std::string, Png> shots;
+  for (const std::string& args : {std::string("--color class"), std::string("--color rgb"),
+                                  std::string("--color opacity"),
+                                  std::string("--mode points --color class")}) {
+    const std::string png = dir_->file("shot" + std::to_string(shots.size()) + ".png");
+    ASSERT_EQ(test::runCommand(kCli + " view " + run() + " " + args + " --size 160x120 --screenshot " +
+                                   png,
+                               &out),
+              0)
+        << out;
+    shots[args] = readPng(png);
+  }
+  const auto differing = [](const Png& a, const Png& b) {
+    std::size_t d = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) d += a.pixels[i] != b.pixels[i];
+    return d;
+  };
+  const std::size_t tenth = shots.begin()->second.pixels.size() / 10;
+  EXPECT_GT(differing(shots["--color class"], shots["--color rgb"]), tenth);
+  EXPECT_GT(differing(shots["--color rgb"], shots["--color opacity"]), tenth);
+  EXPECT_GT(differing(shots["--color class"], shots["--mode points --color class"]), tenth);
+  EXPECT_EQ(test::runCommand(kCli + " view " + run() + " --mode dots --screenshot " +
+                                 dir_->file("x.png"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("--mode: expected splat or points"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + " view " + run() + " --background 1,2 --screenshot " +
+                                 dir_->file("x.png"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("--background"), std::string::npos) << out;
+  EXPECT_FALSE(std::ifstream(dir_->file("x.png")).good());
 }
 
 // `sadsplat table --plots`: two frontier charts with a point per configuration and scene, the

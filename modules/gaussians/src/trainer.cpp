@@ -310,6 +310,10 @@ RenderResult Trainer::renderView(const io::View& view) const {
 }
 
 RenderResult Trainer::renderCamera(const RasterCamera& camera) const {
+  return renderCamera(camera, at::Tensor());
+}
+
+RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;
   RenderSettings settings;
@@ -317,6 +321,14 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera) const {
   settings.background = s.config.background;
   GaussianParams g = s.params.gaussians();
   g.opacity_gate = s.drop.evaluationGate(s.params, s.iteration);
+  if (keep.defined()) {
+    if (keep.dim() != 1 || keep.size(0) != g.means.size(0)) {
+      throw Error("<render>", "keep mask", "one flag per Gaussian (" +
+                  std::to_string(g.means.size(0)) + ")", std::to_string(keep.numel()));
+    }
+    const at::Tensor k = keep.to(g.means.device(), g.means.scalar_type());
+    g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
+  }
   return render(g, camera, settings);
 }
 

@@ -1,7 +1,9 @@
 #include "sadsplat/viz/splat_view.h"
 
 #include <vtkActor.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
+#include <vtkImageData.h>
 #include <vtkFloatArray.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLegendBoxActor.h>
@@ -21,6 +23,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTexture.h>
 #include <vtkUnsignedCharArray.h>
 
 #include <Eigen/Eigenvalues>
@@ -28,6 +31,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -162,6 +166,14 @@ class SplatScene {
         only_[i] = shown;
       }
     }
+    if (options_.mode != "splat" && options_.mode != "points") {
+      throw Error("<command line>", "--mode", "splat or points", options_.mode);
+    }
+    for (const auto& m : models_) {
+      if (splat() && !m.frames) {
+        throw Error(m.name, "--mode splat", "a model the rasterizer can render", "none given");
+      }
+    }
     checkColorMode(options_.color);
     window_->SetSize(options_.width, options_.height);
     window_->SetWindowName("sadsplat view");
@@ -179,9 +191,124 @@ class SplatScene {
     window_->SetMultiSamples(0);
     resetCamera();
     rebuild();
+    renderFrames(1);
   }
 
   vtkRenderWindow* window() { return window_; }
+  bool splat() const { return options_.mode == "splat"; }
+
+  // Splat mode: each viewport's background is the rasterizer's image for the current camera,
+  // at 1/`reduction` of the viewport's resolution.
+  void renderFrames(int reduction) {
+    if (!splat()) return;
+    const int* size = window_->GetSize();
+    for (std::size_t i = 0; i < models_.size(); ++i) {
+      const int w = std::max(1, size[0] / static_cast<int>(models_.size()) / reduction);
+      const int h = std::max(1, size[1] / reduction);
+      io::FrameRequest request;
+      request.camera = cameraFor(w, h);
+      request.content = options_.color == ColorMode::kClass ? io::FrameContent::kClasses
+                        : isScalarMode(options_.color)      ? io::FrameContent::kScalar
+                                                            : io::FrameContent::kRgb;
+      const ColorMode mode = options_.color;
+      request.scalar = [mode](const GaussianPoint& p) { return scalarValue(p, mode); };
+      const bool all = hidden_[i].empty() && (only_.count(i) == 0 || only_.at(i).empty());
+      if (!all) request.visible = [this, i](std::uint32_t label) { return visible(i, label); };
+      const io::SplatFrame frame = models_[i].frames(request);
+      renderers_[i]->SetBackgroundTexture(texture(i, frame));
+      renderers_[i]->TexturedBackgroundOn();
+    }
+  }
+
+  // The VTK camera as a pinhole camera of w x h pixels (square pixels, centred principal point);
+  // the scene camera itself while the view is the one --view named.
+  io::PinholeCamera cameraFor(int w, int h) const {
+    io::PinholeCamera cam;
+    if (exact_) {
+      cam = *exact_;
+      const double sx = static_cast<double>(w) / cam.width, sy = static_cast<double>(h) / cam.height;
+      cam.fx *= sx, cam.cx *= sx, cam.fy *= sy, cam.cy *= sy;
+      cam.width = w, cam.height = h;
+      return cam;
+    }
+    vtkCamera* c = renderers_[0]->GetActiveCamera();
+    double p[3], f[3], u[3];
+    c->GetPosition(p);
+    c->GetFocalPoint(f);
+    c->GetViewUp(u);
+    const Eigen::Vector3d eye(p[0], p[1], p[2]);
+    const Eigen::Vector3d forward = (Eigen::Vector3d(f[0], f[1], f[2]) - eye).normalized();
+    const Eigen::Vector3d down = -(Eigen::Vector3d(u[0], u[1], u[2]) -
+                                   forward.dot(Eigen::Vector3d(u[0], u[1], u[2])) * forward)
+                                      .normalized();
+    const Eigen::Vector3d right = down.cross(forward);
+    Eigen::Matrix3d R;
+    R.row(0) = right;
+    R.row(1) = down;
+    R.row(2) = forward;
+    const Eigen::Quaterniond q(R);
+    cam.qvec = {q.w(), q.x(), q.y(), q.z()};
+    const Eigen::Vector3d t = -R * eye;
+    cam.tvec = {t.x(), t.y(), t.z()};
+    cam.width = w;
+    cam.height = h;
+    cam.fy = 0.5 * h / std::tan(0.5 * c->GetViewAngle() * kPi / 180.0);
+    cam.fx = cam.fy;
+    cam.cx = 0.5 * w;
+    cam.cy = 0.5 * h;
+    return cam;
+  }
+
+  // The frame composited over the background in the current colouring, as a texture.
+  vtkSmartPointer<vtkTexture> texture(std::size_t model, const io::SplatFrame& frame) const {
+    const ViewModel& m = models_[model];
+    vtkNew<vtkImageData> image;
+    image->SetDimensions(frame.width, frame.height, 1);
+    image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+    auto* out = static_cast<std::uint8_t*>(image->GetScalarPointer());
+    const auto lut = lookupTable();
+    const auto& bg = options_.background;
+    for (int y = 0; y < frame.height; ++y) {
+      for (int x = 0; x < frame.width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
+        // VTK's rows run bottom-up.
+        std::uint8_t* o = out + (static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x) * 3;
+        const float a = frame.alpha[i];
+        if (!frame.classes.empty()) {
+          const std::int16_t c = frame.classes[i];
+          const auto rgb = c >= 0 ? classColor(m, static_cast<std::uint32_t>(c))
+                                  : c == -2 ? classColor(m, kUnlabelled) : bg;
+          std::copy(rgb.begin(), rgb.end(), o);
+        } else if (!frame.scalar.empty()) {
+          double rgb[3];
+          lut->GetColor(frame.scalar[i], rgb);
+          for (int k = 0; k < 3; ++k) {
+            o[k] = static_cast<std::uint8_t>(std::lround(255.0 * rgb[k] * a + bg[k] * (1.0 - a)));
+          }
+        } else {
+          for (int k = 0; k < 3; ++k) {
+            o[k] = static_cast<std::uint8_t>(
+                std::min(255.0, std::round(frame.rgb[3 * i + k] + bg[k] * (1.0 - a))));
+          }
+        }
+      }
+    }
+    vtkNew<vtkTexture> tex;
+    tex->SetInputData(image);
+    tex->InterpolateOff();
+    return tex.GetPointer();
+  }
+
+  // Camera moves: a quick frame while the mouse drags, the full one when it stops.
+  void cameraMoving() {
+    exact_.reset();
+    renderFrames(4);
+    window_->Render();
+  }
+  void cameraStopped() {
+    renderFrames(1);
+    window_->Render();
+  }
 
   void checkColorMode(ColorMode mode) const {
     for (const auto& m : models_) {
@@ -201,7 +328,7 @@ class SplatScene {
   void rebuild() {
     for (std::size_t i = 0; i < models_.size(); ++i) {
       renderers_[i]->RemoveAllViewProps();
-      renderers_[i]->AddActor(splatActor(i));
+      if (!splat()) renderers_[i]->AddActor(splatActor(i));
       renderers_[i]->AddActor2D(titleActor(i));
       if (isScalarMode(options_.color)) {
         renderers_[i]->AddActor2D(scalarBar());
@@ -228,6 +355,7 @@ class SplatScene {
         camera->SetViewUp(up.x(), up.y(), up.z());
         camera->SetViewAngle(2.0 * std::atan(0.5 * cam.height / cam.fy) * 180.0 / kPi);
         for (auto& ren : renderers_) ren->ResetCameraClippingRange();
+        exact_ = cam;
         return;
       }
       std::string known;
@@ -240,6 +368,7 @@ class SplatScene {
                       : "a view of the run's scene, e.g. " + known,
                   options_.view);
     }
+    exact_.reset();
     const SceneFrame f = sceneFrame(models_[0]);
     // Any horizontal direction: the one of x (or y) orthogonal to up.
     Eigen::Vector3d side = Eigen::Vector3d::UnitY().cross(f.up);
@@ -296,6 +425,7 @@ class SplatScene {
       return false;
     }
     rebuild();
+    renderFrames(1);
     window_->Render();
     return true;
   }
@@ -443,7 +573,17 @@ class SplatScene {
   std::map<std::size_t, std::set<std::uint32_t>> only_;
   vtkNew<vtkRenderWindow> window_;
   std::vector<vtkSmartPointer<vtkRenderer>> renderers_;
+  std::optional<io::PinholeCamera> exact_;  // the --view camera until the user moves
 };
+
+void onInteraction(vtkObject*, unsigned long event, void* client, void*) {
+  auto* scene = static_cast<SplatScene*>(client);
+  if (event == vtkCommand::EndInteractionEvent) {
+    scene->cameraStopped();
+  } else {
+    scene->cameraMoving();
+  }
+}
 
 }  // namespace
 
@@ -478,6 +618,13 @@ void showModels(const std::vector<ViewModel>& models, const SplatViewOptions& op
   vtkNew<vtkRenderWindowInteractor> interactor;
   vtkNew<KeyStyle> style;
   style->on_key = [&](char k) { return scene.key(k, log); };
+  if (scene.splat()) {
+    vtkNew<vtkCallbackCommand> moved;
+    moved->SetCallback(onInteraction);
+    moved->SetClientData(&scene);
+    style->AddObserver(vtkCommand::InteractionEvent, moved);
+    style->AddObserver(vtkCommand::EndInteractionEvent, moved);
+  }
   interactor->SetInteractorStyle(style);
   interactor->SetRenderWindow(scene.window());
   if (log) *log << keyHelp() << std::flush;

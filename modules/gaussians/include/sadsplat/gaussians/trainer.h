@@ -92,6 +92,9 @@ class Trainer {
   /// \brief Renders the current Gaussians through any camera (no gradients): other sizes,
   /// novel views, the orthographic map camera. As renderView for a view's own camera.
   RenderResult renderCamera(const RasterCamera& camera) const;
+  /// \brief As renderCamera, drawing only the Gaussians where `keep` ([N] bool, on any device) is
+  /// true (a viewer's class selection); an undefined `keep` draws them all.
+  RenderResult renderCamera(const RasterCamera& camera, const at::Tensor& keep) const;
   /// \brief Per-pixel class ids [H, W] int64 from a render's feature image (argmax of the cosine
   /// similarity of the decoded feature to each class embedding).
   at::Tensor predictClasses(const RenderResult& render) const;

@@ -1,9 +1,12 @@
 #pragma once
 /// \file splat_view.h
-/// \brief A VTK view of semantic Gaussian clouds: each Gaussian a splat (vtkPointGaussianMapper),
-/// an opaque disc over its footprint (where opacity x exp(-d^2 / 2 sigma^2) >= 1/4, sigma its
-/// largest axis), coloured by class, colour, confidence, gate or opacity; one model, or two side
-/// by side with linked cameras; an interactive window or a PNG screenshot.
+/// \brief A VTK view of semantic Gaussian clouds, coloured by class, colour, confidence, gate or
+/// opacity; one model, or two side by side with linked cameras; an interactive window or a PNG
+/// screenshot. Two modes: "splat" (default) shows the image sadsplat's rasterizer renders for the
+/// VTK camera (ViewModel::frames), as the model really looks, classes decoded per pixel for a
+/// run; re-rendered at a quarter of the resolution while the camera moves and in full when it
+/// stops. "points" draws each Gaussian as an opaque disc (vtkPointGaussianMapper) over its
+/// footprint (where opacity x exp(-d^2 / 2 sigma^2) >= 1/4), to inspect single Gaussians.
 
 #include <array>
 #include <cstdint>
@@ -19,6 +22,8 @@ namespace viz {
 
 /// \brief How to show the models.
 struct SplatViewOptions {
+  /// "splat" (the rasterizer's image) or "points" (discs).
+  std::string mode = "splat";
   ColorMode color = ColorMode::kClass;
   /// Classes to show (names from the class list, or ids); empty: all.
   std::vector<std::string> classes;

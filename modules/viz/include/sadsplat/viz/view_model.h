@@ -12,6 +12,7 @@
 #include "sadsplat/common/class_info.h"
 #include "sadsplat/common/gaussian_point.h"
 #include "sadsplat/io/scene.h"
+#include "sadsplat/io/splat_frame.h"
 
 namespace sadsplat {
 namespace viz {
@@ -25,6 +26,10 @@ struct ViewModel {
   bool has_semantic = false;   ///< the file has sadsplat's semantic fields (label, gate, ...)
   /// The scene's views (name, camera) when the model is a run whose scene is a cache.
   std::vector<std::pair<std::string, io::PinholeCamera>> cameras;
+  /// Renders the model through a camera (the splat mode); null: the model can only be shown as
+  /// discs (`--mode points`). The viewer's caller sets it (pipeline::SplatFrames), since this
+  /// module has no rasterizer.
+  io::FrameSource frames;
 };
 
 /// \brief Loads a model to view: a run directory (its model.ply, classes.json and the cameras of
