@@ -81,6 +81,31 @@ TEST_P(TrainerOnDevice, ASceneWithoutPointsTrainsFromRandomPoints) {
   EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
 }
 
+// After densification, Gaussians larger than large_split_scale x the extent are split in two
+// every densify_interval (not pruned), up to large_split_last iterations before the end.
+TEST_P(TrainerOnDevice, LargeGaussiansAreSplitAfterDensificationWhenAsked) {
+  TrainConfig config = small(250);
+  config.densify_until = 100;  // densification itself stays off (densify_from is past the end)
+  config.densify_interval = 100;
+  config.large_split_last = 0;
+  Trainer plain(scene_, config);
+  const std::int64_t start = plain.numGaussians();
+  for (int i = 0; i < 250; ++i) plain.step(false);
+  EXPECT_EQ(plain.numGaussians(), start) << "off by default";
+
+  config.large_split_scale = 1e-6;  // every Gaussian is "large": each round doubles the count
+  Trainer split(scene_, config);
+  for (int i = 0; i < 199; ++i) split.step(false);
+  EXPECT_EQ(split.numGaussians(), start);
+  split.step(false);  // iteration 200: the first round after densify_until
+  EXPECT_EQ(split.numGaussians(), 2 * start);
+  split.checkConsistency();
+  config.large_split_last = 100;  // no round in the last 100 iterations: none at 200 of 250
+  Trainer late(scene_, config);
+  for (int i = 0; i < 250; ++i) late.step(false);
+  EXPECT_EQ(late.numGaussians(), start);
+}
+
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label
 // map); returns how many views got them.
 int pseudoLabelTheUnlabelledViews(io::Scene& scene) {

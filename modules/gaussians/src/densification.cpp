@@ -1,6 +1,7 @@
 #include "sadsplat/gaussians/densification.h"
 
 #include <cmath>
+#include <map>
 #include <tuple>
 
 #include "sadsplat/common/error.h"
@@ -52,7 +53,15 @@ class DefaultDensification : public DensificationStrategy {
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
     const TrainConfig& c = config_;
-    if (done > c.densify_until) return;
+    if (done > c.densify_until) {
+      // Not 3DGS: after densification, Gaussians that grew beyond large_split_scale x the extent
+      // are split (not pruned: they fill surfaces), until the last refinement iterations.
+      if (c.large_split_scale > 0 && done % c.densify_interval == 0 &&
+          done <= c.iterations - c.large_split_last) {
+        splitLarge(params, done, resize);
+      }
+      return;
+    }
     if (done > c.densify_from && done % c.densify_interval == 0) {
       densifyAndPrune(params, effective_opacity, done > c.opacity_reset_interval, done, resize);
     }
@@ -102,39 +111,13 @@ class DefaultDensification : public DensificationStrategy {
     const at::Tensor clone = room ? big_grad & (max_scale <= dense) : at::zeros_like(big_grad);
     const at::Tensor split = room ? big_grad & (max_scale > dense) : at::zeros_like(big_grad);
 
-    std::map<std::string, at::Tensor> extra;
     const at::Tensor clone_idx = clone.nonzero().squeeze(1);
     const at::Tensor split_idx = split.nonzero().squeeze(1);
-    // Split: two samples from each large Gaussian, scales divided by 1.6 (3DGS).
-    at::Tensor split_means;
-    {
-      const at::Tensor s = scales.index_select(0, split_idx).repeat({2, 1});
-      at::Generator gen = seededGenerator(c.seed, 7, static_cast<std::uint64_t>(iteration));
-      const at::Tensor noise =
-          at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(grad_accum_.device()) * s;
-      const at::Tensor q = params["quats"].value.detach().index_select(0, split_idx).repeat({2, 1});
-      const at::Tensor qn = q / q.norm(2, 1, true);
-      const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2),
-                       z = qn.select(1, 3);
-      const at::Tensor R =
-          at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                     2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                     2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
-                    1)
-              .view({-1, 3, 3});
-      split_means = at::bmm(R, noise.unsqueeze(2)).squeeze(2) +
-                    params["means"].value.detach().index_select(0, split_idx).repeat({2, 1});
-    }
+    std::map<std::string, at::Tensor> extra = splitRows(params, split_idx, scales, iteration, 7);
     for (const Parameter& q : params.all()) {
       if (!q.per_gaussian) continue;
-      const at::Tensor src = q.value.detach();
-      const at::Tensor cloned = src.index_select(0, clone_idx);
-      std::vector<int64_t> reps(static_cast<std::size_t>(src.dim()), 1);
-      reps[0] = 2;
-      at::Tensor splitted = src.index_select(0, split_idx).repeat(reps);
-      if (q.name == "means") splitted = split_means;
-      if (q.name == "scales") splitted = splitted - std::log(1.6);
-      extra[q.name] = at::cat({cloned, splitted}, 0);
+      const at::Tensor cloned = q.value.detach().index_select(0, clone_idx);
+      extra[q.name] = at::cat({cloned, extra[q.name]}, 0);
     }
     // Originals of split Gaussians go; so do transparent (and, later, huge) ones. Transparent
     // means the opacity a Gaussian renders with at evaluation: times its deterministic gate.
@@ -146,6 +129,52 @@ class DefaultDensification : public DensificationStrategy {
     keep = keep & remove.logical_not();
     resize(keep, extra);
     grad_accum_.zero_();  // the statistics start again with the new rows
+    denom_.zero_();
+    max_radii_.zero_();
+  }
+
+  // Split: two samples from each Gaussian of `idx`, scales divided by 1.6 (3DGS); the new rows
+  // of every per-Gaussian parameter. `salt` separates the random streams of the callers.
+  std::map<std::string, at::Tensor> splitRows(ParameterStore& params, const at::Tensor& idx,
+                                              const at::Tensor& scales, int iteration,
+                                              std::uint64_t salt) const {
+    const TrainConfig& c = config_;
+    const at::Tensor s = scales.index_select(0, idx).repeat({2, 1});
+    at::Generator gen = seededGenerator(c.seed, salt, static_cast<std::uint64_t>(iteration));
+    const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(s.device()) * s;
+    const at::Tensor q = params["quats"].value.detach().index_select(0, idx).repeat({2, 1});
+    const at::Tensor qn = q / q.norm(2, 1, true);
+    const at::Tensor w = qn.select(1, 0), x = qn.select(1, 1), y = qn.select(1, 2),
+                     z = qn.select(1, 3);
+    const at::Tensor R =
+        at::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                   2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+                  1)
+            .view({-1, 3, 3});
+    const at::Tensor means = at::bmm(R, noise.unsqueeze(2)).squeeze(2) +
+                             params["means"].value.detach().index_select(0, idx).repeat({2, 1});
+    std::map<std::string, at::Tensor> rows;
+    for (const Parameter& p : params.all()) {
+      if (!p.per_gaussian) continue;
+      const at::Tensor src = p.value.detach();
+      std::vector<int64_t> reps(static_cast<std::size_t>(src.dim()), 1);
+      reps[0] = 2;
+      at::Tensor split = src.index_select(0, idx).repeat(reps);
+      if (p.name == "means") split = means;
+      if (p.name == "scales") split = split - std::log(1.6);
+      rows[p.name] = split;
+    }
+    return rows;
+  }
+
+  void splitLarge(ParameterStore& params, int iteration, const Resize& resize) {
+    const at::Tensor scales = params["scales"].value.detach().exp();
+    const at::Tensor large = std::get<0>(scales.max(1)) > config_.large_split_scale * extent_;
+    if (!large.any().item<bool>()) return;
+    const at::Tensor idx = large.nonzero().squeeze(1);
+    resize(large.logical_not(), splitRows(params, idx, scales, iteration, 11));
+    grad_accum_.zero_();
     denom_.zero_();
     max_radii_.zero_();
   }

@@ -155,6 +155,12 @@ const std::vector<TrainOption> kOptions = {
      kInf},
     {"checkpoint_interval", &C::checkpoint_interval, "iterations between checkpoints (0: none)",
      nullptr, 0, kInf},
+    {"large_split_scale", &C::large_split_scale,
+     "after densification, split Gaussians larger than this x the scene extent every "
+     "densify_interval (0: off)",
+     nullptr, 0, kInf},
+    {"large_split_last", &C::large_split_last,
+     "the last iterations without large-Gaussian splits", nullptr, 0, kInf},
     {"seed", &C::seed, "random seed", "--seed"},
     {"init", &C::init,
      "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "

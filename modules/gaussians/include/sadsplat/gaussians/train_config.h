@@ -74,6 +74,12 @@ struct TrainConfig {
   /// floater_min_views training views see, or whose largest scale exceeds floater_max_scale x
   /// the scene extent (gaussians/view_coverage.h).
   bool prune_floaters = false;
+  /// Not 3DGS: after densify_until, every densify_interval iterations up to iterations -
+  /// large_split_last, each Gaussian whose largest scale exceeds large_split_scale x the scene
+  /// extent is split in two (3DGS's split: two samples, scales / 1.6), so that no Gaussian stays
+  /// huge without removing what it covers. 0 = off.
+  double large_split_scale = 0.0;
+  int large_split_last = 500;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
   // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
