@@ -214,7 +214,8 @@ TEST(SceneCache, CompressedImagesAreLosslessAndSmaller) {
     EXPECT_EQ(back.views[i].mask.pixels, scene.views[i].mask.pixels);
     EXPECT_EQ(back.views[i].labels.pixels, scene.views[i].labels.pixels);
   }
-  const double ratio = double(test::readFile(dir.file("v3.cache")).size()) / test::readFile(v1).size();
+  const double ratio =
+      double(test::readFile(dir.file("v3.cache")).size()) / test::readFile(v1).size();
   EXPECT_LT(ratio, 0.5) << ratio;
 }
 

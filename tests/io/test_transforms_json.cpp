@@ -29,7 +29,8 @@ std::array<int, 2> noImageSize(const std::string& path) {
 Eigen::Vector2d project(const io::ColmapImage& im, const io::ColmapCamera& cam,
                         const Eigen::Vector3d& world, double* depth = nullptr) {
   const Eigen::Quaterniond q(im.qvec[0], im.qvec[1], im.qvec[2], im.qvec[3]);
-  const Eigen::Vector3d x = q.normalized() * world + Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
+  const Eigen::Vector3d x =
+      q.normalized() * world + Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
   if (depth) *depth = x.z();
   const double fx = cam.params[0], fy = cam.params[1], cx = cam.params[2], cy = cam.params[3];
   return {fx * x.x() / x.z() + cx, fy * x.y() / x.z() + cy};
@@ -64,7 +65,12 @@ class TransformsJson : public ::testing::Test {
 TEST_F(TransformsJson, OpenGlCameraAxesBecomeColmapsWorldToCamera) {
   Eigen::Matrix4d c2w = Eigen::Matrix4d::Identity();
   c2w(2, 3) = 10;
-  const json j = {{"fl_x", 100}, {"fl_y", 100}, {"cx", 100}, {"cy", 50}, {"w", 200}, {"h", 100},
+  const json j = {{"fl_x", 100},
+                  {"fl_y", 100},
+                  {"cx", 100},
+                  {"cy", 50},
+                  {"w", 200},
+                  {"h", 100},
                   {"frames", json::array({frame("images/a.jpg", c2w)})}};
   const io::TransformsJson t = io::readTransformsJson(write(j), noImageSize);
   ASSERT_EQ(t.model.images.size(), 1u);
@@ -95,8 +101,8 @@ TEST_F(TransformsJson, FieldOfViewPerFrameIntrinsicsAndDistortionModels) {
   f4["camera_model"] = "OPENCV_FISHEYE";
   f4["k1"] = 0.2;
   f4["k4"] = 0.001;
-  const json j = {{"camera_angle_x", 2 * std::atan(0.5)}, {"w", 200}, {"h", 100},
-                  {"frames", {f1, f2, f3, f4}}};
+  const json j = {
+      {"camera_angle_x", 2 * std::atan(0.5)}, {"w", 200}, {"h", 100}, {"frames", {f1, f2, f3, f4}}};
   const io::TransformsJson t = io::readTransformsJson(write(j), noImageSize);
   EXPECT_EQ(t.image_dir, tmp_.path());
   ASSERT_EQ(t.model.cameras.size(), 4u);
@@ -115,8 +121,8 @@ TEST_F(TransformsJson, FieldOfViewPerFrameIntrinsicsAndDistortionModels) {
   EXPECT_DOUBLE_EQ(t.model.cameras[3].params[4], 0.2);
   EXPECT_DOUBLE_EQ(t.model.cameras[3].params[7], 0.001);
   // Frames sharing intrinsics share a camera.
-  const json shared = {{"fl_x", 50}, {"w", 20}, {"h", 10},
-                       {"frames", {frame("a.png", I), frame("b.png", I)}}};
+  const json shared = {
+      {"fl_x", 50}, {"w", 20}, {"h", 10}, {"frames", {frame("a.png", I), frame("b.png", I)}}};
   EXPECT_EQ(io::readTransformsJson(write(shared), noImageSize).model.cameras.size(), 1u);
 }
 
@@ -170,7 +176,8 @@ TEST_F(TransformsJson, BadFilesAreOneLineErrors) {
   json nan_focal = with(json::array({frame("a.png", I)}));
   nan_focal["fl_x"] = "wide";
   expectError(nan_focal, "fl_x");
-  expectError(json{{"w", 200}, {"h", 100}, {"frames", json::array({frame("a.png", I)})}}, "focal length");
+  expectError(json{{"w", 200}, {"h", 100}, {"frames", json::array({frame("a.png", I)})}},
+              "focal length");
   test::writeFile(tmp_.file("broken.json"), "{\"frames\": [");
   EXPECT_THROW(io::readTransformsJson(tmp_.file("broken.json"), noImageSize), Error);
 }
@@ -189,7 +196,8 @@ TEST_F(TransformsJson, TheFixtureSceneAsTransformsJsonImportsLikeItsColmapModel)
     const Eigen::Matrix3d w2c = q.normalized().toRotationMatrix();
     Eigen::Matrix4d c2w = Eigen::Matrix4d::Identity();
     c2w.topLeftCorner<3, 3>() = w2c.transpose();
-    c2w.topRightCorner<3, 1>() = -w2c.transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
+    c2w.topRightCorner<3, 1>() =
+        -w2c.transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
     c2w.col(1) *= -1;
     c2w.col(2) *= -1;
     json f = frame("images/" + im.name, c2w);
@@ -210,9 +218,10 @@ TEST_F(TransformsJson, TheFixtureSceneAsTransformsJsonImportsLikeItsColmapModel)
     points.push_back(x);
   }
   io::writeSemanticPly(dir + "/sparse_pc.ply", points);
-  test::writeFile(dir + "/transforms.json",
-                  json{{"camera_model", "OPENCV"}, {"frames", frames}, {"ply_file_path", "sparse_pc.ply"}}
-                      .dump());
+  test::writeFile(
+      dir + "/transforms.json",
+      json{{"camera_model", "OPENCV"}, {"frames", frames}, {"ply_file_path", "sparse_pc.ply"}}
+          .dump());
   const io::Scene reference = io::importScene(dir);
   std::filesystem::remove_all(dir + "/sparse");
   const io::Scene scene = io::importScene(dir);

@@ -1,7 +1,7 @@
 // `sadsplat view MODEL`: a VTK window (or a screenshot) of one model, or two side by side.
-#include <iostream>
 #include <array>
 #include <cstdlib>
+#include <iostream>
 #include <sstream>
 
 #include "../cli_support.h"
@@ -51,7 +51,8 @@ class ViewCommand : public Command {
     c->add_option("--compare", compare_, "a second model beside it, cameras linked");
     c->add_option("--screenshot", options_.screenshot, "write this PNG (offscreen) and exit");
     c->add_option("--size", size_, "window / screenshot size")->capture_default_str();
-    c->add_option("--splat-scale", options_.splat_scale, "points mode: factor on every disc's radius")
+    c->add_option("--splat-scale", options_.splat_scale,
+                  "points mode: factor on every disc's radius")
         ->capture_default_str();
     c->add_option("--background", background_, "background colour R,G,B (0-255)")
         ->capture_default_str();
@@ -82,7 +83,7 @@ class ViewCommand : public Command {
 
  private:
   std::string model_, compare_, color_ = "class", classes_, size_ = "1280x720", device_ = "cpu",
-                                  background_ = "28,30,36";
+                                background_ = "28,30,36";
   viz::SplatViewOptions options_;
 };
 

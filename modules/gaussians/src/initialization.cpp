@@ -100,8 +100,7 @@ std::vector<io::ScenePoint> randomPointsInView(const std::vector<io::PinholeCame
   for (const auto& c : cameras) rotations.push_back(c.rotation());
   std::vector<io::ScenePoint> points;
   const std::int64_t max_draws = 200ll * count;
-  for (std::int64_t draw = 0; draw < max_draws && static_cast<int>(points.size()) < count;
-       ++draw) {
+  for (std::int64_t draw = 0; draw < max_draws && static_cast<int>(points.size()) < count; ++draw) {
     const std::size_t i = pick(rng);
     const io::PinholeCamera& from = cameras[i];
     const auto& R = rotations[i];
@@ -111,7 +110,8 @@ std::vector<io::ScenePoint> randomPointsInView(const std::vector<io::PinholeCame
     // World point X = R^T (x_cam - t).
     const double d[3] = {xc - from.tvec[0], yc - from.tvec[1], depth - from.tvec[2]};
     std::array<double, 3> X{};
-    for (int k = 0; k < 3; ++k) X[k] = R[0 * 3 + k] * d[0] + R[1 * 3 + k] * d[1] + R[2 * 3 + k] * d[2];
+    for (int k = 0; k < 3; ++k)
+      X[k] = R[0 * 3 + k] * d[0] + R[1 * 3 + k] * d[1] + R[2 * 3 + k] * d[2];
     std::size_t seen = 0;
     for (std::size_t j = 0; j < cameras.size() && seen < needed_views; ++j) {
       const auto& c = cameras[j];
@@ -131,11 +131,10 @@ std::vector<io::ScenePoint> randomPointsInView(const std::vector<io::PinholeCame
     points.push_back(p);
   }
   if (points.size() < 4) {
-    throw Error("<scene>", "cameras",
-                "views that overlap (random points seen by " + std::to_string(needed_views) +
-                    " cameras)",
-                std::to_string(points.size()) + " such points in " + std::to_string(max_draws) +
-                    " draws");
+    throw Error(
+        "<scene>", "cameras",
+        "views that overlap (random points seen by " + std::to_string(needed_views) + " cameras)",
+        std::to_string(points.size()) + " such points in " + std::to_string(max_draws) + " draws");
   }
   return points;
 }

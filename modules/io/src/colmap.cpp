@@ -45,8 +45,7 @@ void validateCamera(const ColmapCamera& c, const std::string& file, const std::s
   for (std::size_t i = 0; i < c.params.size(); ++i) {
     requireFinite(c.params[i], file, where + " param " + std::to_string(i));
   }
-  if (c.params[0] <= 0 ||
-      (cameraModelHasFy(c.model) ? c.params[1] <= 0 : false)) {
+  if (c.params[0] <= 0 || (cameraModelHasFy(c.model) ? c.params[1] <= 0 : false)) {
     throw Error(file, where + " focal length", "positive", std::to_string(c.params[0]));
   }
 }
@@ -133,7 +132,8 @@ std::vector<ColmapCamera> readCamerasText(const std::string& path) {
     if (!modelFromName(model, &c.model)) {
       throw Error(path, lines.where() + " MODEL",
                   "one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, OPENCV_FISHEYE, "
-                  "FULL_OPENCV", model);
+                  "FULL_OPENCV",
+                  model);
     }
     c.width = parseField<std::uint64_t>(in, lines, "WIDTH");
     c.height = parseField<std::uint64_t>(in, lines, "HEIGHT");

@@ -107,7 +107,8 @@ std::vector<std::uint8_t> encodeRegions(const std::string& path,
 std::vector<std::int32_t> decodeRegions(const std::string& path, const std::string& field,
                                         const std::uint8_t* data, std::size_t size,
                                         std::size_t count, int width) {
-  const std::vector<std::uint8_t> bytes = compression::inflateRaw(path, field, data, size, count * 4);
+  const std::vector<std::uint8_t> bytes =
+      compression::inflateRaw(path, field, data, size, count * 4);
   std::vector<std::int32_t> regions(count);
   std::uint32_t previous = 0;
   for (std::size_t i = 0; i < count; ++i) {

@@ -91,12 +91,13 @@ void poseOf(const std::string& path, const std::string& where, const json& m, Co
     }
   }
   // Rigid: the tools write rotation matrices; a scale hidden in them would skew every ray.
-  const double orthogonality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthogonality > 1e-3 || r.determinant() < 0) {
     std::ostringstream got;
     got << "max |R^T R - I| " << orthogonality << ", det " << r.determinant();
-    throw Error(path, where + " transform_matrix", "a rotation (orthonormal, det +1) and a translation",
-                got.str());
+    throw Error(path, where + " transform_matrix",
+                "a rotation (orthonormal, det +1) and a translation", got.str());
   }
   // OpenGL camera axes (y up, z back) -> OpenCV's (y down, z forward): flip the y and z columns.
   const Eigen::Matrix3d c2w = r * Eigen::Vector3d(1, -1, -1).asDiagonal();
@@ -207,9 +208,8 @@ TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& im
     if (!pathExists(dir + "/" + file) && pathExists(dir + "/" + file + ".png")) file += ".png";
     files.push_back(file);
   }
-  const bool in_images = std::all_of(files.begin(), files.end(), [](const std::string& f) {
-    return f.rfind("images/", 0) == 0;
-  });
+  const bool in_images = std::all_of(
+      files.begin(), files.end(), [](const std::string& f) { return f.rfind("images/", 0) == 0; });
   TransformsJson out;
   out.image_dir = in_images ? dir + "/images" : dir;
 
@@ -224,8 +224,8 @@ TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& im
       height = static_cast<int>(f.number("h"));
     } else {
       if (!pathExists(image_path)) {
-        throw Error(path, f.where() + " file_path", "an existing image (its size is needed: no w/h)",
-                    image_path + " missing");
+        throw Error(path, f.where() + " file_path",
+                    "an existing image (its size is needed: no w/h)", image_path + " missing");
       }
       const auto size = image_size(image_path);
       width = size[0];
@@ -251,15 +251,15 @@ TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& im
     if (!names.insert(image.name).second) {
       throw Error(path, f.where() + " file_path", "each image once", image.name + " twice");
     }
-    poseOf(path, f.where(), frames[i].contains("transform_matrix") ? frames[i]["transform_matrix"]
-                                                                   : json(),
-           &image);
+    poseOf(path, f.where(),
+           frames[i].contains("transform_matrix") ? frames[i]["transform_matrix"] : json(), &image);
     out.model.images.push_back(std::move(image));
   }
 
   if (top.contains("ply_file_path") && top["ply_file_path"].is_string()) {
     const std::string ply = dir + "/" + normalisedRelative(top["ply_file_path"].get<std::string>());
-    if (!pathExists(ply)) throw Error(path, "ply_file_path", "an existing PLY point cloud", ply + " missing");
+    if (!pathExists(ply))
+      throw Error(path, "ply_file_path", "an existing PLY point cloud", ply + " missing");
     const auto cloud = readPointCloudPly(ply);
     for (const auto& p : cloud) {
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;

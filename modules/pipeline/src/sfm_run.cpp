@@ -147,8 +147,8 @@ std::string uprightPhotos(const std::string& photos_dir, const std::vector<std::
     if (upright.empty()) throw Error(from, "image data", "a readable photo", "cannot decode");
     const std::string ext = io::lowerExtension(photos[i]);
     const bool jpeg = ext == ".jpg" || ext == ".jpeg";
-    if (!cv::imwrite(to, upright, jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 98}
-                                       : std::vector<int>{})) {
+    if (!cv::imwrite(to, upright,
+                     jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 98} : std::vector<int>{})) {
       throw Error(to, "file", "a writable upright copy of " + from, "cannot write");
     }
   }

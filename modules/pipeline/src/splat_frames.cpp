@@ -18,11 +18,11 @@ namespace pipeline {
 
 struct SplatFrames::State {
   at::Device device{at::kCPU};
-  std::unique_ptr<OpenedRun> run;         // a run: its trainer renders and decodes
-  pcl::PointCloud<GaussianPoint> cloud;   // the Gaussians, in the order the tensors hold them
-  gaussians::GaussianParams params;       // render-ready (runs: the trainer's parameters)
+  std::unique_ptr<OpenedRun> run;        // a run: its trainer renders and decodes
+  pcl::PointCloud<GaussianPoint> cloud;  // the Gaussians, in the order the tensors hold them
+  gaussians::GaussianParams params;      // render-ready (runs: the trainer's parameters)
   int sh_degree = 3;
-  int num_labels = 0;                     // plain models: 1 + the largest label
+  int num_labels = 0;  // plain models: 1 + the largest label
 
   at::Tensor keepMask(const io::FrameRequest& r) const {
     if (!r.visible) return at::Tensor();
@@ -46,8 +46,7 @@ struct SplatFrames::State {
   }
 };
 
-SplatFrames::SplatFrames(const std::string& path, const std::string& device)
-    : state_(new State) {
+SplatFrames::SplatFrames(const std::string& path, const std::string& device) : state_(new State) {
   State& s = *state_;
   if (device == "cuda") s.device = at::Device(at::kCUDA, 0);
   namespace fs = std::filesystem;
@@ -60,8 +59,7 @@ SplatFrames::SplatFrames(const std::string& path, const std::string& device)
   }
   const std::string model = io::isDirectory(path) ? (fs::path(path) / "model.ply").string() : path;
   s.cloud = io::readGaussians(model);
-  const gaussians::GaussianTensors t =
-      gaussians::fromCloud(s.cloud, s.device, /*feature_dim=*/0);
+  const gaussians::GaussianTensors t = gaussians::fromCloud(s.cloud, s.device, /*feature_dim=*/0);
   s.params.means = t.means;
   s.params.quats = t.rotations;
   s.params.log_scales = t.log_scales;

@@ -3,8 +3,8 @@
 #include <vtkActor.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
-#include <vtkImageData.h>
 #include <vtkFloatArray.h>
+#include <vtkImageData.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLegendBoxActor.h>
 #include <vtkLookupTable.h>
@@ -226,7 +226,8 @@ class SplatScene {
     io::PinholeCamera cam;
     if (exact_) {
       cam = *exact_;
-      const double sx = static_cast<double>(w) / cam.width, sy = static_cast<double>(h) / cam.height;
+      const double sx = static_cast<double>(w) / cam.width,
+                   sy = static_cast<double>(h) / cam.height;
       cam.fx *= sx, cam.cx *= sx, cam.fy *= sy, cam.cy *= sy;
       cam.width = w, cam.height = h;
       return cam;
@@ -272,12 +273,14 @@ class SplatScene {
       for (int x = 0; x < frame.width; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * frame.width + x;
         // VTK's rows run bottom-up.
-        std::uint8_t* o = out + (static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x) * 3;
+        std::uint8_t* o =
+            out + (static_cast<std::size_t>(frame.height - 1 - y) * frame.width + x) * 3;
         const float a = frame.alpha[i];
         if (!frame.classes.empty()) {
           const std::int16_t c = frame.classes[i];
-          const auto rgb = c >= 0 ? classColor(m, static_cast<std::uint32_t>(c))
-                                  : c == -2 ? classColor(m, kUnlabelled) : bg;
+          const auto rgb = c >= 0    ? classColor(m, static_cast<std::uint32_t>(c))
+                           : c == -2 ? classColor(m, kUnlabelled)
+                                     : bg;
           std::copy(rgb.begin(), rgb.end(), o);
         } else if (!frame.scalar.empty()) {
           double rgb[3];
