@@ -17,7 +17,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsa
 # The views, reports and charts render through Mesa's software OpenGL, whose JIT-compiled code LSan sees
 # as leaks from an unknown module (no stack to suppress by): those tests run with ASan and UBSan
 # but without the leak check.
-viz_tests="^(ViewScreenshot|Report|FrontierCharts)\."
+viz_tests="^(ViewScreenshot|SplatMode|Report|FrontierCharts)\."
 # Three end-to-end runs take ~460 s of the ASan pass's test time (~600 s of wall on 2 cores for
 # all of it, 2026-11-24) and add no code path of their own: the demo (synth, pseudo-labels, two trainings, eval: the same paths as
 # Cli.TrainEvalAndResumeOnTheFixture and Cli.PseudoLabelOptions*), kill -9 + resume (resume is
