@@ -48,14 +48,20 @@ class TrainerOnDevice : public TrainerTest, public ::testing::WithParamInterface
 };
 INSTANTIATE_TEST_SUITE_P(Devices, TrainerOnDevice, ::testing::Values("cpu", "cuda"));
 
-TEST_P(TrainerOnDevice, RgbLossFallsOnTheTinyScene) {
-  Trainer trainer(scene_, small(240));
+// Trains 240 steps; the mean RGB loss of the first and of the last 30.
+std::pair<double, double> firstAndLastRgbLoss(Trainer& trainer) {
   double first = 0, last = 0;
   for (int i = 0; i < 240; ++i) {
     const auto stats = trainer.step();
     if (i < 30) first += stats.rgb_loss / 30;
     if (i >= 210) last += stats.rgb_loss / 30;
   }
+  return {first, last};
+}
+
+TEST_P(TrainerOnDevice, RgbLossFallsOnTheTinyScene) {
+  Trainer trainer(scene_, small(240));
+  const auto [first, last] = firstAndLastRgbLoss(trainer);
   EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
   EXPECT_EQ(trainer.iteration(), 240);
 }
@@ -72,12 +78,7 @@ TEST_P(TrainerOnDevice, ASceneWithoutPointsTrainsFromRandomPoints) {
   config.init_random_count = 3000;
   Trainer trainer(scene, config);
   EXPECT_EQ(trainer.numGaussians(), 3000);
-  double first = 0, last = 0;
-  for (int i = 0; i < 240; ++i) {
-    const auto stats = trainer.step();
-    if (i < 30) first += stats.rgb_loss / 30;
-    if (i >= 210) last += stats.rgb_loss / 30;
-  }
+  const auto [first, last] = firstAndLastRgbLoss(trainer);
   EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
 }
 

@@ -57,12 +57,16 @@ void inflateBounded(const std::string& path, const std::string& field, z_stream&
 
 }  // namespace
 
-std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data,
-                               std::size_t size) {
+namespace {
+
+// One deflate call over the whole input; `window_bits` picks the wrapper (16 + MAX_WBITS: gzip,
+// -MAX_WBITS: raw), `what` names the stream in errors.
+std::vector<std::uint8_t> deflateAll(const std::string& path, const char* what,
+                                     const std::uint8_t* data, std::size_t size, int level,
+                                     int window_bits, int strategy) {
   z_stream s{};
-  if (deflateInit2(&s, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 9, Z_DEFAULT_STRATEGY) !=
-      Z_OK) {
-    throw Error(path, "gzip", "zlib to initialise", "an initialisation failure");
+  if (deflateInit2(&s, level, Z_DEFLATED, window_bits, 9, strategy) != Z_OK) {
+    throw Error(path, what, "zlib to initialise", "an initialisation failure");
   }
   std::vector<std::uint8_t> out(deflateBound(&s, size) + 64);
   s.next_in = const_cast<Bytef*>(data);
@@ -71,9 +75,17 @@ std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data
   s.avail_out = static_cast<uInt>(out.size());
   const int rc = deflate(&s, Z_FINISH);
   deflateEnd(&s);
-  if (rc != Z_STREAM_END) throw Error(path, "gzip", "the data compressed", "a zlib error");
+  if (rc != Z_STREAM_END) throw Error(path, what, "the data compressed", "a zlib error");
   out.resize(out.size() - s.avail_out);
   return out;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> gzip(const std::string& path, const std::uint8_t* data,
+                               std::size_t size) {
+  return deflateAll(path, "gzip", data, size, Z_DEFAULT_COMPRESSION, 16 + MAX_WBITS,
+                    Z_DEFAULT_STRATEGY);
 }
 
 std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t* data,
@@ -82,21 +94,8 @@ std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t
   if (size > (std::size_t(1) << 30)) {
     throw Error(path, "deflate", "a block of at most 1 GiB", std::to_string(size) + " bytes");
   }
-  z_stream s{};
-  if (deflateInit2(&s, level, Z_DEFLATED, -MAX_WBITS, 9,
-                   huffman_only ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY) != Z_OK) {
-    throw Error(path, "deflate", "zlib to initialise", "an initialisation failure");
-  }
-  std::vector<std::uint8_t> out(deflateBound(&s, size) + 64);
-  s.next_in = const_cast<Bytef*>(data);
-  s.avail_in = static_cast<uInt>(size);
-  s.next_out = out.data();
-  s.avail_out = static_cast<uInt>(out.size());
-  const int rc = deflate(&s, Z_FINISH);
-  deflateEnd(&s);
-  if (rc != Z_STREAM_END) throw Error(path, "deflate", "the data compressed", "a zlib error");
-  out.resize(out.size() - s.avail_out);
-  return out;
+  return deflateAll(path, "deflate", data, size, level, -MAX_WBITS,
+                    huffman_only ? Z_HUFFMAN_ONLY : Z_DEFAULT_STRATEGY);
 }
 
 std::vector<std::uint8_t> gunzip(

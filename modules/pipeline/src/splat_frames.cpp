@@ -37,8 +37,7 @@ struct SplatFrames::State {
                                          const at::Tensor& features) const {
     gaussians::GaussianParams g = params;
     g.features = features;
-    if (run) g.opacity_gate = at::Tensor();
-    if (keep.defined()) g.opacity_gate = keep;
+    g.opacity_gate = keep;  // undefined: every Gaussian
     gaussians::RenderSettings settings;
     settings.sh_degree = 0;
     settings.depth = false;
