@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Run ON THE GPU MACHINE from the repository root: sadsplat against gsplat in one run of this script.
-# Needs .deps/debs (scripts/gpu/fetch_deps.sh) and .deps/gsplat (gsplat's source with Debian's
-# glm headers: scripts/gsplat_reference/README.md) carried along.
+# Needs .deps/debs (scripts/gpu/fetch_deps.sh), .deps/gsplat (gsplat's source with Debian's
+# glm headers) and .deps/fused-ssim (scripts/gsplat_reference/README.md) carried along.
 #   [LIMIT=590] [GSPLAT_RUNS="ref"] bash scripts/gpu/gsplat_side_by_side.sh [bench] [SCENE ...]
 # Builds sadsplat (build-gpu/) and gsplat (JIT, /tmp/gsplat-ext) side by side, then
 #   bench   sadsplat_bench_rasterizer --device cuda and scripts/gsplat_reference/
 #           bench_rasterizer_gsplat.py, alternating, two passes each (take the best of the two);
 #   SCENE   (city_0, port_1, ...) trainings at 800x450, 7000 iterations, one at a time:
 #           sadsplat Net-1 (--drop none, no pseudo-labels), sadsplat full (pseudo-labels +
-#           --drop full), and the gsplat reference of Net-1 (GSPLAT_RUNS: ref = with SSIM,
-#           nossim = SSIM weight 0, a lower bound for gsplat with a fused SSIM). LIKE_FOR_LIKE=1
+#           --drop full), and the gsplat reference of Net-1 (GSPLAT_RUNS: ref = with fused-ssim's
+#           CUDA SSIM, as gsplat's trainer; torchssim = SSIM composed of torch convolutions;
+#           nossim = SSIM weight 0, a lower bound). LIKE_FOR_LIKE=1
 #           adds sadsplat Net-1 with max_screen_radius 100000: no screen-size pruning, as
 #           gsplat's default strategy (the Gaussian counts then match).
 # No run starts when fewer than its expected seconds are left before LIMIT. $OUT gets
@@ -107,8 +108,10 @@ for scene in "${args[@]}"; do
   if [ $gs_ok = 0 ]; then
     for variant in ${GSPLAT_RUNS:-ref}; do
       [ "$(left)" -gt 110 ] || break
-      ssim=0.2; [ "$variant" = nossim ] && ssim=0
-      timeout $(( $(left) - 5 )) "$py" scripts/gsplat_reference/train_gsplat.py "$cache" --ssim-weight "$ssim" \
+      ssim=(--ssim-weight 0.2 --ssim fused)
+      [ "$variant" = torchssim ] && ssim=(--ssim-weight 0.2 --ssim torch)
+      [ "$variant" = nossim ] && ssim=(--ssim-weight 0)
+      timeout $(( $(left) - 5 )) "$py" scripts/gsplat_reference/train_gsplat.py "$cache" "${ssim[@]}" \
         --json "$work/gsplat_${scene}_$variant.json" > "$work/logs/gsplat_${scene}_$variant.log" 2>&1
     done
   fi

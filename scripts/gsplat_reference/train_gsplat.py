@@ -11,8 +11,12 @@ exponentially from 1.6e-4 to 1.6e-6 x scene extent), SH degree +1 every 1000 ite
 too, rendered with 32 more channels and decoded by a linear layer, loss 1 - cosine to the one-hot
 class), Adam (fused, as gsplat's simple_trainer). Densification is gsplat's DefaultStrategy with
 sadsplat's schedule and thresholds (from 500 to iterations/2 every 100, gradient 2e-4, dense 0.01
-x extent, opacity reset every 3000). SSIM is a separable 11-tap Gaussian window written with
-torch convolutions (gsplat ships none); --ssim-weight 0 gives a lower bound for a fused SSIM.
+x extent, opacity reset every 3000). SSIM (11-tap Gaussian window, sigma 1.5, zero padding, as
+sadsplat's) is by default the fused CUDA SSIM that gsplat's own trainer uses (`fused-ssim`,
+https://github.com/rahul-goel/fused-ssim, built just in time from its source in FUSED_SSIM_SRC,
+default .deps/fused-ssim; padding "same" = sadsplat's definition; its value is checked against the
+torch composition below at start); --ssim torch uses that composition of torch convolutions,
+--ssim-weight 0 none.
 
   PYTHONPATH=<gsplat source> python3 train_gsplat.py CACHE [--iterations 7000] [--json OUT.json]
 """
@@ -148,12 +152,36 @@ def ssim(a, b, window):
     return m.mean()
 
 
+def load_fused_ssim():
+    """fused-ssim's CUDA extension, built just in time from its source (the package's own
+    Python wrapper imports the module `fused_ssim_cuda`)."""
+    import os
+    from torch.utils.cpp_extension import load
+    here = os.path.dirname(os.path.abspath(__file__))
+    src = os.environ.get("FUSED_SSIM_SRC", os.path.join(here, "..", "..", ".deps", "fused-ssim"))
+    if not os.path.isfile(os.path.join(src, "ssim.cu")):
+        sys.exit(f"{src}: no fused-ssim source (ssim.cu); see scripts/gsplat_reference/README.md, "
+                 "or pass --ssim torch")
+    build = os.environ.get("FUSED_SSIM_BUILD", "/tmp/fused-ssim-ext")
+    os.makedirs(build, exist_ok=True)
+    module = load(name="fused_ssim_cuda", build_directory=build,
+                  sources=[os.path.join(src, f) for f in ("ext.cpp", "ssim.cu", "ssim3d.cu")],
+                  extra_cflags=["-O3", "-DFUSED_SSIM_CUDA"],
+                  extra_cuda_cflags=["-O3", "-DFUSED_SSIM_CUDA", "--maxrregcount=32", "--use_fast_math"])
+    sys.modules["fused_ssim_cuda"] = module
+    sys.path.insert(0, src)
+    from fused_ssim import fused_ssim
+    return fused_ssim
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("cache")
     ap.add_argument("--iterations", type=int, default=7000)
     ap.add_argument("--features", type=int, default=32)
     ap.add_argument("--ssim-weight", type=float, default=0.2)
+    ap.add_argument("--ssim", choices=["fused", "torch"], default="fused",
+                    help="fused: fused-ssim's CUDA kernels (as gsplat's trainer); torch: convolutions")
     ap.add_argument("--seed", type=int, default=42)
     ap.add_argument("--packed", action="store_true", help="gsplat's packed mode")
     ap.add_argument("--json", help="write the results here")
@@ -218,6 +246,27 @@ def main():
     strategy.check_sanity(params, optimizers)
     state = strategy.initialize_state(scene_scale=extent)
     window = gaussian_window(device=dev)
+    ssim_of = lambda a, b: ssim(a, b, window)  # noqa: E731
+    if args.ssim == "fused" and args.ssim_weight > 0:
+        fused_ssim = load_fused_ssim()
+
+        def ssim_of(a, b):  # [H, W, 3] images, the render first (fused-ssim differentiates only it)
+            return fused_ssim(a.permute(2, 0, 1).unsqueeze(0), b.permute(2, 0, 1).unsqueeze(0), padding="same")
+
+        probe = torch.Generator(device=dev).manual_seed(0)
+        a = torch.rand(90, 160, 3, device=dev, generator=probe)
+        b = (a + 0.1 * torch.rand(90, 160, 3, device=dev, generator=probe)).clamp(0, 1)
+        a.requires_grad_(True)
+        fused_value = ssim_of(a, b)
+        (fused_grad,) = torch.autograd.grad(fused_value, a)
+        torch_value = ssim(a, b, window)
+        (torch_grad,) = torch.autograd.grad(torch_value, a)
+        diff = abs(fused_value.item() - torch_value.item())
+        grad_diff = ((fused_grad - torch_grad).abs().max() / torch_grad.abs().max()).item()
+        print(f"fused SSIM vs torch SSIM on a test pair: |value difference| {diff:.2e}, "
+              f"max gradient difference {grad_diff:.2e} of the largest", flush=True)
+        if diff > 1e-4 or grad_diff > 1e-2:
+            sys.exit("fused-ssim does not compute the SSIM defined here")
     gen = torch.Generator().manual_seed(args.seed)
 
     def render(i, degree, semantic):
@@ -242,7 +291,7 @@ def main():
         l1 = ((image - d["rgb"]).abs() * m).mean()
         if args.ssim_weight <= 0:
             return l1
-        return (1 - args.ssim_weight) * l1 + args.ssim_weight * (1 - ssim(image * m, d["rgb"] * m, window))
+        return (1 - args.ssim_weight) * l1 + args.ssim_weight * (1 - ssim_of(image * m, d["rgb"] * m))
 
     def semantic_loss(i, feats):
         lab = data[i]["labels"]
@@ -303,6 +352,7 @@ def main():
     result = {"cache": args.cache, "iterations": args.iterations, "train_seconds": train_s,
               "load_seconds": load_s, "num_gaussians": len(params["means"]),
               "psnr": sum(psnr) / max(1, len(psnr)), "miou": miou, "ssim_weight": args.ssim_weight,
+              "ssim": args.ssim if args.ssim_weight > 0 else "none",
               "packed": args.packed, "peak_memory_gb": torch.cuda.max_memory_allocated() / 2**30}
     print(json.dumps(result))
     if args.json:
