@@ -35,22 +35,60 @@ def fail(path, field, expected):
     sys.exit(f"train_gsplat.py: {path}: {field}: expected {expected}")
 
 
+def med_decode(residuals):
+    """Undoes the median edge prediction of scene cache version 3 (docs/formats.md) on a stack
+    of planes [N, H, W] of one size: pixel = residual + predictor (mod 256), the predictor from
+    the left (a), above (b) and above-left (c) pixels. A pixel needs only pixels of earlier
+    anti-diagonals, so each anti-diagonal of every plane is decoded at once."""
+    import numpy as np
+    r = residuals.astype(np.int32)
+    n, h, w = r.shape
+    v = np.zeros_like(r)
+    v[:, 0, :] = np.cumsum(r[:, 0, :], axis=1) % 256  # first row: the left pixel (0 first)
+    for y in range(1, h):  # first column: the pixel above
+        v[:, y, 0] = (v[:, y - 1, 0] + r[:, y, 0]) % 256
+    for d in range(2, h + w - 1):  # the pixels x + y = d with x, y >= 1
+        y = np.arange(max(1, d - w + 1), min(h - 1, d - 1) + 1)
+        x = d - y
+        a, b, c = v[:, y, x - 1], v[:, y - 1, x], v[:, y - 1, x - 1]
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        pred = np.where(c >= hi, lo, np.where(c <= lo, hi, a + b - c))
+        v[:, y, x] = (pred + r[:, y, x]) % 256
+    return v.astype(np.uint8)
+
+
 def read_cache(path):
+    """The views, classes and points of a sadsplat scene cache, versions 1-3 (docs/formats.md),
+    read without sadsplat."""
+    import zlib
+    import numpy as np
     data = open(path, "rb").read()
     if len(data) < 32 or data[:8] != b"SADSCENE":
         fail(path, "magic", "SADSCENE (a sadsplat scene cache)")
     version, _flags, size, _hash = struct.unpack_from("<IIQQ", data, 8)
-    if version != 1 or size != len(data) - 32:
-        fail(path, "header", "version 1 and payload size = file size - 32")
+    if version not in (1, 2, 3) or size != len(data) - 32:
+        fail(path, "header", "version 1, 2 or 3 and payload size = file size - 32")
     classes, views, points = [], [], None
+    pending = {}  # (h, w) -> [(view, key, channels, residual planes [c, h, w])]
     pos, end = 32, len(data)
 
     def string(p):
         (n,) = struct.unpack_from("<I", data, p)
         return data[p + 4:p + 4 + n].decode("utf-8", "replace"), p + 4 + n
 
-    def plane(p, count):
-        return torch.frombuffer(bytearray(data[p:p + count]), dtype=torch.uint8), p + count
+    def plane(p, view, key, w, h, channels):
+        if version < 3:
+            count = w * h * channels
+            raw = np.frombuffer(data, dtype=np.uint8, count=count, offset=p)
+            view[key] = torch.from_numpy(raw.reshape(h, w, channels).copy())
+            return p + count
+        (n,) = struct.unpack_from("<Q", data, p)
+        raw = zlib.decompress(data[p + 8:p + 8 + n], wbits=-15)
+        if len(raw) != w * h * channels:
+            fail(path, f"view {view['name']}: {key}", f"{w * h * channels} bytes, got {len(raw)}")
+        planes = np.frombuffer(raw, dtype=np.uint8).reshape(channels, h, w)
+        pending.setdefault((h, w), []).append((view, key, channels, planes))
+        return p + 8 + n
 
     while pos + 12 <= end:
         tag = data[pos:pos + 4]
@@ -76,20 +114,32 @@ def read_cache(path):
             p += 24
             roles, has_labels = data[p], data[p + 1]
             p += 2
-            rgb, p = plane(p, w * h * 3)
-            mask, p = plane(p, w * h)
-            labels = None
+            view = dict(name=name, w=w, h=h, K=(fx, fy, cx, cy), q=q, t=t, train=bool(roles & 1),
+                        test=bool(roles & 2), labelled=bool(roles & 4), labels=None)
+            p = plane(p, view, "rgb", w, h, 3)
+            p = plane(p, view, "mask", w, h, 1)
             if has_labels:
-                labels, p = plane(p, w * h)
-            views.append(dict(name=name, w=w, h=h, K=(fx, fy, cx, cy), q=q, t=t,
-                              train=bool(roles & 1), test=bool(roles & 2),
-                              labelled=bool(roles & 4), rgb=rgb.view(h, w, 3),
-                              mask=mask.view(h, w), labels=None if labels is None else labels.view(h, w)))
+                p = plane(p, view, "labels", w, h, 1)
+            views.append(view)
         elif tag == b"PNTS":
             (count,) = struct.unpack_from("<Q", data, c)
             rows = list(struct.iter_unpack("<fffBBB", data[c + 8:c + 8 + 15 * count]))
             points = torch.tensor(rows, dtype=torch.float32)
         pos = nxt
+    for (h, w), items in pending.items():  # version 3: every plane of one size decoded together
+        decoded = med_decode(np.concatenate([planes for *_, planes in items]))
+        k = 0
+        for view, key, channels, _ in items:
+            planes = decoded[k:k + channels].astype(np.int32)
+            k += channels
+            if channels == 3:  # G, R-G, B-G -> R, G, B
+                g = planes[0]
+                planes = np.stack([(planes[1] + g) % 256, g, (planes[2] + g) % 256])
+            view[key] = torch.from_numpy(np.ascontiguousarray(planes.transpose(1, 2, 0)).astype(np.uint8))
+    for v in views:
+        v["mask"] = v["mask"][..., 0]
+        if v["labels"] is not None:
+            v["labels"] = v["labels"][..., 0]
     if not views or points is None or not classes:
         fail(path, "chunks", "CLAS, VIEW and PNTS chunks")
     return classes, views, points
