@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -185,6 +186,31 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
                              &out),
             1);
   EXPECT_NE(out.find("device: expected cpu,cuda, got tpu"), std::string::npos) << out;
+}
+
+// --schedule long: the run's config has the long schedule's keys (prune after the densification,
+// refine the last sixth), keys the user set stay; other schedule names are usage errors.
+TEST(Cli, TheLongScheduleSetsItsKeysAndKeepsGivenOnes) {
+  test::TempDir dir;
+  const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  const std::string run = dir.file("run");
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " train " + cache + " --schedule long --iterations 24 " +
+                                 "--drop full --out " + run,
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("long schedule: lambda_l0_from 0 -> 12; recovery_iterations 0 -> 4;"),
+            std::string::npos)
+      << out;
+  const std::string config = io::readWholeFile(run + "/config.json");
+  EXPECT_NE(config.find("\"lambda_l0_from\": 12"), std::string::npos) << config;
+  EXPECT_NE(config.find("\"recovery_iterations\": 4"), std::string::npos) << config;
+  EXPECT_NE(config.find("\"iterations\": 24"), std::string::npos) << config;
+  EXPECT_EQ(test::runCommand(kCli + " train " + cache + " --schedule short --out " + dir.file("x"),
+                             &out),
+            2)
+      << out;
 }
 
 // A run trained on a relative scene path is evaluated from another working directory (run.json

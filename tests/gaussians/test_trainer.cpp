@@ -107,6 +107,33 @@ TEST_P(TrainerOnDevice, LargeGaussiansAreSplitAfterDensificationWhenAsked) {
   EXPECT_EQ(late.numGaussians(), start);
 }
 
+// scale_limit bounds every Gaussian's scale by the limit x the scene extent after every step; off,
+// the scales grow past it (the bound is what keeps them, not the scene).
+TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : scene_.views) {
+    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  const double extent = gaussians::sceneExtent(cameras);  // as the trainer's (floater test below)
+  TrainConfig config = small(60);
+  const auto largest = [](const Trainer& t) {
+    return t.parameters().log_scales.detach().max().exp().item<double>();
+  };
+  Trainer free(scene_, config);
+  const double limit = 0.5 * largest(free) / extent;  // half the largest initial scale
+  for (int i = 0; i < 60; ++i) free.step(false);
+  EXPECT_GT(largest(free), limit * extent * 1.05);
+
+  config.scale_limit = limit;
+  Trainer bounded(scene_, config);
+  for (int i = 0; i < 60; ++i) {
+    bounded.step(false);
+    ASSERT_LE(largest(bounded), limit * extent * (1 + 1e-5)) << "after step " << i + 1;
+  }
+  const auto stats = bounded.step();
+  EXPECT_TRUE(std::isfinite(stats.rgb_loss));
+}
+
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label
 // map); returns how many views got them.
 int pseudoLabelTheUnlabelledViews(io::Scene& scene) {
@@ -601,6 +628,29 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   EXPECT_EQ(back.lambda_l0_ramp, 700);
   c.device = "tpu";
   EXPECT_THROW(Trainer(scene_, c), Error);
+}
+
+TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {
+  TrainConfig c;
+  std::vector<std::string> changed;
+  const TrainConfig net1 = c.longSchedule({}, &changed);
+  EXPECT_EQ(net1.iterations, 30000);
+  EXPECT_EQ(net1.lambda_l0_from, 0);  // no drop: nothing else changes
+  EXPECT_EQ(net1.recovery_iterations, 0);
+  EXPECT_EQ(changed.size(), 1u);
+  c.drop = "full";
+  const TrainConfig full = c.longSchedule({});
+  EXPECT_EQ(full.lambda_l0_from, 15000);  // after the densification (half of the run)
+  EXPECT_EQ(full.recovery_iterations, 5000);
+  full.check();
+  c.iterations = 12000;
+  c.recovery_iterations = 100;
+  const TrainConfig given = c.longSchedule({"iterations", "recovery_iterations"});
+  EXPECT_EQ(given.iterations, 12000);
+  EXPECT_EQ(given.lambda_l0_from, 6000);
+  EXPECT_EQ(given.recovery_iterations, 100);
+  c.densify_until = 4000;
+  EXPECT_EQ(c.longSchedule({"iterations"}).lambda_l0_from, 4000);
 }
 
 TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRates) {

@@ -42,6 +42,11 @@ class TrainCommand : public Command {
                 "with a global batch of B = ranks x views per step > 1, take the schedule in B "
                 "times fewer steps and the learning rates x sqrt(B): as many views seen as one "
                 "view per step");
+    c->add_option("--schedule", schedule_,
+                  "paper: the paper's 7000-iteration schedule (default); long: 30000 iterations "
+                  "and, with a drop, gates pushed shut only after the densification and the last "
+                  "sixth refined without gates (for the smallest model; keys you set are kept)")
+        ->check(CLI::IsMember({"paper", "long"}));
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "
                 "and write RUN/profile.md");
@@ -93,6 +98,14 @@ class TrainCommand : public Command {
       gaussians::setOptionFromText(*option, is_flag ? "true" : values_[option], config,
                                    "<command line>");
     }
+    if (!resume_ && schedule_ == "long") {
+      std::vector<std::string> changed;
+      config = config.longSchedule(given, &changed);
+      std::cout << "long schedule:";
+      for (const auto& c : changed) std::cout << " " << c << ";";
+      std::cout << " (set a key to keep its value)\n";
+      config.check("--schedule long");
+    }
     if (!resume_) {
       std::vector<std::string> changed;
       config = config.shortRunSchedule(given, &changed);
@@ -136,7 +149,7 @@ class TrainCommand : public Command {
   }
 
  private:
-  std::string scene_, out_, config_file_;
+  std::string scene_, out_, config_file_, schedule_ = "paper";
   double scale_ = 0.5;
   bool resume_ = false, profile_ = false, batch_schedule_ = false;
   int nproc_ = 0;

@@ -53,6 +53,9 @@ class DefaultDensification : public DensificationStrategy {
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
     const TrainConfig& c = config_;
+    if (c.scale_limit > 0) {  // a projection onto the bound: Adam's moments stay as they are
+      params["scales"].value.clamp_max_(std::log(c.scale_limit * extent_));
+    }
     if (done > c.densify_until) {
       // Not 3DGS: after densification, Gaussians that grew beyond large_split_scale x the extent
       // are split (not pruned: they fill surfaces), until the last refinement iterations.

@@ -161,6 +161,10 @@ const std::vector<TrainOption> kOptions = {
      nullptr, 0, kInf},
     {"large_split_last", &C::large_split_last,
      "the last iterations without large-Gaussian splits", nullptr, 0, kInf},
+    {"scale_limit", &C::scale_limit,
+     "no Gaussian's scale exceeds this x the scene extent: log-scales clamped after every step "
+     "(0: off)",
+     "--scale-limit", 0, kInf},
     {"seed", &C::seed, "random seed", "--seed"},
     {"init", &C::init,
      "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "
@@ -325,6 +329,24 @@ TrainConfig TrainConfig::shortRunSchedule(const std::vector<std::string>& given,
   set("opacity_reset_interval", c.opacity_reset_interval,
       std::max(iterations, opacity_reset_interval));
   set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
+  return c;
+}
+
+TrainConfig TrainConfig::longSchedule(const std::vector<std::string>& given,
+                                      std::vector<std::string>* changed) const {
+  TrainConfig c = *this;
+  const auto set = [&](const char* key, int& member, int value) {
+    if (std::find(given.begin(), given.end(), key) != given.end() || member == value) return;
+    if (changed) changed->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
+                                    std::to_string(value));
+    member = value;
+  };
+  set("iterations", c.iterations, 30000);
+  if (c.drop != "none") {
+    const int densify_end = c.densify_until < 0 ? c.iterations / 2 : c.densify_until;
+    set("lambda_l0_from", c.lambda_l0_from, densify_end);
+    set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
+  }
   return c;
 }
 

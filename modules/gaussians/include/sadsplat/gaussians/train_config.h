@@ -80,6 +80,12 @@ struct TrainConfig {
   /// huge without removing what it covers. 0 = off.
   double large_split_scale = 0.0;
   int large_split_last = 500;
+  /// Not 3DGS: no Gaussian's scale (standard deviation along any axis) exceeds scale_limit x
+  /// the scene extent. The log-scales are clamped after every optimiser step (a projection onto
+  /// the bound), so the large, blurry Gaussians that the floater census counts (larger than
+  /// 0.1 x the extent) do not form; smaller ones densify into what they would have covered.
+  /// 0 = off.
+  double scale_limit = 0.0;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
   // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
@@ -145,6 +151,17 @@ struct TrainConfig {
   /// \param[out] changed if not null, "key default -> value" for each key it changed
   TrainConfig shortRunSchedule(const std::vector<std::string>& given,
                                std::vector<std::string>* changed = nullptr) const;
+
+  /// \brief The long schedule (`sadsplat train --schedule long`, not the paper), for users who
+  /// want the smallest model: 30000 iterations (densification until half of them, as 3DGS);
+  /// with a drop, the gates are pushed shut only after the densification (lambda_l0_from =
+  /// iterations / 2) and the last iterations / 6 refine the model without gates
+  /// (recovery_iterations): prune late, then refine, as the pruning work that reaches >= 10x
+  /// does. Each key only where it is not in `given` (keys the user set; a given `iterations`
+  /// sets the length the others follow).
+  /// \param[out] changed if not null, "key default -> value" for each key it changed
+  TrainConfig longSchedule(const std::vector<std::string>& given,
+                           std::vector<std::string>* changed = nullptr) const;
 
   /// \brief Checks every option against its range in the option table (train_options.h) and
   /// the rules between options (recovery_iterations below iterations).
