@@ -53,8 +53,10 @@ class DefaultDensification : public DensificationStrategy {
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
     const TrainConfig& c = config_;
-    if (c.scale_limit > 0) {  // a projection onto the bound: Adam's moments stay as they are
-      params["scales"].value.clamp_max_(std::log(c.scale_limit * extent_));
+    if (c.scale_limit > 0) {
+      // A projection onto the bound (Adam's moments stay as they are). 1e-6 below it, so that
+      // exp() of the float log-scale never rounds above the bound (it did by 6e-8 of it).
+      params["scales"].value.clamp_max_(std::log(c.scale_limit * extent_) - 1e-6);
     }
     if (done > c.densify_until) {
       // Not 3DGS: after densification, Gaussians that grew beyond large_split_scale x the extent
