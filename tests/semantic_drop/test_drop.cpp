@@ -320,6 +320,33 @@ TEST(DropStrategy, ACappedEventRemovesTheHighestDropProbabilitiesFirst) {
   EXPECT_GE(removed_p.min().item<float>(), spared_p.max().item<float>());
 }
 
+// Late pruning under the balanced rule: no drop event before lambda_l0_from, events after it; the
+// paper's rule drops from the start whatever lambda_l0_from says.
+TEST(DropStrategy, TheBalancedRuleHasNoDropEventBeforeTheL0ForceStarts) {
+  const io::Scene scene =
+      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
+  const auto firstDrop = [&](const std::string& rule) {
+    gaussians::TrainConfig c;
+    c.iterations = 120;
+    c.feature_dim = 8;
+    c.densify_from = 100000;
+    c.checkpoint_interval = 0;
+    c.drop = "full";
+    c.drop_rule = rule;
+    c.drop_interval = 20;
+    c.lambda_l0_from = 70;
+    c.log_alpha_init = 0.0;  // P_learned = 0.17: every event removes some
+    gaussians::Trainer trainer(scene, c);
+    trainer.setDropStrategy(makeDropStrategy(c));
+    for (int i = 0; i < c.iterations; ++i) {
+      if (trainer.step().dropped > 0) return trainer.iteration();
+    }
+    return -1;
+  };
+  EXPECT_EQ(firstDrop("balanced"), 80);  // the first event at or after iteration 70
+  EXPECT_EQ(firstDrop("paper"), 20);
+}
+
 struct CollapseRun {
   std::int64_t gaussians = 0;
   double psnr = 0;  // mean over every view of the scene, rendered as evaluation renders

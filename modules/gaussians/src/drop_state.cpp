@@ -82,6 +82,7 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
 
 void DropState::observeRgbLoss(int done, double rgb_loss) {
   if (!drop_ || !balanced() || config_.drop_guard <= 0 || !std::isfinite(rgb_loss)) return;
+  if (done < config_.lambda_l0_from) return;  // no drop events before (dropIfDue)
   // Readings in the second half of each drop interval: the level the model has settled to.
   const int interval = config_.drop_interval;
   if (interval <= 0 || done % interval <= interval / 2) return;
@@ -107,6 +108,10 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
                                   std::int64_t* dropped) {
   DropDecision decision;
   if (!drop_->dropNow(done)) return decision;
+  // The balanced rule prunes late when asked: no drop event (and no guard reading) before the L0
+  // force starts, so that densification, opacity resets and the semantic factor alone remove
+  // nothing before it (the paper's rule drops from the start).
+  if (balanced() && done < config_.lambda_l0_from) return decision;
   DropInputs in;
   if (balanced()) {
     if (config_.drop_guard > 0 && guard_[3] > 0) {

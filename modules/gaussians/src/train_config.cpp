@@ -189,7 +189,8 @@ const std::vector<TrainOption> kOptions = {
      kInf},
     {"lambda_l0", &C::lambda_l0, "weight of the L0 sparsity loss", "--lambda-l0", 0, kInf},
     {"lambda_l0_from", &C::lambda_l0_from,
-     "the L0 loss starts at this iteration (not the paper; 0: from the start)",
+     "the L0 loss starts at this iteration; balanced rule: its first drop event too (not the paper; "
+     "0: from the start)",
      "--lambda-l0-from", 0, kInf},
     {"lambda_l0_ramp", &C::lambda_l0_ramp,
      "the L0 weight rises linearly over this many iterations (0: at once)", "--lambda-l0-ramp",

@@ -99,7 +99,8 @@ struct TrainConfig {
   /// Not the paper: the L0 weight is 0 before iteration lambda_l0_from and then rises linearly
   /// to lambda_l0 over lambda_l0_ramp iterations (semantic_drop::scheduledL0Weight), so that the
   /// gates learn with the full, densified set before they are pushed shut. 0 / 0 = the paper's
-  /// constant weight.
+  /// constant weight. Under the balanced rule the same holds for its L0 force, and there is no
+  /// drop event before lambda_l0_from either (late pruning).
   int lambda_l0_from = 0;
   int lambda_l0_ramp = 0;
   /// Not the paper: exponent gamma of a per-Gaussian weight on the L0 term, so that the
