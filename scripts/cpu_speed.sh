@@ -52,7 +52,10 @@ if [ -n "${OPENSPLAT_SRC:-}" ]; then
     cmake --build "$out/opensplat-build" --target opensplat > "$out/opensplat-build.log" 2>&1 ||
       { tail -20 "$out/opensplat-build.log"; exit 1; }
   fi
-  echo "OpenSplat $(git -C "$src" describe --always --tags 2>/dev/null || echo "(not a git checkout)"), $(cat "$src/VERSION" 2>/dev/null)"
+  # Only the checkout's own commit: a copy inside another repository has none.
+  commit="(not a git checkout)"
+  [ -e "$src/.git" ] && commit=$(git -C "$src" describe --always --tags 2>/dev/null)
+  echo "OpenSplat $commit, $(cat "$src/VERSION" 2>/dev/null)"
 fi
 
 seconds() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", b - a }'; }
