@@ -207,9 +207,9 @@ TEST(Cli, TheLongScheduleSetsItsKeysAndKeepsGivenOnes) {
   EXPECT_NE(config.find("\"lambda_l0_from\": 12"), std::string::npos) << config;
   EXPECT_NE(config.find("\"recovery_iterations\": 4"), std::string::npos) << config;
   EXPECT_NE(config.find("\"iterations\": 24"), std::string::npos) << config;
-  EXPECT_EQ(test::runCommand(kCli + " train " + cache + " --schedule short --out " + dir.file("x"),
-                             &out),
-            2)
+  EXPECT_EQ(
+      test::runCommand(kCli + " train " + cache + " --schedule short --out " + dir.file("x"), &out),
+      2)
       << out;
 }
 
