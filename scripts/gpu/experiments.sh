@@ -15,7 +15,9 @@
 #       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
-#       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs)
+#       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
+#       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
+#       summary says at which iteration it stopped)
 #
 # RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
 #   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set
@@ -265,8 +267,16 @@ mode_scene() {
         --out "$work/run_$name" $flags > "$work/results/train_$name.log" 2>&1 &&
         "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" &&
         { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho \
-            > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } ||
+            > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } || {
         echo "$name: stopped (rc $?)"
+        # A training stopped at the deadline leaves its checkpoint: evaluate the model as it was
+        # (metrics.json says at which iteration), so that a run too long for the call still says
+        # where it got to.
+        if [ -f "$work/run_$name/checkpoint.bin" ] && [ ! -s "$work/results/metrics_$name.json" ]; then
+          timeout 60 "$bin" eval "$work/run_$name" > "$work/results/partial_$name.json" \
+            2>> "$work/results/eval_$name.log"
+        fi
+      }
     ) &
   done
   wait
@@ -276,6 +286,12 @@ mode_scene() {
     local name="${spec%%:*}"
     f="$work/results/metrics_$name.json"
     [ -s "$f" ] && metrics_line "$name" "$f" >> "$summary"
+    f="$work/results/partial_$name.json"
+    if [ -s "$f" ]; then
+      local stopped_at
+      stopped_at=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["iterations"])' "$f")
+      metrics_line "$name (stopped at iteration $stopped_at)" "$f" >> "$summary"
+    fi
     f="$work/results/ortho_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
     echo "    flags: ${spec#*:}; $(train_summary "$work/results/train_$name.log"); drops: $(tr '\r' '\n' < "$work/results/train_$name.log" | grep -c '^\[drop\]')" >> "$summary"
