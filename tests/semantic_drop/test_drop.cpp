@@ -22,6 +22,24 @@ namespace {
 
 using namespace semantic_drop;
 
+// The fixture scene the training tests below drop on.
+io::Scene tinyScene() {
+  return io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
+}
+
+// A short training on the tiny scene with a drop every `drop_interval` iterations; no
+// densification, no checkpoints.
+gaussians::TrainConfig tinyDropConfig(int iterations, const std::string& drop, int drop_interval) {
+  gaussians::TrainConfig c;
+  c.iterations = iterations;
+  c.feature_dim = 8;
+  c.densify_from = 100000;
+  c.checkpoint_interval = 0;
+  c.drop = drop;
+  c.drop_interval = drop_interval;
+  return c;
+}
+
 TEST(HardConcrete, EmpiricalNonZeroProbabilityMatchesTheClosedForm) {
   at::manual_seed(11);
   for (double la : {-2.0, -0.5, 0.0, 1.5}) {
@@ -153,15 +171,8 @@ TEST(DropStrategy, DecisionCountsTheReasonsOfTheRemovals) {
 }
 
 TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
-  const io::Scene scene =
-      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
-  gaussians::TrainConfig c;
-  c.iterations = 100;
-  c.feature_dim = 8;
-  c.densify_from = 100000;
-  c.checkpoint_interval = 0;
-  c.drop = "full";
-  c.drop_interval = 25;
+  const io::Scene scene = tinyScene();
+  gaussians::TrainConfig c = tinyDropConfig(100, "full", 25);
   c.log_alpha_init = 0.0;  // P_learned = 0.17: visible drops within 100 iterations
   gaussians::Trainer trainer(scene, c);
   trainer.setDropStrategy(makeDropStrategy(c));
@@ -323,17 +334,10 @@ TEST(DropStrategy, ACappedEventRemovesTheHighestDropProbabilitiesFirst) {
 // Late pruning under the balanced rule: no drop event before lambda_l0_from, events after it; the
 // paper's rule drops from the start whatever lambda_l0_from says.
 TEST(DropStrategy, TheBalancedRuleHasNoDropEventBeforeTheL0ForceStarts) {
-  const io::Scene scene =
-      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
+  const io::Scene scene = tinyScene();
   const auto firstDrop = [&](const std::string& rule) {
-    gaussians::TrainConfig c;
-    c.iterations = 120;
-    c.feature_dim = 8;
-    c.densify_from = 100000;
-    c.checkpoint_interval = 0;
-    c.drop = "full";
+    gaussians::TrainConfig c = tinyDropConfig(120, "full", 20);
     c.drop_rule = rule;
-    c.drop_interval = 20;
     c.lambda_l0_from = 70;
     c.log_alpha_init = 0.0;  // P_learned = 0.17: every event removes some
     gaussians::Trainer trainer(scene, c);
@@ -355,16 +359,9 @@ struct CollapseRun {
 // The tiny scene with the drop's pressure far past what it can bear (lambda_l0 = 5, gates that
 // learn fast, drops every 25 iterations): the regime in which the paper's rule empties a model.
 CollapseRun trainUnderPressure(const std::string& drop, const std::string& rule) {
-  const io::Scene scene =
-      io::readSceneCache(std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache");
-  gaussians::TrainConfig c;
-  c.iterations = 200;
-  c.feature_dim = 8;
-  c.densify_from = 100000;
-  c.checkpoint_interval = 0;
-  c.drop = drop;
+  const io::Scene scene = tinyScene();
+  gaussians::TrainConfig c = tinyDropConfig(200, drop, 25);
   c.drop_rule = rule;
-  c.drop_interval = 25;
   c.lambda_l0 = 5.0;
   c.lr_log_alpha = 0.1;
   gaussians::Trainer trainer(scene, c);
