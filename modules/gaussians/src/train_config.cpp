@@ -311,42 +311,53 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
   setFromJson(option, value, config, origin);
 }
 
+namespace {
+
+// A schedule's change of one key: `member` becomes `value` unless the user gave `key`; each
+// change is noted in `changed` (if not null) as "key old -> new".
+class ScheduleKeys {
+ public:
+  ScheduleKeys(const std::vector<std::string>& given, std::vector<std::string>* changed)
+      : given_(given), changed_(changed) {}
+  void set(const char* key, int& member, int value) const {
+    if (std::find(given_.begin(), given_.end(), key) != given_.end() || member == value) return;
+    if (changed_) {
+      changed_->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
+                          std::to_string(value));
+    }
+    member = value;
+  }
+
+ private:
+  const std::vector<std::string>& given_;
+  std::vector<std::string>* changed_;
+};
+
+}  // namespace
+
 TrainConfig TrainConfig::shortRunSchedule(const std::vector<std::string>& given,
                                           std::vector<std::string>* changed) const {
   TrainConfig c = *this;
   if (iterations >= 7000) return c;
-  const auto free = [&](const char* key) {
-    return std::find(given.begin(), given.end(), key) == given.end();
-  };
-  const auto set = [&](const char* key, int& member, int value) {
-    if (!free(key) || member == value) return;
-    if (changed) changed->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
-                                    std::to_string(value));
-    member = value;
-  };
-  set("sh_increase_interval", c.sh_increase_interval,
-      std::min(sh_increase_interval, std::max(1, iterations / 4)));
-  set("densify_from", c.densify_from, std::min(densify_from, iterations / 10));
-  set("opacity_reset_interval", c.opacity_reset_interval,
-      std::max(iterations, opacity_reset_interval));
-  set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
+  const ScheduleKeys keys(given, changed);
+  keys.set("sh_increase_interval", c.sh_increase_interval,
+           std::min(sh_increase_interval, std::max(1, iterations / 4)));
+  keys.set("densify_from", c.densify_from, std::min(densify_from, iterations / 10));
+  keys.set("opacity_reset_interval", c.opacity_reset_interval,
+           std::max(iterations, opacity_reset_interval));
+  keys.set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
   return c;
 }
 
 TrainConfig TrainConfig::longSchedule(const std::vector<std::string>& given,
                                       std::vector<std::string>* changed) const {
   TrainConfig c = *this;
-  const auto set = [&](const char* key, int& member, int value) {
-    if (std::find(given.begin(), given.end(), key) != given.end() || member == value) return;
-    if (changed) changed->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
-                                    std::to_string(value));
-    member = value;
-  };
-  set("iterations", c.iterations, 30000);
+  const ScheduleKeys keys(given, changed);
+  keys.set("iterations", c.iterations, 30000);
   if (c.drop != "none") {
     const int densify_end = c.densify_until < 0 ? c.iterations / 2 : c.densify_until;
-    set("lambda_l0_from", c.lambda_l0_from, densify_end);
-    set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
+    keys.set("lambda_l0_from", c.lambda_l0_from, densify_end);
+    keys.set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
   }
   return c;
 }
