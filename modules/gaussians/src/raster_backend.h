@@ -59,14 +59,19 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
                                    const at::Tensor& log_scales, const at::Tensor& radii,
                                    const CameraParams& cam, const at::Tensor& g_means2d,
                                    const at::Tensor& g_conics, const at::Tensor& g_depths);
+/// The CPU rasterizer's tile loops: kFastest takes the vectorised form for float where the build
+/// has one (raster_cpu_tiles.h; bit-identical results), kScalar always the scalar reference.
+enum class CpuTileLoops { kFastest, kScalar };
+
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,
                                  const at::Tensor& radii, const at::Tensor& depths, int width,
-                                 int height);
+                                 int height, CpuTileLoops loops = CpuTileLoops::kFastest);
 RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,
                                  const RasterResult& forward, const at::Tensor& g_image,
-                                 const at::Tensor& g_alpha);
+                                 const at::Tensor& g_alpha,
+                                 CpuTileLoops loops = CpuTileLoops::kFastest);
 
 // The CUDA backend takes the stream to run on (a cudaStream_t, as void* so that this header
 // needs no CUDA) and expects the tensors' device to be current: the caller, which links LibTorch's

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <type_traits>
 #include <vector>
 
 #include "raster_backend.h"
+#include "raster_cpu_tiles.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
 
@@ -185,133 +187,59 @@ std::vector<T> skipThresholds(const T* opacities, int64_t n) {
   return thresholds;
 }
 
-// Calls visit(px, py) for every pixel of tile (tx, ty) inside the image, row by row.
-template <typename Visit>
-inline void forEachTilePixel(int tx, int ty, int width, int height, Visit&& visit) {
-  const int y_end = std::min(height, (ty + 1) * kTileSize);
-  const int x_end = std::min(width, (tx + 1) * kTileSize);
-  for (int py = ty * kTileSize; py < y_end; ++py) {
-    for (int px = tx * kTileSize; px < x_end; ++px) visit(px, py);
-  }
-}
+using cpu_tiles::TileList;
 
-// One Gaussian of a tile's list, gathered: what a pixel needs to decide on it and blend it.
+// One tile of the forward pass with the loops `loops` asks for. accum: kTileSize * D values.
 template <typename T>
-struct PackedGaussian {
-  T mean2d[2];
-  T conic[3];
-  T opacity;
-  T skip;  // skipThresholds
-};
-
-// A tile's Gaussians copied front to back into contiguous arrays (values as [L, D]): every pixel
-// of the tile walks the same list, so gathering it once per tile turns 256 indirect, scattered
-// reads per Gaussian into one. The arithmetic per pixel is unchanged.
-template <typename T>
-struct TileList {
-  std::vector<PackedGaussian<T>> gaussians;
-  std::vector<T> values;
-  const int* ids = nullptr;  // into the binning's gaussian_ids
-
-  int size() const { return static_cast<int>(gaussians.size()); }
-
-  void gather(const int* tile_ids, int count, const T* means2d, const T* conics, const T* opacities,
-              const T* skip, const T* all_values, int64_t D) {
-    ids = tile_ids;
-    gaussians.resize(static_cast<std::size_t>(count));
-    values.resize(static_cast<std::size_t>(count * D));
-    for (int j = 0; j < count; ++j) {
-      const int g = tile_ids[j];
-      PackedGaussian<T>& p = gaussians[j];
-      p.mean2d[0] = means2d[2 * g];
-      p.mean2d[1] = means2d[2 * g + 1];
-      for (int k = 0; k < 3; ++k) p.conic[k] = conics[3 * g + k];
-      p.opacity = opacities[g];
-      p.skip = skip[g];
-      std::copy(all_values + g * D, all_values + (g + 1) * D, values.begin() + j * D);
-    }
-  }
-};
-
-// Blends one tile of the forward pass. kD > 0: the channel count as a compile-time constant (the
-// RGB-only renders); 0: `dynamic_d` channels.
-template <int kD, typename T>
-void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
-                 T* accum, T* img, T* alpha_out, int* last_out) {
-  const int64_t D = kD > 0 ? kD : dynamic_d;
-  const PackedGaussian<T>* pg = list.gaussians.data();
-  const T* val = list.values.data();
-  const int count = list.size();
-  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
-    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-    std::fill(accum, accum + D, T(0));
-    T trans = T(1);
-    int last = 0;
-    for (int j = 0; j < count; ++j) {
-      const PackedGaussian<T>& p = pg[j];
-      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-      T G;
-      bool clamped;
-      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-      if (alpha == T(0)) continue;
-      const T next = trans * (T(1) - alpha);
-      if (next < T(kMinTransmittance)) break;
-      const T w = alpha * trans;
-      const T* v = val + j * D;
-      for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
-      trans = next;
-      last = j + 1;
-    }
-    const int64_t pix = static_cast<int64_t>(py) * width + px;
-    std::copy(accum, accum + D, img + pix * D);
-    alpha_out[pix] = T(1) - trans;
-    last_out[pix] = last;
-  });
-}
-
-// The backward of one tile: gradients of the tile's Gaussians, in list order, into `grads`
-// ([L, 6 + D]: mean2d, conic, opacity, values), which the caller has zeroed.
-template <int kD, typename T>
-void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
-                  const T* gimg, const T* galpha, const T* alpha_fwd, const int* last_fwd, T* accum,
-                  T* last_value, T* grads) {
-  const int64_t D = kD > 0 ? kD : dynamic_d;
-  const int64_t row = 6 + D;
-  const PackedGaussian<T>* pg = list.gaussians.data();
-  const T* val = list.values.data();
-  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
-    const int64_t pix = static_cast<int64_t>(py) * width + px;
-    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
-    const T final_trans = T(1) - alpha_fwd[pix];
-    const T* gpix = gimg + pix * D;
-    T trans = final_trans;
-    std::fill(accum, accum + D, T(0));
-    std::fill(last_value, last_value + D, T(0));
-    T last_alpha = T(0);
-    for (int j = last_fwd[pix] - 1; j >= 0; --j) {
-      const PackedGaussian<T>& p = pg[j];
-      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-      T G;
-      bool clamped;
-      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-      if (alpha == T(0)) continue;
-      trans = trans / (T(1) - alpha);
-      const T w = alpha * trans;
-      T* gb = grads + j * row;
-      const T* v = val + j * D;
-      T g_a = T(0);
-      for (int64_t ch = 0; ch < D; ++ch) {
-        accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
-        last_value[ch] = v[ch];
-        g_a += (v[ch] - accum[ch]) * gpix[ch];
-        gb[6 + ch] += w * gpix[ch];
+void forwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int width, int height,
+                    CpuTileLoops loops, T* accum, T* img, T* alpha_out, int* last_out) {
+#if SADSPLAT_CPU_RASTER_SIMD
+  if constexpr (std::is_same_v<T, float>) {
+    if (loops == CpuTileLoops::kFastest) {
+      if (D == 3) {
+        cpu_tiles::forwardTileRows<3>(list, D, tx, ty, width, height, accum, img, alpha_out,
+                                      last_out);
+      } else {
+        cpu_tiles::forwardTileRows<0>(list, D, tx, ty, width, height, accum, img, alpha_out,
+                                      last_out);
       }
-      g_a *= trans;
-      g_a += galpha[pix] * final_trans / (T(1) - alpha);
-      last_alpha = alpha;
-      pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
+      return;
     }
-  });
+  }
+#endif
+  if (D == 3) {
+    cpu_tiles::forwardTile<3>(list, D, tx, ty, width, height, accum, img, alpha_out, last_out);
+  } else {
+    cpu_tiles::forwardTile<0>(list, D, tx, ty, width, height, accum, img, alpha_out, last_out);
+  }
+}
+
+// One tile of the backward pass (see forwardOneTile). accum, last_value: kTileSize * D values.
+template <typename T>
+void backwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int width, int height,
+                     CpuTileLoops loops, const T* gimg, const T* galpha, const T* alpha_fwd,
+                     const int* last_fwd, T* accum, T* last_value, T* grads) {
+#if SADSPLAT_CPU_RASTER_SIMD
+  if constexpr (std::is_same_v<T, float>) {
+    if (loops == CpuTileLoops::kFastest) {
+      if (D == 3) {
+        cpu_tiles::backwardTileRows<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
+                                       last_fwd, accum, last_value, grads);
+      } else {
+        cpu_tiles::backwardTileRows<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
+                                       last_fwd, accum, last_value, grads);
+      }
+      return;
+    }
+  }
+#endif
+  if (D == 3) {
+    cpu_tiles::backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
+                               accum, last_value, grads);
+  } else {
+    cpu_tiles::backwardTile<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
+                               accum, last_value, grads);
+  }
 }
 
 }  // namespace
@@ -319,7 +247,7 @@ void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, in
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,
                                  const at::Tensor& radii, const at::Tensor& depths, int width,
-                                 int height) {
+                                 int height, CpuTileLoops loops) {
   const int64_t n = means2d.size(0);
   const int64_t D = values.size(1);
   RasterResult out;
@@ -343,17 +271,14 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const int tiles_x = tileGrid(width, height).first;
     const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
-      std::vector<T> accum(static_cast<std::size_t>(D));
+      std::vector<T> accum(static_cast<std::size_t>(kTileSize * D));
       TileList<T> list;
       for (int64_t tile = begin; tile < end; ++tile) {
         const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
         list.gather(ids + start, stop - start, m2, co, op, skip.data(), val, D);
-        if (D == 3) {
-          forwardTile<3>(list, D, tx, ty, width, height, accum.data(), img, alpha_out, last_out);
-        } else {
-          forwardTile<0>(list, D, tx, ty, width, height, accum.data(), img, alpha_out, last_out);
-        }
+        forwardOneTile(list, D, tx, ty, width, height, loops, accum.data(), img, alpha_out,
+                       last_out);
       }
     });
   });
@@ -363,7 +288,7 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
 RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,
                                  const RasterResult& fwd, const at::Tensor& g_image,
-                                 const at::Tensor& g_alpha) {
+                                 const at::Tensor& g_alpha, CpuTileLoops loops) {
   const int64_t n = means2d.size(0);
   const int64_t D = values.size(1);
   const int height = static_cast<int>(fwd.alpha.size(0));
@@ -392,7 +317,8 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
     at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
       T* buf = buf_base + static_cast<int64_t>(at::get_thread_num()) * n * row;
-      std::vector<T> accum(static_cast<std::size_t>(D)), last_value(static_cast<std::size_t>(D));
+      std::vector<T> accum(static_cast<std::size_t>(kTileSize * D));
+      std::vector<T> last_value(accum.size());
       std::vector<T> grads;
       TileList<T> list;
       for (int64_t tile = begin; tile < end; ++tile) {
@@ -400,19 +326,14 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
         // Only the Gaussians up to the tile's last contributor have gradients.
         int used = 0;
-        forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+        cpu_tiles::forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
           used = std::max(used, last_fwd[static_cast<int64_t>(py) * width + px]);
         });
         if (used == 0) continue;
         list.gather(ids + start, std::min(used, stop - start), m2, co, op, skip.data(), val, D);
         grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
-        if (D == 3) {
-          backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
-                          accum.data(), last_value.data(), grads.data());
-        } else {
-          backwardTile<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
-                          accum.data(), last_value.data(), grads.data());
-        }
+        backwardOneTile(list, D, tx, ty, width, height, loops, gimg, galpha, alpha_fwd, last_fwd,
+                        accum.data(), last_value.data(), grads.data());
         for (int j = 0; j < list.size(); ++j) {
           T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
           const T* gt = grads.data() + j * row;

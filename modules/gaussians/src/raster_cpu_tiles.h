@@ -1,0 +1,320 @@
+#pragma once
+// The CPU rasterizer's per-tile loops (raster_cpu.cpp runs them over the tiles): the scalar
+// reference, for any scalar type, and for float a vectorised form that tests a Gaussian's skip
+// threshold at one tile row's 16 pixels at once with SSE2 (x86-64's baseline). Most
+// (pixel, Gaussian) pairs of a tile's list are skipped (~92 % on the demo city at 160x90); the
+// vectorised form does the pairs that are not with the scalar code, pixel by pixel in the same
+// order, so its images and gradients are bit-identical to the scalar form's
+// (test_raster_cpu_paths.cpp).
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#define SADSPLAT_CPU_RASTER_SIMD 1
+#else
+#define SADSPLAT_CPU_RASTER_SIMD 0
+#endif
+
+#include "sadsplat/gaussians/raster_math.h"
+
+namespace sadsplat {
+namespace gaussians {
+namespace raster {
+namespace cpu_tiles {
+
+// Calls visit(px, py) for every pixel of tile (tx, ty) inside the image, row by row.
+template <typename Visit>
+inline void forEachTilePixel(int tx, int ty, int width, int height, Visit&& visit) {
+  const int y_end = std::min(height, (ty + 1) * kTileSize);
+  const int x_end = std::min(width, (tx + 1) * kTileSize);
+  for (int py = ty * kTileSize; py < y_end; ++py) {
+    for (int px = tx * kTileSize; px < x_end; ++px) visit(px, py);
+  }
+}
+
+// One Gaussian of a tile's list, gathered: what a pixel needs to decide on it and blend it.
+template <typename T>
+struct PackedGaussian {
+  T mean2d[2];
+  T conic[3];
+  T opacity;
+  T skip;  // skipThresholds
+};
+
+// A tile's Gaussians copied front to back into contiguous arrays (values as [L, D]): every pixel
+// of the tile walks the same list, so gathering it once per tile turns 256 indirect, scattered
+// reads per Gaussian into one. The arithmetic per pixel is unchanged.
+template <typename T>
+struct TileList {
+  std::vector<PackedGaussian<T>> gaussians;
+  std::vector<T> values;
+  const int* ids = nullptr;  // into the binning's gaussian_ids
+
+  int size() const { return static_cast<int>(gaussians.size()); }
+
+  void gather(const int* tile_ids, int count, const T* means2d, const T* conics, const T* opacities,
+              const T* skip, const T* all_values, int64_t D) {
+    ids = tile_ids;
+    gaussians.resize(static_cast<std::size_t>(count));
+    values.resize(static_cast<std::size_t>(count * D));
+    for (int j = 0; j < count; ++j) {
+      const int g = tile_ids[j];
+      PackedGaussian<T>& p = gaussians[j];
+      p.mean2d[0] = means2d[2 * g];
+      p.mean2d[1] = means2d[2 * g + 1];
+      for (int k = 0; k < 3; ++k) p.conic[k] = conics[3 * g + k];
+      p.opacity = opacities[g];
+      p.skip = skip[g];
+      std::copy(all_values + g * D, all_values + (g + 1) * D, values.begin() + j * D);
+    }
+  }
+};
+
+// Blends one tile of the forward pass. kD > 0: the channel count as a compile-time constant (the
+// RGB-only renders); 0: `dynamic_d` channels.
+template <int kD, typename T>
+void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
+                 T* accum, T* img, T* alpha_out, int* last_out) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const PackedGaussian<T>* pg = list.gaussians.data();
+  const T* val = list.values.data();
+  const int count = list.size();
+  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+    std::fill(accum, accum + D, T(0));
+    T trans = T(1);
+    int last = 0;
+    for (int j = 0; j < count; ++j) {
+      const PackedGaussian<T>& p = pg[j];
+      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+      T G;
+      bool clamped;
+      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+      if (alpha == T(0)) continue;
+      const T next = trans * (T(1) - alpha);
+      if (next < T(kMinTransmittance)) break;
+      const T w = alpha * trans;
+      const T* v = val + j * D;
+      for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
+      trans = next;
+      last = j + 1;
+    }
+    const int64_t pix = static_cast<int64_t>(py) * width + px;
+    std::copy(accum, accum + D, img + pix * D);
+    alpha_out[pix] = T(1) - trans;
+    last_out[pix] = last;
+  });
+}
+
+// The backward of one tile: gradients of the tile's Gaussians, in list order, into `grads`
+// ([L, 6 + D]: mean2d, conic, opacity, values), which the caller has zeroed.
+template <int kD, typename T>
+void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
+                  const T* gimg, const T* galpha, const T* alpha_fwd, const int* last_fwd, T* accum,
+                  T* last_value, T* grads) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const int64_t row = 6 + D;
+  const PackedGaussian<T>* pg = list.gaussians.data();
+  const T* val = list.values.data();
+  forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
+    const int64_t pix = static_cast<int64_t>(py) * width + px;
+    const T fx = T(px) + T(0.5), fy = T(py) + T(0.5);
+    const T final_trans = T(1) - alpha_fwd[pix];
+    const T* gpix = gimg + pix * D;
+    T trans = final_trans;
+    std::fill(accum, accum + D, T(0));
+    std::fill(last_value, last_value + D, T(0));
+    T last_alpha = T(0);
+    for (int j = last_fwd[pix] - 1; j >= 0; --j) {
+      const PackedGaussian<T>& p = pg[j];
+      if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
+      T G;
+      bool clamped;
+      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+      if (alpha == T(0)) continue;
+      trans = trans / (T(1) - alpha);
+      const T w = alpha * trans;
+      T* gb = grads + j * row;
+      const T* v = val + j * D;
+      T g_a = T(0);
+      for (int64_t ch = 0; ch < D; ++ch) {
+        accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
+        last_value[ch] = v[ch];
+        g_a += (v[ch] - accum[ch]) * gpix[ch];
+        gb[6 + ch] += w * gpix[ch];
+      }
+      g_a *= trans;
+      g_a += galpha[pix] * final_trans / (T(1) - alpha);
+      last_alpha = alpha;
+      pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
+    }
+  });
+}
+
+#if SADSPLAT_CPU_RASTER_SIMD
+
+// One tile row's pixel centres along x, as four 4-lane vectors (lane l: pixel x0 + l).
+struct RowLanes {
+  __m128 fx[4];
+  unsigned valid;  // bit l: pixel x0 + l lies inside the image
+
+  RowLanes(int x0, int width) {
+    for (int q = 0; q < 4; ++q) {
+      const int x = x0 + 4 * q;
+      fx[q] = _mm_setr_ps(float(x) + 0.5f, float(x + 1) + 0.5f, float(x + 2) + 0.5f,
+                          float(x + 3) + 0.5f);
+    }
+    const int lanes = std::min(width - x0, kTileSize);
+    valid = lanes >= 32 ? ~0u : (1u << lanes) - 1u;
+  }
+};
+
+// Bit l set where pixel lane l does not skip Gaussian p: the negation of the scalar test
+// `gaussianPower(...) < p.skip` (a NaN power is not skipped there either), computed with the same
+// float operations in the same order (no FMA on x86-64's baseline), so the bits agree exactly.
+inline unsigned notSkipped(const PackedGaussian<float>& p, const RowLanes& row, float fy) {
+  const float dy = p.mean2d[1] - fy;
+  const __m128 c0 = _mm_set1_ps(p.conic[0]), c1 = _mm_set1_ps(p.conic[1]);
+  const __m128 dy_term = _mm_set1_ps(p.conic[2] * dy * dy), vdy = _mm_set1_ps(dy);
+  const __m128 mx = _mm_set1_ps(p.mean2d[0]), half = _mm_set1_ps(-0.5f);
+  const __m128 skip = _mm_set1_ps(p.skip);
+  unsigned bits = 0;
+  for (int q = 0; q < 4; ++q) {
+    const __m128 dx = _mm_sub_ps(mx, row.fx[q]);
+    const __m128 sum = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(c0, dx), dx), dy_term);
+    const __m128 power = _mm_sub_ps(_mm_mul_ps(half, sum), _mm_mul_ps(_mm_mul_ps(c1, dx), vdy));
+    bits |= static_cast<unsigned>(_mm_movemask_ps(_mm_cmpnlt_ps(power, skip))) << (4 * q);
+  }
+  return bits;
+}
+
+// forwardTile for float, a tile row at a time: per Gaussian one vectorised skip test for the
+// row's 16 pixels, then forwardTile's per-pixel arithmetic for the pixels that do not skip it.
+// `accum`: kTileSize * D floats.
+template <int kD>
+void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int ty, int width,
+                     int height, float* accum, float* img, float* alpha_out, int* last_out) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const PackedGaussian<float>* pg = list.gaussians.data();
+  const float* val = list.values.data();
+  const int count = list.size();
+  const int x0 = tx * kTileSize;
+  const RowLanes row(x0, width);
+  const int lanes = std::min(width - x0, kTileSize);
+  const int y_end = std::min(height, (ty + 1) * kTileSize);
+  float trans[kTileSize];
+  int last[kTileSize];
+  for (int py = ty * kTileSize; py < y_end; ++py) {
+    const float fy = float(py) + 0.5f;
+    std::fill(accum, accum + kTileSize * D, 0.f);
+    std::fill(trans, trans + kTileSize, 1.f);
+    std::fill(last, last + kTileSize, 0);
+    unsigned active = row.valid;
+    for (int j = 0; j < count && active != 0; ++j) {
+      const PackedGaussian<float>& p = pg[j];
+      for (unsigned bits = notSkipped(p, row, fy) & active; bits != 0; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        float G;
+        bool clamped;
+        const float alpha =
+            pixelAlpha(p.mean2d, p.conic, p.opacity, float(x0 + l) + 0.5f, fy, &G, &clamped);
+        if (alpha == 0.f) continue;
+        const float next = trans[l] * (1.f - alpha);
+        if (next < float(kMinTransmittance)) {
+          active &= ~(1u << l);
+          continue;
+        }
+        const float w = alpha * trans[l];
+        const float* v = val + j * D;
+        float* a = accum + l * D;
+        for (int64_t ch = 0; ch < D; ++ch) a[ch] += w * v[ch];
+        trans[l] = next;
+        last[l] = j + 1;
+      }
+    }
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t pix = static_cast<int64_t>(py) * width + x0 + l;
+      std::copy(accum + l * D, accum + (l + 1) * D, img + pix * D);
+      alpha_out[pix] = 1.f - trans[l];
+      last_out[pix] = last[l];
+    }
+  }
+}
+
+// backwardTile for float, a tile row at a time (see forwardTileRows). For each Gaussian the
+// row's pixels add their gradients in pixel order, rows in order: the same sequence of additions
+// to every gradient as backwardTile's pixel-by-pixel walk. `accum`, `last_value`: kTileSize * D.
+template <int kD>
+void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int ty, int width,
+                      int height, const float* gimg, const float* galpha, const float* alpha_fwd,
+                      const int* last_fwd, float* accum, float* last_value, float* grads) {
+  const int64_t D = kD > 0 ? kD : dynamic_d;
+  const int64_t grad_row = 6 + D;
+  const PackedGaussian<float>* pg = list.gaussians.data();
+  const float* val = list.values.data();
+  const int x0 = tx * kTileSize;
+  const RowLanes row(x0, width);
+  const int lanes = std::min(width - x0, kTileSize);
+  const int y_end = std::min(height, (ty + 1) * kTileSize);
+  float trans[kTileSize], final_trans[kTileSize], last_alpha[kTileSize], g_out[kTileSize];
+  int last[kTileSize];
+  for (int py = ty * kTileSize; py < y_end; ++py) {
+    const float fy = float(py) + 0.5f;
+    const int64_t pix0 = static_cast<int64_t>(py) * width + x0;
+    std::fill(accum, accum + kTileSize * D, 0.f);
+    std::fill(last_value, last_value + kTileSize * D, 0.f);
+    int end = 0;
+    for (int l = 0; l < kTileSize; ++l) {
+      const bool inside = l < lanes;
+      final_trans[l] = inside ? 1.f - alpha_fwd[pix0 + l] : 1.f;
+      trans[l] = final_trans[l];
+      last[l] = inside ? last_fwd[pix0 + l] : 0;
+      g_out[l] = inside ? galpha[pix0 + l] : 0.f;
+      last_alpha[l] = 0.f;
+      end = std::max(end, last[l]);
+    }
+    for (int j = end - 1; j >= 0; --j) {
+      // The pixels whose last contributor lies at or behind list position j.
+      unsigned live = 0;
+      for (int l = 0; l < lanes; ++l) live |= static_cast<unsigned>(last[l] > j) << l;
+      const PackedGaussian<float>& p = pg[j];
+      for (unsigned bits = notSkipped(p, row, fy) & live; bits != 0; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        float G;
+        bool clamped;
+        const float fx = float(x0 + l) + 0.5f;
+        const float alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+        if (alpha == 0.f) continue;
+        trans[l] = trans[l] / (1.f - alpha);
+        const float w = alpha * trans[l];
+        float* gb = grads + j * grad_row;
+        const float* v = val + j * D;
+        const float* gpix = gimg + (pix0 + l) * D;
+        float* a = accum + l * D;
+        float* lv = last_value + l * D;
+        float g_a = 0.f;
+        for (int64_t ch = 0; ch < D; ++ch) {
+          a[ch] = last_alpha[l] * lv[ch] + (1.f - last_alpha[l]) * a[ch];
+          lv[ch] = v[ch];
+          g_a += (v[ch] - a[ch]) * gpix[ch];
+          gb[6 + ch] += w * gpix[ch];
+        }
+        g_a *= trans[l];
+        g_a += g_out[l] * final_trans[l] / (1.f - alpha);
+        last_alpha[l] = alpha;
+        pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2,
+                           gb + 5);
+      }
+    }
+  }
+}
+
+#endif  // SADSPLAT_CPU_RASTER_SIMD
+
+}  // namespace cpu_tiles
+}  // namespace raster
+}  // namespace gaussians
+}  // namespace sadsplat
