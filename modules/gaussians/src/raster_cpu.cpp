@@ -4,6 +4,7 @@
 #include <ATen/Parallel.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -270,10 +271,14 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const std::vector<T> skip = skipThresholds(op, n);
     const int tiles_x = tileGrid(width, height).first;
     const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
-    at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
+    // Tiles are handed out one at a time (their lists differ in length many times over; a
+    // static split leaves one thread idle); every pixel is written once, so the result does not
+    // depend on which thread draws which tile.
+    std::atomic<int64_t> next_tile{0};
+    at::parallel_for(0, at::get_num_threads(), 1, [&](int64_t, int64_t) {
       std::vector<T> accum(static_cast<std::size_t>(kTileSize * D));
       TileList<T> list;
-      for (int64_t tile = begin; tile < end; ++tile) {
+      for (int64_t tile = next_tile++; tile < num_tiles; tile = next_tile++) {
         const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
         list.gather(ids + start, stop - start, m2, co, op, skip.data(), val, D);
@@ -294,7 +299,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
   const int height = static_cast<int>(fwd.alpha.size(0));
   const int width = static_cast<int>(fwd.alpha.size(1));
   // One gradient buffer per thread (tiles share Gaussians), summed at the end; each tile sums
-  // into its own list-ordered rows first and adds them to its thread's buffer once. Row layout:
+  // into its own list-ordered rows first and adds them to its buffer once. Row layout:
   // mean2d (2), conic (3), opacity (1), values (D).
   const int64_t row = 6 + D;
   const int threads = at::get_num_threads();
@@ -315,29 +320,53 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     const std::vector<T> skip = skipThresholds(op, n);
     const int tiles_x = tileGrid(width, height).first;
     const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
-    at::parallel_for(0, num_tiles, 1, [&](int64_t begin, int64_t end) {
-      T* buf = buf_base + static_cast<int64_t>(at::get_thread_num()) * n * row;
+    // Per tile: how far its pixels walk its list (the sum of their `last`: the backward's work,
+    // which differs many times over between tiles) and the furthest (entries behind every
+    // pixel's last contributor get no gradient).
+    std::vector<int64_t> work_before(static_cast<std::size_t>(num_tiles) + 1, 0);
+    std::vector<int> used(static_cast<std::size_t>(num_tiles), 0);
+    for (int tile = 0; tile < num_tiles; ++tile) {
+      int64_t walked = 0;
+      cpu_tiles::forEachTilePixel(
+          tile % tiles_x, tile / tiles_x, width, height, [&](int px, int py) {
+            const int last = last_fwd[static_cast<int64_t>(py) * width + px];
+            walked += last;
+            used[tile] = std::max(used[tile], last);
+          });
+      work_before[tile + 1] = work_before[tile] + walked;
+    }
+    // Buffer k sums a contiguous run of tiles of about 1/threads of the work, in tile order, and
+    // the buffers are summed in order: the gradients depend on the thread count (as with any
+    // split) but not on which thread runs which run.
+    std::vector<int> run_start(static_cast<std::size_t>(threads) + 1, num_tiles);
+    for (int k = 0; k < threads; ++k) {
+      const int64_t target = work_before.back() * k / threads;
+      run_start[k] = static_cast<int>(
+          std::lower_bound(work_before.begin() + 1, work_before.end(), target + 1) -
+          (work_before.begin() + 1));
+    }
+    run_start[0] = 0;
+    at::parallel_for(0, threads, 1, [&](int64_t first_run, int64_t end_run) {
       std::vector<T> accum(static_cast<std::size_t>(kTileSize * D));
       std::vector<T> last_value(accum.size());
       std::vector<T> grads;
       TileList<T> list;
-      for (int64_t tile = begin; tile < end; ++tile) {
-        const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
-        const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
-        // Only the Gaussians up to the tile's last contributor have gradients.
-        int used = 0;
-        cpu_tiles::forEachTilePixel(tx, ty, width, height, [&](int px, int py) {
-          used = std::max(used, last_fwd[static_cast<int64_t>(py) * width + px]);
-        });
-        if (used == 0) continue;
-        list.gather(ids + start, std::min(used, stop - start), m2, co, op, skip.data(), val, D);
-        grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
-        backwardOneTile(list, D, tx, ty, width, height, loops, gimg, galpha, alpha_fwd, last_fwd,
-                        accum.data(), last_value.data(), grads.data());
-        for (int j = 0; j < list.size(); ++j) {
-          T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
-          const T* gt = grads.data() + j * row;
-          for (int64_t c = 0; c < row; ++c) gb[c] += gt[c];
+      for (int64_t k = first_run; k < end_run; ++k) {
+        T* buf = buf_base + k * n * row;
+        for (int tile = run_start[k]; tile < run_start[k + 1]; ++tile) {
+          if (used[tile] == 0) continue;
+          const int tx = tile % tiles_x, ty = tile / tiles_x;
+          const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
+          list.gather(ids + start, std::min(used[tile], stop - start), m2, co, op, skip.data(), val,
+                      D);
+          grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
+          backwardOneTile(list, D, tx, ty, width, height, loops, gimg, galpha, alpha_fwd, last_fwd,
+                          accum.data(), last_value.data(), grads.data());
+          for (int j = 0; j < list.size(); ++j) {
+            T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
+            const T* gt = grads.data() + j * row;
+            for (int64_t c = 0; c < row; ++c) gb[c] += gt[c];
+          }
         }
       }
     });
