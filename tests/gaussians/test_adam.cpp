@@ -1,8 +1,13 @@
 // The fused Adam step against the textbook formula written with tensor operations.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/adam.h"
+
+#include "adam_math.h"
 
 namespace sadsplat {
 namespace {
@@ -32,6 +37,40 @@ TEST(Adam, FusedStepMatchesTheTextbookFormulaOverSeveralSteps) {
   EXPECT_TRUE(at::allclose(x, rx, 1e-12, 1e-14));
   EXPECT_TRUE(at::allclose(m, rm, 1e-12, 1e-14));
   EXPECT_TRUE(at::allclose(v, rv, 1e-12, 1e-14));
+}
+
+TEST(Adam, FloatStepIsBitIdenticalToTheScalarUpdateOfEveryElement) {
+  // 1027 elements: the vectorised loop's remainder too; every third gradient 0 (a Gaussian that
+  // no view saw) and a step without any gradient.
+  at::manual_seed(5);
+  at::Tensor x = at::randn({1027}), m = at::zeros_like(x), v = at::zeros_like(x);
+  std::vector<float> rx(x.data_ptr<float>(), x.data_ptr<float>() + x.numel());
+  std::vector<float> rm(rx.size(), 0.f), rv(rx.size(), 0.f);
+  const gaussians::AdamSettings settings;
+  for (std::int64_t step = 1; step <= 4; ++step) {
+    at::Tensor g = at::randn({1027}) * 3;
+    g.view({-1}).slice(0, 0, 1027, 3).zero_();
+    const bool without_gradient = step == 3;
+    adamStep(x, without_gradient ? at::Tensor() : g, m, v, 0.05, step, settings);
+    const double k = static_cast<double>(step);
+    const gaussians::adam::Coefficients<float> c{float(settings.beta1),
+                                                 float(1 - settings.beta1),
+                                                 float(settings.beta2),
+                                                 float(1 - settings.beta2),
+                                                 float(1 - std::pow(settings.beta1, k)),
+                                                 float(1 - std::pow(settings.beta2, k)),
+                                                 float(settings.eps),
+                                                 float(0.05)};
+    for (std::size_t i = 0; i < rx.size(); ++i) {
+      gaussians::adam::update(&rx[i], without_gradient ? 0.f : g.data_ptr<float>()[i], &rm[i],
+                              &rv[i], c);
+    }
+  }
+  for (std::size_t i = 0; i < rx.size(); ++i) {
+    ASSERT_EQ(x.data_ptr<float>()[i], rx[i]) << "value " << i;
+    ASSERT_EQ(m.data_ptr<float>()[i], rm[i]) << "m " << i;
+    ASSERT_EQ(v.data_ptr<float>()[i], rv[i]) << "v " << i;
+  }
 }
 
 TEST(Adam, FirstStepMovesEachElementByTheLearningRateAgainstItsGradientSign) {

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
 #include <c10/cuda/CUDAStream.h>
@@ -45,6 +49,45 @@ adam::Coefficients<T> coefficients(double lr, std::int64_t step, const AdamSetti
           T(lr)};
 }
 
+// Elements [begin, end) of a float step, four at a time with SSE where the build has it: the same
+// operations in the same order as adam::update (SSE's division and square root round exactly as
+// the scalar ones do and x86-64's baseline has no FMA to contract them), so every element is
+// bit-identical to the scalar loop's; four times fewer divisions and square roots to wait on.
+void updateFloats(float* x, const float* g, float* m, float* v, const adam::Coefficients<float>& c,
+                  int64_t begin, int64_t end) {
+  int64_t i = begin;
+#if defined(__SSE2__)
+  const __m128 beta1 = _mm_set1_ps(c.beta1), one_minus_beta1 = _mm_set1_ps(c.one_minus_beta1);
+  const __m128 beta2 = _mm_set1_ps(c.beta2), one_minus_beta2 = _mm_set1_ps(c.one_minus_beta2);
+  const __m128 correction1 = _mm_set1_ps(c.correction1), correction2 = _mm_set1_ps(c.correction2);
+  const __m128 eps = _mm_set1_ps(c.eps), lr = _mm_set1_ps(c.lr);
+  for (; i + 4 <= end; i += 4) {
+    const __m128 grad = g ? _mm_loadu_ps(g + i) : _mm_setzero_ps();
+    const __m128 m_new =
+        _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(m + i), beta1), _mm_mul_ps(grad, one_minus_beta1));
+    const __m128 v_new = _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(v + i), beta2),
+                                    _mm_mul_ps(_mm_mul_ps(grad, grad), one_minus_beta2));
+    _mm_storeu_ps(m + i, m_new);
+    _mm_storeu_ps(v + i, v_new);
+    const __m128 denominator = _mm_add_ps(_mm_sqrt_ps(_mm_div_ps(v_new, correction2)), eps);
+    const __m128 step = _mm_mul_ps(lr, _mm_div_ps(_mm_div_ps(m_new, correction1), denominator));
+    _mm_storeu_ps(x + i, _mm_sub_ps(_mm_loadu_ps(x + i), step));
+  }
+#endif
+  for (; i < end; ++i) adam::update(x + i, g ? g[i] : 0.f, m + i, v + i, c);
+}
+
+template <typename T>
+void updateRange(T* x, const T* g, T* m, T* v, const adam::Coefficients<T>& c, int64_t begin,
+                 int64_t end) {
+  for (int64_t i = begin; i < end; ++i) adam::update(x + i, g ? g[i] : T(0), m + i, v + i, c);
+}
+
+void updateRange(float* x, const float* g, float* m, float* v, const adam::Coefficients<float>& c,
+                 int64_t begin, int64_t end) {
+  updateFloats(x, g, m, v, c, begin, end);
+}
+
 }  // namespace
 
 void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
@@ -80,9 +123,7 @@ void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tens
     scalar_t* vv = v.data_ptr<scalar_t>();
     const scalar_t* gg = g.defined() ? g.data_ptr<scalar_t>() : nullptr;
     at::parallel_for(0, value.numel(), 1 << 15, [&](int64_t begin, int64_t end) {
-      for (int64_t i = begin; i < end; ++i) {
-        adam::update(x + i, gg ? gg[i] : scalar_t(0), mm + i, vv + i, c);
-      }
+      updateRange(x, gg, mm, vv, c, begin, end);
     });
   });
 }
