@@ -33,32 +33,44 @@ std::array<float, 11> window() {
 
 namespace {
 
-#if SADSPLAT_HAVE_CUDA
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-// mean(SSIM map) of a (differentiable) against b (a constant target).
+// mean(SSIM map) of a (differentiable) against b (a constant target), on a's device.
 class FusedSsim : public torch::autograd::Function<FusedSsim> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a, const at::Tensor& b) {
     const ScopedPhase phase("SSIM");
-    const c10::cuda::CUDAGuard guard(a.device());
     const at::Tensor ac = a.contiguous(), bc = b.contiguous();
-    auto [map, partials] = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
-    ctx->save_for_backward({ac, bc, partials});
-    return map.mean();
+    std::array<at::Tensor, 2> out;
+    if (ac.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      const c10::cuda::CUDAGuard guard(ac.device());
+      out = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
+#endif
+    } else {
+      out = ssim_fused::forwardCpu(ac, bc);
+    }
+    ctx->save_for_backward({ac, bc, out[1]});
+    return out[0].mean();
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const at::Tensor& a = saved[0];
     const ScopedPhase phase("SSIM backward");
-    const c10::cuda::CUDAGuard guard(a.device());
     const at::Tensor upstream = grads[0].to(at::kFloat).contiguous();
-    at::Tensor grad = ssim_fused::backwardCuda(a, saved[1], saved[2], upstream, currentStream(a));
+    at::Tensor grad;
+    if (a.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+      const c10::cuda::CUDAGuard guard(a.device());
+      grad = ssim_fused::backwardCuda(a, saved[1], saved[2], upstream, currentStream(a));
+#endif
+    } else {
+      grad = ssim_fused::backwardCpu(a, saved[1], saved[2], upstream.item<float>());
+    }
     return {grad, at::Tensor()};
   }
 };
-#endif
 
 }  // namespace
 
@@ -85,21 +97,16 @@ at::Tensor ssimReference(const at::Tensor& a, const at::Tensor& b) {
 
 bool ssimIsFused(const at::Tensor& a, const at::Tensor& b) {
 #if SADSPLAT_HAVE_CUDA
-  return a.is_cuda() && b.is_cuda() && a.scalar_type() == at::kFloat &&
-         b.scalar_type() == at::kFloat && a.dim() == 3 && a.size(2) == 3 &&
-         a.sizes().equals(b.sizes()) && a.device() == b.device() && !b.requires_grad();
+  const bool device_ok = a.device() == b.device() && (a.is_cuda() || a.is_cpu());
 #else
-  (void)a;
-  (void)b;
-  return false;
+  const bool device_ok = a.is_cpu() && b.is_cpu();
 #endif
+  return device_ok && a.scalar_type() == at::kFloat && b.scalar_type() == at::kFloat &&
+         a.dim() == 3 && a.size(2) == 3 && a.sizes().equals(b.sizes()) && !b.requires_grad();
 }
 
 at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
-#if SADSPLAT_HAVE_CUDA
-  if (ssimIsFused(a, b)) return FusedSsim::apply(a, b);
-#endif
-  return ssimReference(a, b);
+  return ssimIsFused(a, b) ? FusedSsim::apply(a, b) : ssimReference(a, b);
 }
 
 double psnr(const at::Tensor& a, const at::Tensor& b) {

@@ -1,9 +1,10 @@
 #pragma once
-// Internal interface of the fused SSIM (image_metrics.cpp <-> ssim_cuda.cu): the loss's SSIM of
-// two [H, W, 3] float32 images in four memory-bound passes instead of ten convolutions and ~30
-// element-wise kernels. Same definition as the reference composition in image_metrics.cpp:
-// 11x11 Gaussian window (sigma 1.5), zero padding, C1 = 0.01^2, C2 = 0.03^2, mean over H x W x 3.
-// The gradient is taken with respect to the first image only (the second is the target).
+// Internal interface of the fused SSIM (image_metrics.cpp <-> ssim_cpu.cpp, ssim_cuda.cu): the
+// loss's SSIM of two [H, W, 3] float32 images in four memory-bound passes instead of ten
+// convolutions and ~30 element-wise kernels. Same definition as the reference composition in
+// image_metrics.cpp: 11x11 Gaussian window (sigma 1.5), zero padding, C1 = 0.01^2, C2 = 0.03^2,
+// mean over H x W x 3. The gradient is taken with respect to the first image only (the second is
+// the target).
 
 #include <ATen/ATen.h>
 
@@ -15,6 +16,12 @@ namespace ssim_fused {
 
 /// The normalised 1-D window, as the reference computes it (float).
 std::array<float, 11> window();
+
+/// forwardCuda / backwardCuda on the CPU: contiguous float32 [H, W, 3] CPU tensors; `upstream`
+/// the incoming gradient of the mean as a number.
+std::array<at::Tensor, 2> forwardCpu(const at::Tensor& a, const at::Tensor& b);
+at::Tensor backwardCpu(const at::Tensor& a, const at::Tensor& b, const at::Tensor& partials,
+                       float upstream);
 
 #if SADSPLAT_COMPILE_CUDA
 /// SSIM map [H, W, 3] and the per-pixel partial derivatives of the map with respect to the

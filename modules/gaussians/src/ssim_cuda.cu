@@ -7,13 +7,12 @@
 
 #include "sadsplat/common/cuda_support.h"
 #include "ssim_backend.h"
+#include "ssim_math.h"
 
 namespace sadsplat {
 namespace gaussians {
 namespace ssim_fused {
 namespace {
-
-constexpr int kRadius = 5;
 
 // The 1-D window, passed to the kernels by value.
 struct Window {
@@ -61,20 +60,10 @@ __global__ void statsVertical(const float* blurred, int W, int H, int64_t n, Win
                               float* partials) {
   const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= n) return;
-  constexpr float kC1 = 0.01f * 0.01f, kC2 = 0.03f * 0.03f;
-  float s[5];
+  float s[5], q[3];
   vertical<5>(i, W, H, n, blurred, win, s);
-  const float mx = s[0], my = s[1];
-  const float sxx = s[2] - mx * mx, syy = s[3] - my * my, sxy = s[4] - mx * my;
-  const float A = 2 * mx * my + kC1, B = 2 * sxy + kC2;
-  const float C = mx * mx + my * my + kC1, D = sxx + syy + kC2;
-  const float CD = C * D;
-  const float S = (A * B) / CD;
-  map[i] = S;
-  // S = A B / (C D) with A(mx), B(mx, E[ab]), C(mx), D(mx, E[a^2]):
-  partials[i] = (2 * my * (B - A) - S * 2 * mx * (D - C)) / CD;  // dS/dmx
-  partials[n + i] = -S / D;                                       // dS/dE[a^2]
-  partials[2 * n + i] = 2 * A / CD;                               // dS/dE[ab]
+  map[i] = ssimFromStats(s, q);
+  for (int k = 0; k < 3; ++k) partials[k * n + i] = q[k];
 }
 
 __global__ void partialsHorizontal(const float* partials, int W, int64_t n, Window win,
@@ -93,18 +82,15 @@ __global__ void partialsHorizontal(const float* partials, int W, int64_t n, Wind
   for (int k = 0; k < 3; ++k) out[k * n + i] = acc[k];
 }
 
-// The window is symmetric, so the transposed blur is the blur: da(p) = sum_q w(q - p) [dS/dmx(q)
-// + 2 a(p) dS/dE[a^2](q) + b(p) dS/dE[ab](q)].
+// The vertical pass of the partials and the gradient (ssimGradient).
 // `upstream` is the incoming gradient of the mean (a device scalar: no host synchronisation).
-__global__ void gradientVertical(const float* blurred, const float* a, const float* b, int W,
-                                 int H, int64_t n, Window win, const float* upstream,
-                                 float* grad) {
+__global__ void gradientVertical(const float* blurred, const float* a, const float* b, int W, int H,
+                                 int64_t n, Window win, const float* upstream, float* grad) {
   const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= n) return;
   float s[3];
   vertical<3>(i, W, H, n, blurred, win, s);
-  const float scale = *upstream / static_cast<float>(n);
-  grad[i] = scale * (s[0] + 2 * a[i] * s[1] + b[i] * s[2]);
+  grad[i] = ssimGradient(s, a[i], b[i], *upstream / static_cast<float>(n));
 }
 
 void check(const char* what) { checkCudaLaunch("<ssim>", what); }
@@ -131,11 +117,10 @@ std::array<at::Tensor, 2> forwardCuda(const at::Tensor& a, const at::Tensor& b, 
   const Window win = makeWindow();
   at::Tensor blurred = at::empty({5, H, W, 3}, a.options());
   statsHorizontal<<<blocksFor(n), kThreads, 0, stream>>>(a.data_ptr<float>(), b.data_ptr<float>(),
-                                                          W, n, win, blurred.data_ptr<float>());
+                                                         W, n, win, blurred.data_ptr<float>());
   check("statsHorizontal");
-  statsVertical<<<blocksFor(n), kThreads, 0, stream>>>(blurred.data_ptr<float>(), W, H, n, win,
-                                                        map.data_ptr<float>(),
-                                                        partials.data_ptr<float>());
+  statsVertical<<<blocksFor(n), kThreads, 0, stream>>>(
+      blurred.data_ptr<float>(), W, H, n, win, map.data_ptr<float>(), partials.data_ptr<float>());
   check("statsVertical");
   return {map, partials};
 }
@@ -150,12 +135,11 @@ at::Tensor backwardCuda(const at::Tensor& a, const at::Tensor& b, const at::Tens
   const Window win = makeWindow();
   at::Tensor blurred = at::empty({3, H, W, 3}, a.options());
   partialsHorizontal<<<blocksFor(n), kThreads, 0, stream>>>(partials.data_ptr<float>(), W, n, win,
-                                                             blurred.data_ptr<float>());
+                                                            blurred.data_ptr<float>());
   check("partialsHorizontal");
-  gradientVertical<<<blocksFor(n), kThreads, 0, stream>>>(blurred.data_ptr<float>(),
-                                                           a.data_ptr<float>(), b.data_ptr<float>(),
-                                                           W, H, n, win, upstream.data_ptr<float>(),
-                                                           grad.data_ptr<float>());
+  gradientVertical<<<blocksFor(n), kThreads, 0, stream>>>(
+      blurred.data_ptr<float>(), a.data_ptr<float>(), b.data_ptr<float>(), W, H, n, win,
+      upstream.data_ptr<float>(), grad.data_ptr<float>());
   check("gradientVertical");
   return grad;
 }

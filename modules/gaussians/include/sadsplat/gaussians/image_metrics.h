@@ -8,9 +8,9 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief Mean SSIM of two [H, W, 3] images. On CUDA float32 images whose second image needs no
-/// gradient (a loss against a target) it runs fused (four memory-bound passes, the gradient for
-/// the first image only); otherwise as ssimReference.
+/// \brief Mean SSIM of two [H, W, 3] images. On float32 images (CPU or CUDA) whose second image
+/// needs no gradient (a loss against a target) it runs fused (four memory-bound passes, the
+/// gradient for the first image only); otherwise as ssimReference.
 at::Tensor ssim(const at::Tensor& a, const at::Tensor& b);
 /// \brief The same SSIM composed of ATen operations (separable convolutions), on any device and
 /// differentiable in both images: the reference the fused path is tested against.
