@@ -246,11 +246,13 @@ void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int
 
 // backwardTile for float, a tile row at a time (see forwardTileRows). For each Gaussian the
 // row's pixels add their gradients in pixel order, rows in order: the same sequence of additions
-// to every gradient as backwardTile's pixel-by-pixel walk. `accum`, `last_value`: kTileSize * D.
+// to every gradient as backwardTile's pixel-by-pixel walk. `accum`, `last_value`: kTileSize * D;
+// `row_buffer`: 6 + D.
 template <int kD>
 void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int ty, int width,
                       int height, const float* gimg, const float* galpha, const float* alpha_fwd,
-                      const int* last_fwd, float* accum, float* last_value, float* grads) {
+                      const int* last_fwd, float* accum, float* last_value, float* row_buffer,
+                      float* grads) {
   const int64_t D = kD > 0 ? kD : dynamic_d;
   const int64_t grad_row = 6 + D;
   const PackedGaussian<float>* pg = list.gaussians.data();
@@ -261,6 +263,9 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
   const int y_end = std::min(height, (ty + 1) * kTileSize);
   float trans[kTileSize], final_trans[kTileSize], last_alpha[kTileSize], g_out[kTileSize];
   int last[kTileSize];
+  // One Gaussian's gradient row: a fixed array for RGB, the caller's buffer otherwise.
+  float rgb_row[6 + 3];
+  float* gb = kD == 3 ? rgb_row : row_buffer;
   for (int py = ty * kTileSize; py < y_end; ++py) {
     const float fy = float(py) + 0.5f;
     const int64_t pix0 = static_cast<int64_t>(py) * width + x0;
@@ -281,7 +286,13 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
       unsigned live = 0;
       for (int l = 0; l < lanes; ++l) live |= static_cast<unsigned>(last[l] > j) << l;
       const PackedGaussian<float>& p = pg[j];
-      for (unsigned bits = notSkipped(p, row, fy) & live; bits != 0; bits &= bits - 1) {
+      unsigned bits = notSkipped(p, row, fy) & live;
+      if (bits == 0) continue;
+      // The row's additions to Gaussian j's gradients, in lane order, on a local copy of its
+      // gradient row (kept in registers for RGB), written back once.
+      float* gj = grads + j * grad_row;
+      std::copy(gj, gj + grad_row, gb);
+      for (; bits != 0; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
         float G;
         bool clamped;
@@ -290,7 +301,6 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
         if (alpha == 0.f) continue;
         trans[l] = trans[l] / (1.f - alpha);
         const float w = alpha * trans[l];
-        float* gb = grads + j * grad_row;
         const float* v = val + j * D;
         const float* gpix = gimg + (pix0 + l) * D;
         float* a = accum + l * D;
@@ -308,6 +318,7 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
         pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2,
                            gb + 5);
       }
+      std::copy(gb, gb + grad_row, gj);
     }
   }
 }
