@@ -109,7 +109,7 @@ const std::vector<TrainOption> kOptions = {
      "iterations between raising the SH degree by one", nullptr, 1, kInf},
     {"lambda_ssim", &C::lambda_ssim, "weight of D-SSIM in the RGB loss (paper: 0.2)", nullptr, 0,
      1},
-    {"fused_ssim", &C::fused_ssim, "CUDA: the SSIM loss in fused kernels (false: reference)"},
+    {"fused_ssim", &C::fused_ssim, "the SSIM loss in fused passes, CPU and CUDA (false: the reference composition)"},
     {"fused_semantic_loss", &C::fused_semantic_loss,
      "CUDA: the semantic loss in fused kernels (false: reference)"},
     {"lambda_rgb", &C::lambda_rgb, "weight of the RGB loss", nullptr, 0, kInf},

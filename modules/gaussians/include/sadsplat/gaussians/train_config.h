@@ -19,8 +19,9 @@ struct TrainConfig {
   int max_sh_degree = 3;
   int sh_increase_interval = 1000;
   double lambda_ssim = 0.2;  ///< paper: lambda_SSIM = 0.2
-  /// On CUDA, the SSIM loss in fused kernels (gaussians::ssim); false: the reference composition
-  /// of convolutions (gaussians::ssimReference), the same value ~10x slower (for comparisons).
+  /// The SSIM loss in fused passes on CPU and CUDA (gaussians::ssim); false: the reference
+  /// composition of convolutions (gaussians::ssimReference), the same value, slower (for
+  /// comparisons).
   bool fused_ssim = true;
   /// On CUDA, the semantic loss in fused kernels (gaussians::semanticLoss); false: the reference
   /// composition of ATen operations (gaussians::semanticLossReference), for comparisons.
