@@ -73,6 +73,53 @@ struct TileList {
   }
 };
 
+// Blends Gaussian j (past the skip test) into the pixel at (fx, fy): its channel sums `accum`,
+// transmittance `trans` and last contributor `last`. False when the pixel saturates before it
+// (the pixel stops there). The forward's per-pixel arithmetic lives only here: the scalar and the
+// vectorised loops both call it, so they round alike.
+template <typename T>
+inline bool blendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, int j, T fx, T fy,
+                          T* accum, T* trans, int* last) {
+  T G;
+  bool clamped;
+  const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+  if (alpha == T(0)) return true;
+  const T next = *trans * (T(1) - alpha);
+  if (next < T(kMinTransmittance)) return false;
+  const T w = alpha * *trans;
+  for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
+  *trans = next;
+  *last = j + 1;
+  return true;
+}
+
+// The backward of blendGaussian for the pixel at (fx, fy), walked back to front: adds Gaussian
+// j's gradients (mean2d, conic, opacity, values) to its row `gb`. The pixel's state: `trans`,
+// `last_alpha`, `accum`, `last_value` (updated); gpix its image gradient, g_alpha_out its alpha
+// gradient, final_trans its transmittance after the forward. Shared by both loops, as above.
+template <typename T>
+inline void unblendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, T fx, T fy,
+                            const T* gpix, T g_alpha_out, T final_trans, T* trans, T* last_alpha,
+                            T* accum, T* last_value, T* gb) {
+  T G;
+  bool clamped;
+  const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
+  if (alpha == T(0)) return;
+  *trans = *trans / (T(1) - alpha);
+  const T w = alpha * *trans;
+  T g_a = T(0);
+  for (int64_t ch = 0; ch < D; ++ch) {
+    accum[ch] = *last_alpha * last_value[ch] + (T(1) - *last_alpha) * accum[ch];
+    last_value[ch] = v[ch];
+    g_a += (v[ch] - accum[ch]) * gpix[ch];
+    gb[6 + ch] += w * gpix[ch];
+  }
+  g_a *= *trans;
+  g_a += g_alpha_out * final_trans / (T(1) - alpha);
+  *last_alpha = alpha;
+  pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
+}
+
 // Blends one tile of the forward pass. kD > 0: the channel count as a compile-time constant (the
 // RGB-only renders); 0: `dynamic_d` channels.
 template <int kD, typename T>
@@ -90,17 +137,7 @@ void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int
     for (int j = 0; j < count; ++j) {
       const PackedGaussian<T>& p = pg[j];
       if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-      T G;
-      bool clamped;
-      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-      if (alpha == T(0)) continue;
-      const T next = trans * (T(1) - alpha);
-      if (next < T(kMinTransmittance)) break;
-      const T w = alpha * trans;
-      const T* v = val + j * D;
-      for (int64_t ch = 0; ch < D; ++ch) accum[ch] += w * v[ch];
-      trans = next;
-      last = j + 1;
+      if (!blendGaussian(p, val + j * D, D, j, fx, fy, accum, &trans, &last)) break;
     }
     const int64_t pix = static_cast<int64_t>(py) * width + px;
     std::copy(accum, accum + D, img + pix * D);
@@ -131,25 +168,8 @@ void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, in
     for (int j = last_fwd[pix] - 1; j >= 0; --j) {
       const PackedGaussian<T>& p = pg[j];
       if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
-      T G;
-      bool clamped;
-      const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-      if (alpha == T(0)) continue;
-      trans = trans / (T(1) - alpha);
-      const T w = alpha * trans;
-      T* gb = grads + j * row;
-      const T* v = val + j * D;
-      T g_a = T(0);
-      for (int64_t ch = 0; ch < D; ++ch) {
-        accum[ch] = last_alpha * last_value[ch] + (T(1) - last_alpha) * accum[ch];
-        last_value[ch] = v[ch];
-        g_a += (v[ch] - accum[ch]) * gpix[ch];
-        gb[6 + ch] += w * gpix[ch];
-      }
-      g_a *= trans;
-      g_a += galpha[pix] * final_trans / (T(1) - alpha);
-      last_alpha = alpha;
-      pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
+      unblendGaussian(p, val + j * D, D, fx, fy, gpix, galpha[pix], final_trans, &trans,
+                      &last_alpha, accum, last_value, grads + j * row);
     }
   });
 }
@@ -192,7 +212,7 @@ inline unsigned notSkipped(const PackedGaussian<float>& p, const RowLanes& row, 
 }
 
 // forwardTile for float, a tile row at a time: per Gaussian one vectorised skip test for the
-// row's 16 pixels, then forwardTile's per-pixel arithmetic for the pixels that do not skip it.
+// row's 16 pixels, then blendGaussian for the pixels that do not skip it.
 // `accum`: kTileSize * D floats.
 template <int kD>
 void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int ty, int width,
@@ -217,22 +237,10 @@ void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int
       const PackedGaussian<float>& p = pg[j];
       for (unsigned bits = notSkipped(p, row, fy) & active; bits != 0; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
-        float G;
-        bool clamped;
-        const float alpha =
-            pixelAlpha(p.mean2d, p.conic, p.opacity, float(x0 + l) + 0.5f, fy, &G, &clamped);
-        if (alpha == 0.f) continue;
-        const float next = trans[l] * (1.f - alpha);
-        if (next < float(kMinTransmittance)) {
+        if (!blendGaussian(p, val + j * D, D, j, float(x0 + l) + 0.5f, fy, accum + l * D, &trans[l],
+                           &last[l])) {
           active &= ~(1u << l);
-          continue;
         }
-        const float w = alpha * trans[l];
-        const float* v = val + j * D;
-        float* a = accum + l * D;
-        for (int64_t ch = 0; ch < D; ++ch) a[ch] += w * v[ch];
-        trans[l] = next;
-        last[l] = j + 1;
       }
     }
     for (int l = 0; l < lanes; ++l) {
@@ -294,29 +302,9 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
       std::copy(gj, gj + grad_row, gb);
       for (; bits != 0; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
-        float G;
-        bool clamped;
-        const float fx = float(x0 + l) + 0.5f;
-        const float alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-        if (alpha == 0.f) continue;
-        trans[l] = trans[l] / (1.f - alpha);
-        const float w = alpha * trans[l];
-        const float* v = val + j * D;
-        const float* gpix = gimg + (pix0 + l) * D;
-        float* a = accum + l * D;
-        float* lv = last_value + l * D;
-        float g_a = 0.f;
-        for (int64_t ch = 0; ch < D; ++ch) {
-          a[ch] = last_alpha[l] * lv[ch] + (1.f - last_alpha[l]) * a[ch];
-          lv[ch] = v[ch];
-          g_a += (v[ch] - a[ch]) * gpix[ch];
-          gb[6 + ch] += w * gpix[ch];
-        }
-        g_a *= trans[l];
-        g_a += g_out[l] * final_trans[l] / (1.f - alpha);
-        last_alpha[l] = alpha;
-        pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2,
-                           gb + 5);
+        unblendGaussian(p, val + j * D, D, float(x0 + l) + 0.5f, fy, gimg + (pix0 + l) * D,
+                        g_out[l], final_trans[l], &trans[l], &last_alpha[l], accum + l * D,
+                        last_value + l * D, gb);
       }
       std::copy(gb, gb + grad_row, gj);
     }
