@@ -52,15 +52,8 @@ TEST(Adam, FloatStepIsBitIdenticalToTheScalarUpdateOfEveryElement) {
     g.view({-1}).slice(0, 0, 1027, 3).zero_();
     const bool without_gradient = step == 3;
     adamStep(x, without_gradient ? at::Tensor() : g, m, v, 0.05, step, settings);
-    const double k = static_cast<double>(step);
-    const gaussians::adam::Coefficients<float> c{float(settings.beta1),
-                                                 float(1 - settings.beta1),
-                                                 float(settings.beta2),
-                                                 float(1 - settings.beta2),
-                                                 float(1 - std::pow(settings.beta1, k)),
-                                                 float(1 - std::pow(settings.beta2, k)),
-                                                 float(settings.eps),
-                                                 float(0.05)};
+    const auto c = gaussians::adam::coefficientsAt<float>(step, 0.05, settings.beta1,
+                                                          settings.beta2, settings.eps);
     for (std::size_t i = 0; i < rx.size(); ++i) {
       gaussians::adam::update(&rx[i], without_gradient ? 0.f : g.data_ptr<float>()[i], &rm[i],
                               &rv[i], c);

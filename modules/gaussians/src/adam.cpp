@@ -38,15 +38,7 @@ void expectLike(const at::Tensor& t, const at::Tensor& value, const char* name) 
 
 template <typename T>
 adam::Coefficients<T> coefficients(double lr, std::int64_t step, const AdamSettings& s) {
-  const double k = static_cast<double>(step);
-  return {T(s.beta1),
-          T(1 - s.beta1),
-          T(s.beta2),
-          T(1 - s.beta2),
-          T(1 - std::pow(s.beta1, k)),
-          T(1 - std::pow(s.beta2, k)),
-          T(s.eps),
-          T(lr)};
+  return adam::coefficientsAt<T>(step, lr, s.beta1, s.beta2, s.eps);
 }
 
 // Elements [begin, end) of a float step, four at a time with SSE where the build has it: the same

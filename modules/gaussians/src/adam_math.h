@@ -10,6 +10,7 @@
 #endif
 
 #include <cmath>
+#include <cstdint>
 
 namespace sadsplat {
 namespace gaussians {
@@ -20,6 +21,21 @@ template <typename T>
 struct Coefficients {
   T beta1, one_minus_beta1, beta2, one_minus_beta2, correction1, correction2, eps, lr;
 };
+
+/// The constants of step `step` (>= 1) for learning rate lr and Adam's beta1, beta2, eps.
+template <typename T>
+inline Coefficients<T> coefficientsAt(std::int64_t step, double lr, double beta1, double beta2,
+                                      double eps) {
+  const double k = static_cast<double>(step);
+  return {T(beta1),
+          T(1 - beta1),
+          T(beta2),
+          T(1 - beta2),
+          T(1 - std::pow(beta1, k)),
+          T(1 - std::pow(beta2, k)),
+          T(eps),
+          T(lr)};
+}
 
 template <typename T>
 SADSPLAT_ADAM_HD void update(T* value, T grad, T* m, T* v, const Coefficients<T>& c) {
