@@ -88,37 +88,14 @@ TEST(ImageMetrics, SsimGradientMatchesFiniteDifferences) {
   }
 }
 
-TEST(ImageMetrics, FusedCpuSsimMatchesTheReferenceValueAndGradient) {
-  // As the CUDA test below: odd sizes (borders), a blurred pair and the training size.
-  for (const auto& [H, W] : {std::pair<int, int>{45, 80}, {7, 5}, {450, 800}}) {
-    const at::Tensor a_in = randomImage(H, W, 5);
-    const at::Tensor b = (a_in * 0.7 + randomImage(H, W, 6) * 0.3).contiguous();
-    const at::Tensor a = a_in.clone().requires_grad_(true);
-    ASSERT_TRUE(gaussians::ssimIsFused(a, b));
-    const at::Tensor fused = ssim(a, b);
-    const at::Tensor g_fused = torch::autograd::grad({fused * 2.0}, {a})[0];
-    const at::Tensor a_ref = a_in.clone().requires_grad_(true);
-    const at::Tensor ref = ssimReference(a_ref, b);
-    const at::Tensor g_ref = torch::autograd::grad({ref * 2.0}, {a_ref})[0];
-    EXPECT_NEAR(fused.item<double>(), directSsim(a_in, b), 1e-5) << H << "x" << W;
-    EXPECT_NEAR(fused.item<double>(), ref.item<double>(), 1e-5) << H << "x" << W;
-    const double scale = g_ref.abs().max().item<double>();
-    EXPECT_LT((g_fused - g_ref).abs().max().item<double>(), 1e-3 * scale) << H << "x" << W;
-  }
-  // Double images and targets that need a gradient take the reference path.
-  const at::Tensor t = randomImage(8, 8, 7);
-  EXPECT_FALSE(gaussians::ssimIsFused(t.to(at::kDouble), t.to(at::kDouble)));
-  EXPECT_FALSE(gaussians::ssimIsFused(t, t.clone().requires_grad_(true)));
-}
-
-TEST(ImageMetrics, FusedCudaSsimMatchesTheReferenceValueAndGradient) {
-  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
-  // Odd sizes so that borders and partial blocks are exercised; a blurred pair (SSIM ~0.5-0.9)
-  // as in training, and an unrelated pair.
+// The fused SSIM of a blurred pair on `device` against its definition (1e-5) and the reference
+// composition on the CPU (value 1e-5, gradient 1e-3 of its largest element), at odd sizes
+// (borders, partial blocks) and the training size.
+void expectFusedSsimMatchesTheReference(const at::Device& device) {
   for (const auto& [H, W] : {std::pair<int, int>{45, 80}, {7, 5}, {450, 800}}) {
     const at::Tensor a_cpu = randomImage(H, W, 5);
     const at::Tensor b_cpu = (a_cpu * 0.7 + randomImage(H, W, 6) * 0.3).contiguous();
-    const at::Tensor a = a_cpu.cuda().requires_grad_(true), b = b_cpu.cuda();
+    const at::Tensor a = a_cpu.to(device).requires_grad_(true), b = b_cpu.to(device);
     ASSERT_TRUE(gaussians::ssimIsFused(a, b));
     const at::Tensor fused = ssim(a, b);
     const at::Tensor g_fused = torch::autograd::grad({fused * 2.0}, {a})[0];
@@ -130,6 +107,19 @@ TEST(ImageMetrics, FusedCudaSsimMatchesTheReferenceValueAndGradient) {
     const double scale = g_ref.abs().max().item<double>();
     EXPECT_LT((g_fused.cpu() - g_ref).abs().max().item<double>(), 1e-3 * scale) << H << "x" << W;
   }
+}
+
+TEST(ImageMetrics, FusedCpuSsimMatchesTheReferenceValueAndGradient) {
+  expectFusedSsimMatchesTheReference(at::kCPU);
+  // Double images and targets that need a gradient take the reference path.
+  const at::Tensor t = randomImage(8, 8, 7);
+  EXPECT_FALSE(gaussians::ssimIsFused(t.to(at::kDouble), t.to(at::kDouble)));
+  EXPECT_FALSE(gaussians::ssimIsFused(t, t.clone().requires_grad_(true)));
+}
+
+TEST(ImageMetrics, FusedCudaSsimMatchesTheReferenceValueAndGradient) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  expectFusedSsimMatchesTheReference(at::Device(at::kCUDA, 0));
   // A target that needs a gradient takes the reference path.
   const at::Tensor t = randomImage(8, 8, 7).cuda().requires_grad_(true);
   EXPECT_FALSE(gaussians::ssimIsFused(t, t));
