@@ -3,7 +3,8 @@
 # along (scripts/gpu/fetch_deps.sh fills it on Debian).
 #
 #   gpu_build [SRC_DIR]          build SRC_DIR (default .) into SRC_DIR/build-gpu with CUDA; logs
-#                                in $OUT/gpu_*.log; incremental when build-gpu/ exists
+#                                in $OUT/gpu_*.log; incremental when build-gpu/ exists;
+#                                GPU_BUILD_TARGET (env, e.g. sadsplat) builds that target only
 #   gpu_baseline TARBALL         unpack a baseline source tarball into /tmp/ab-base and build it
 #                                with this tree's lib.sh (sets BASE_BIN_DIR)
 #   scene_cache KIND_SEED [WxH] [BIN]
@@ -62,7 +63,8 @@ gpu_build() {
       -DCLI11_DIR="$GPU_DEPS_PREFIX/usr/share/cmake/CLI11" \
       -DSADSPLAT_WITH_CUDA=ON -DSADSPLAT_WITH_OPENCV=OFF -DSADSPLAT_WITH_VTK=OFF \
       -DSADSPLAT_WITH_OPEN3D=OFF "${zlib_args[@]}" > "$OUT/gpu_configure${2:-}.log" 2>&1 &&
-    cmake --build build-gpu -j "$(nproc)" > "$OUT/gpu_build${2:-}.log" 2>&1
+    cmake --build build-gpu -j "$(nproc)" ${GPU_BUILD_TARGET:+--target "$GPU_BUILD_TARGET"} \
+      > "$OUT/gpu_build${2:-}.log" 2>&1
     local rc=$?
     echo "build of $src: rc $rc, $(( $(date +%s) - start )) s" | tee -a "$OUT/gpu_build${2:-}.log"
     [ $rc = 0 ] || tail -30 "$OUT/gpu_build${2:-}.log"
