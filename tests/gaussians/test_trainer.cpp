@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
@@ -15,6 +17,7 @@
 namespace sadsplat {
 namespace {
 
+using gaussians::TensorArchive;
 using gaussians::TrainConfig;
 using gaussians::Trainer;
 
@@ -509,6 +512,32 @@ TEST_F(TrainerTest, ResumeBetweenL0WeightUpdatesIsExact) {
   ASSERT_EQ(rest->size(), 5u);
   for (int k = 0; k < 5; ++k) EXPECT_TRUE(at::equal((*rest)[k], (*all)[4 + k])) << 4 + k;
   EXPECT_TRUE(at::equal(straight.parameters().means, resumed.parameters().means));
+}
+
+// The snapshot a checkpoint is written from on another thread is a copy: steps taken after it
+// (the optimiser updates the parameters and moments in place) leave it as it was, and a trainer
+// restored from it continues exactly like the one it was taken from.
+TEST_F(TrainerTest, CheckpointSnapshotIsACopyTheTrainingDoesNotChange) {
+  TrainConfig c = small(6);
+  Trainer trainer(scene_, c);
+  for (int i = 0; i < 2; ++i) trainer.step();
+  const TensorArchive snapshot = trainer.checkpointSnapshot();
+  std::map<std::string, at::Tensor> kept;
+  for (const auto& [name, t] : snapshot.tensors) kept[name] = t.clone();
+  const at::Tensor means_then = trainer.parameters().means.clone();
+  for (int i = 0; i < 2; ++i) trainer.step();
+  ASSERT_FALSE(at::equal(trainer.parameters().means, means_then));  // the steps moved them
+  ASSERT_FALSE(kept.empty());
+  for (const auto& [name, t] : snapshot.tensors) {
+    EXPECT_TRUE(at::equal(t, kept[name])) << name << " changed after the snapshot";
+  }
+  test::TempDir dir;
+  gaussians::writeTensorArchive(dir.file("ckpt.bin"), snapshot);
+  Trainer resumed(scene_, c);
+  resumed.loadCheckpoint(dir.file("ckpt.bin"));
+  EXPECT_TRUE(at::equal(resumed.parameters().means, means_then));
+  for (int i = 0; i < 2; ++i) resumed.step();
+  EXPECT_TRUE(at::equal(resumed.parameters().means, trainer.parameters().means));
 }
 
 TEST_F(TrainerTest, ResumeAcrossTheRecoveryIsExact) {

@@ -369,7 +369,7 @@ pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
   return gaussians::toCloud(t);
 }
 
-void Trainer::saveCheckpoint(const std::string& path) const {
+TensorArchive Trainer::checkpointSnapshot() const {
   const State& s = *state_;
   TensorArchive a;
   s.params.save(a);
@@ -377,7 +377,17 @@ void Trainer::saveCheckpoint(const std::string& path) const {
   s.densification->save(a);
   a.numbers["iteration"] = s.iteration;
   a.numbers["num_classes"] = s.num_classes;
-  writeTensorArchive(path, a);
+  // Copies, also of CPU tensors: the optimiser updates the live ones in place.
+  for (auto& entry : a.tensors) {
+    if (entry.second.defined()) {
+      entry.second = entry.second.detach().to(at::kCPU, /*non_blocking=*/false, /*copy=*/true);
+    }
+  }
+  return a;
+}
+
+void Trainer::saveCheckpoint(const std::string& path) const {
+  writeTensorArchive(path, checkpointSnapshot());
 }
 
 void Trainer::loadCheckpoint(const std::string& path) {

@@ -18,6 +18,7 @@
 #include "sadsplat/gaussians/drop_strategy.h"
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/scene.h"
 
@@ -112,6 +113,9 @@ class Trainer {
   pcl::PointCloud<GaussianPoint> toCloud() const;
   std::int64_t numGaussians() const;
 
+  /// \brief Every tensor of the training state, copied to host memory: the archive stays as it
+  /// is while training goes on (for writing it on another thread).
+  TensorArchive checkpointSnapshot() const;
   /// \brief Writes every tensor of the training state (atomically).
   void saveCheckpoint(const std::string& path) const;
   /// \brief Restores a state written by saveCheckpoint (same scene and configuration).
