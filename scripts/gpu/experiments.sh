@@ -39,8 +39,11 @@
 #   growth     3 seed-0 scenes x Net-1 grown to fewer Gaussians (none_gradX: densify threshold X)
 #   late       3 seed-0 scenes x Net-1, full, and late pruning (L0 force and drop events from 3500,
 #              1000 recovery iterations) at L0 strength 3 and 4
+#   recovery   3 seed-0 scenes x Net-1, full, and the default drop followed by 1000 recovery
+#              iterations, alone and after removing 30 % / 50 % of the least contributing
+#              Gaussians at the recovery's start (rp0.3, rp0.5)
 #   A configuration full_<parts> takes any of pX (P_base), lambdaX, fromN, rampM, impG
-#   (--l0-importance G), recN (--recovery N), sX (--l0-strength X). Env SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run
+#   (--l0-importance G), recN (--recovery N), sX (--l0-strength X), rpX (--recovery-prune X). Env SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run
 #   starts with less left; SADSPLAT_BIN, DEVICE (cuda), WIDTH x HEIGHT (800 x 450), ITERATIONS
 #   (7000) change the setup (e.g. a quick CPU check).
 set -uo pipefail
@@ -181,6 +184,7 @@ table_run_one() {
           imp*) flags+=(--l0-importance "${token#imp}") ;;
           rec[0-9]*) flags+=(--recovery "${token#rec}") ;;
           s[0-9]*) flags+=(--l0-strength "${token#s}") ;;
+          rp[0-9]*) flags+=(--recovery-prune "${token#rp}") ;;
           *) echo "unknown part $token of configuration $config"; return 1 ;;
         esac
       done ;;
@@ -204,7 +208,7 @@ table_run_one() {
 }
 
 mode_table() {
-  table="${1:?usage: experiments.sh table ablation|pbase|l0schedule|growth|late [JOBS] [DEADLINE_S]}"
+  table="${1:?usage: experiments.sh table ablation|pbase|l0schedule|growth|late|recovery [JOBS] [DEADLINE_S]}"
   local parallel="${2:-4}"; deadline_start "${3:-540}"
   device="${DEVICE:-cuda}"; size="${WIDTH:-800}x${HEIGHT:-450}"; iterations="${ITERATIONS:-7000}"
   local scenes configs
@@ -217,7 +221,9 @@ mode_table() {
     growth)   scenes=(city_0 country_0 port_0); configs=(none_grad0.0005 none_grad0.001 none_grad0.002) ;;
     late)     scenes=(city_0 country_0 port_0)
               configs=(none full full_from3500_rec1000_s3 full_from3500_rec1000_s4) ;;
-    *) echo "unknown table $table (ablation, pbase, l0schedule, growth or late)"; return 2 ;;
+    recovery) scenes=(city_0 country_0 port_0)
+              configs=(none full full_rec1000 full_rec1000_rp0.3 full_rec1000_rp0.5) ;;
+    *) echo "unknown table $table (ablation, pbase, l0schedule, growth, late or recovery)"; return 2 ;;
   esac
   [ -n "${SCENES:-}" ] && read -r -a scenes <<< "$SCENES"
   [ -n "${CONFIGS:-}" ] && read -r -a configs <<< "$CONFIGS"
