@@ -12,6 +12,7 @@
 # Method: the full drop (--drop full), no pseudo-labels; 800x450 caches made here by synth.
 # VIEWS (env, default 1): views per step and rank in the batched runs (global batch GPUS x VIEWS).
 # EXTRA_FLAGS (env) go to every training, e.g. --profile (then $OUT gets profile_<run>.md).
+# Output names carry the shape: xl_ranks4x2 (4 ranks x 2 views), xl_1gpu_batch8 (8 views a step).
 # $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
 # and the metrics.
 set -euo pipefail
@@ -62,13 +63,13 @@ wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
 all_gpus=$(seq -s, 0 $(( gpus - 1 )))
 if [ "${PAIR:-0}" = 1 ] && [[ $wanted == *" xl_1gpu "* && $wanted == *" xl_1gpu_batch "* ]]; then
   run xl_1gpu "$xl" 0 --iterations "$iterations" &
-  run xl_1gpu_batch "$xl" 1 --iterations "$iterations" --views-per-step "$batch" --batch-schedule &
+  run "xl_1gpu_batch$batch" "$xl" 1 --iterations "$iterations" --views-per-step "$batch" --batch-schedule &
   wait
 else
   [[ $wanted == *" xl_1gpu "* ]] && run xl_1gpu "$xl" 0 --iterations "$iterations"
-  [[ $wanted == *" xl_1gpu_batch "* ]] && run xl_1gpu_batch "$xl" 0 --iterations "$iterations" --views-per-step "$batch" --batch-schedule
+  [[ $wanted == *" xl_1gpu_batch "* ]] && run "xl_1gpu_batch$batch" "$xl" 0 --iterations "$iterations" --views-per-step "$batch" --batch-schedule
 fi
-[[ $wanted == *" xl_ranks "* ]] && run xl_ranks "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
+[[ $wanted == *" xl_ranks "* ]] && run "xl_ranks${gpus}x$views" "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 [[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
-[[ $wanted == *" city_ranks "* ]] && run city_ranks "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
+[[ $wanted == *" city_ranks "* ]] && run "city_ranks${gpus}x$views" "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 echo "(batch runs take $half steps of $batch views)" >> "$summary"
