@@ -23,13 +23,14 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsa
 # as leaks from an unknown module (no stack to suppress by): those tests run with ASan and UBSan
 # but without the leak check.
 viz_tests="^(ViewScreenshot|SplatMode|Report|FrontierCharts)\."
-# Three end-to-end runs take ~460 s of the ASan pass's test time (~600 s of wall on 2 cores for
-# all of it, 2026-11-24) and add no code path of their own: the demo (synth, pseudo-labels, two trainings, eval: the same paths as
-# Cli.TrainEvalAndResumeOnTheFixture and Cli.PseudoLabelOptions*), kill -9 + resume (resume is
-# TrainerTest.ResumeFromACheckpointIsExact in process), a second two-rank training, and the
-# end-to-end SfM (376 s here, 2026-11-26, nearly all of it in COLMAP, which is not instrumented;
-# the georeference and EXIF code it calls have their own tests). They run in the Release pass;
-# SADSPLAT_ASAN_ALL=1 runs them here too.
+# Four end-to-end runs leave the ASan pass: they took ~460 s of its test time (~600 s of wall on
+# 2 cores for all of it, 2026-11-24) plus 376 s for the SfM one (2026-11-26), and run little
+# instrumented code the other tests do not: the demo (synth, pseudo-labels, two trainings, eval:
+# the same paths as Cli.TrainEvalAndResumeOnTheFixture and Cli.PseudoLabelOptions*), kill -9 +
+# resume (resume is TrainerTest.ResumeFromACheckpointIsExact in process), a second two-rank
+# training, and the SfM (nearly all of it in COLMAP, which is not instrumented; the georeference
+# and EXIF code it calls have their own tests). They run in the Release pass; SADSPLAT_ASAN_ALL=1
+# runs them here too.
 slow_tests="^(Cli\.DemoRunsTheMethodAndTheBaseline|Faults\.KillNineThenResumeIsBitIdentical|Distributed\.TwoRanksTrainLikeOneProcessWithTwoViewsPerStep|Sfm\.SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras)$"
 [ "${SADSPLAT_ASAN_ALL:-0}" = 1 ] && slow_tests="^$"
 ctest --test-dir build-asan --output-on-failure -j 2 -E "^Package\.|$viz_tests|$slow_tests" --timeout 900

@@ -43,9 +43,10 @@
 #              iterations, alone and after removing 30 % / 50 % of the least contributing
 #              Gaussians at the recovery's start (rp0.3, rp0.5)
 #   A configuration full_<parts> takes any of pX (P_base), lambdaX, fromN, rampM, impG
-#   (--l0-importance G), recN (--recovery N), sX (--l0-strength X), rpX (--recovery-prune X). Env SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run
-#   starts with less left; SADSPLAT_BIN, DEVICE (cuda), WIDTH x HEIGHT (800 x 450), ITERATIONS
-#   (7000) change the setup (e.g. a quick CPU check).
+#   (--l0-importance G), recN (--recovery N), sX (--l0-strength X), rpX (--recovery-prune X).
+#   Env SCENES, CONFIGS, SEEDS restrict the lists; MIN_RUN_S (30): no run starts with less left;
+#   SADSPLAT_BIN, DEVICE (cuda), WIDTH x HEIGHT (800 x 450), ITERATIONS (7000) change the setup
+#   (e.g. a quick CPU check).
 set -uo pipefail
 source "$(dirname "$0")/lib.sh"
 mode="${1:?usage: experiments.sh one|profile|runs|table ...}"; shift
