@@ -11,7 +11,6 @@
 #include <cstring>
 #include <filesystem>
 #include <iomanip>
-#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -247,11 +246,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   BackgroundTask checkpoint_writes;
   const auto checkpointInBackground = [&] {
     if (!writer) return;
-    auto snapshot = std::make_shared<gaussians::TensorArchive>(trainer.checkpointSnapshot());
     const int iteration = trainer.iteration();
     const double elapsed = seconds();
-    checkpoint_writes.start([&o, &config, checkpoint, snapshot, iteration, elapsed] {
-      gaussians::writeTensorArchive(checkpoint, *snapshot);
+    // The archive holds tensor handles: copying the lambda shares the snapshot's storage.
+    checkpoint_writes.start([&o, &config, checkpoint, snapshot = trainer.checkpointSnapshot(),
+                             iteration, elapsed] {
+      gaussians::writeTensorArchive(checkpoint, snapshot);
       writeRunJson(o.out, o.scene, o.scale, config.device, iteration, elapsed);
     });
     last_checkpoint = iteration;
