@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <nlohmann/json.hpp>
+
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
@@ -295,8 +297,13 @@ TEST(Cli, DemoRunsTheMethodAndTheBaseline) {
   EXPECT_NE(out.find("[drop] iteration 5: removed"), std::string::npos) << out;
   EXPECT_NE(out.find("| mIoU |"), std::string::npos) << out;
   EXPECT_TRUE(io::pathExists(dir.file("full/pseudo_labels/report.json")));
-  EXPECT_TRUE(io::pathExists(dir.file("full/run/metrics.json")));
   EXPECT_TRUE(io::pathExists(dir.file("full/run/model.ply")));
+  // The held-out views sit between training views: most of their pixels are covered.
+  const auto metrics = nlohmann::json::parse(test::readFile(dir.file("full/run/metrics.json")));
+  EXPECT_TRUE(metrics["psnr_covered"].is_number()) << metrics.dump();
+  EXPECT_GT(metrics["covered_fraction"].get<double>(), 0.5);
+  EXPECT_LE(metrics["covered_fraction"].get<double>(), 1.0);
+  EXPECT_EQ(metrics["covered_min_views"].get<int>(), 2);
 
   ASSERT_EQ(
       test::runCommand(kCli + " demo --baseline --iterations 10 --out " + dir.file("base"), &out),

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/view_coverage.h"
 
 namespace sadsplat {
@@ -48,6 +49,48 @@ TEST(ViewCoverage, CountsTheCamerasThatSeeEachCentre) {
   EXPECT_TRUE(size_only[0].item<bool>());
   EXPECT_EQ(size_only.sum().item<int>(), 1);
   EXPECT_EQ(gaussians::floaterMask(means, log_scales, cameras, 0, 0).sum().item<int>(), 0);
+}
+
+TEST(ViewCoverage, PixelsCountTheTrainingViewsThatSeeTheirSurface) {
+  // The evaluated view is the camera at x = 0, the surface a plane at depth 5. A pixel's centre
+  // u + 0.5 back-projects to x = (u + 0.5 - 50) / 100 * 5, which the camera at x = 2 sees at
+  // u' = u + 0.5 - 40: inside its image from column 40 on. One pixel renders nothing.
+  const at::Tensor depth = at::full({100, 100}, 5.0, at::kFloat);
+  at::Tensor alpha = at::ones({100, 100}, at::kFloat);
+  alpha[7][70] = 0.2;
+  const at::Tensor counts = gaussians::pixelViewCounts(depth, alpha, viewCamera(0),
+                                                       {viewCamera(0), viewCamera(2)});
+  ASSERT_EQ(counts.sizes(), at::IntArrayRef({100, 100}));
+  ASSERT_EQ(counts.scalar_type(), at::kInt);
+  EXPECT_EQ(counts[50][0].item<int>(), 1);
+  EXPECT_EQ(counts[50][39].item<int>(), 1);
+  EXPECT_EQ(counts[50][40].item<int>(), 2);
+  EXPECT_EQ(counts[99][99].item<int>(), 2);
+  EXPECT_EQ(counts[7][70].item<int>(), 0);
+  EXPECT_EQ(counts.eq(2).sum().item<int>(), 60 * 100 - 1);
+
+  // A rotated, moved camera sees every pixel it back-projects (a transposed rotation would not):
+  // 90 degrees about x, then 30 about y, centre away from the origin.
+  RasterCamera turned = viewCamera(0);
+  const double h = std::sqrt(0.5), c15 = std::cos(M_PI / 12), s15 = std::sin(M_PI / 12);
+  turned.qvec = {h * c15, h * c15, h * s15, -h * s15};  // q_y(30) * q_x(90)
+  turned.tvec = {0.3, -1.0, 2.0};
+  const at::Tensor self =
+      gaussians::pixelViewCounts(at::full({100, 100}, 3.0, at::kFloat),
+                                 at::ones({100, 100}, at::kFloat), turned, {turned});
+  EXPECT_EQ(self.sum().item<int>(), 100 * 100);
+  // Every pixel's surface lies 3 in front of the centre: the same camera moved 4 along its axis
+  // has all of it 1 behind it.
+  RasterCamera beyond = turned;
+  beyond.tvec = {turned.tvec[0], turned.tvec[1], turned.tvec[2] - 4.0};
+  const at::Tensor behind =
+      gaussians::pixelViewCounts(at::full({100, 100}, 3.0, at::kFloat),
+                                 at::ones({100, 100}, at::kFloat), turned, {beyond});
+  EXPECT_EQ(behind.sum().item<int>(), 0);
+
+  EXPECT_THROW(gaussians::pixelViewCounts(at::ones({10, 10}), at::ones({10, 10}), viewCamera(0),
+                                          {viewCamera(0)}),
+               Error);
 }
 
 TEST(ViewCoverage, SceneExtentIsTheCamerasRadiusTimes1point1) {

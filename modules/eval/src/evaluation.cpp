@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/image_metrics.h"
@@ -95,6 +97,12 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   bool any_test = false;
   for (const auto& v : scene.views) any_test = any_test || v.test;
   double psnr_sum = 0, ssim_sum = 0, render_seconds = 0;
+  double covered_psnr_sum = 0, covered_pixels = 0, evaluated_pixels = 0;
+  int covered_views = 0;
+  std::vector<gaussians::RasterCamera> training;
+  for (const io::View& v : scene.views) {
+    if (v.train) training.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
   const bool semantic = !scene.classes.empty();
   for (const io::View& view : scene.views) {
     if (any_test && !view.test) continue;
@@ -134,6 +142,27 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                               .to(r.rgb.device());
     const at::Tensor rgb = r.rgb.clamp(0, 1);
     psnr_sum += gaussians::psnr(rgb, gt);
+    {
+      const at::Tensor inside =
+          at::from_blob(const_cast<std::uint8_t*>(view.mask.pixels.data()), {H, W},
+                        at::TensorOptions().dtype(at::kByte))
+              .to(r.rgb.device())
+              .gt(0);
+      const at::Tensor covered =
+          gaussians::pixelViewCounts(r.depth, r.alpha, gaussians::RasterCamera::fromPinhole(
+                                                             view.camera), training)
+                  .ge(kCoveredMinViews) &
+          inside;
+      const double n = covered.sum().item<double>();
+      evaluated_pixels += inside.sum().item<double>();
+      covered_pixels += n;
+      if (n > 0) {
+        const double mse =
+            ((rgb - gt).pow(2).sum(2) * covered).sum().item<double>() / (3.0 * n);
+        covered_psnr_sum += mse > 0 ? -10.0 * std::log10(mse) : 99.0;
+        ++covered_views;
+      }
+    }
     ssim_sum += gaussians::ssim(rgb, gt).item<double>();
     result.views.push_back(view.name);
 #if SADSPLAT_HAVE_OPENCV
@@ -156,6 +185,9 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   }
   result.psnr = psnr_sum / result.views.size();
   result.ssim = ssim_sum / result.views.size();
+  result.psnr_covered = covered_views > 0 ? covered_psnr_sum / covered_views
+                                          : std::numeric_limits<double>::quiet_NaN();
+  result.covered_fraction = evaluated_pixels > 0 ? covered_pixels / evaluated_pixels : 0.0;
   result.render_ms = 1000.0 * render_seconds / result.views.size();
   return result;
 }
@@ -188,6 +220,10 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
       {"per_class_iou", per_class},
       {"psnr", r.psnr},
       {"ssim", r.ssim},
+      {"psnr_covered",
+       std::isnan(r.psnr_covered) ? nlohmann::json(nullptr) : nlohmann::json(r.psnr_covered)},
+      {"covered_fraction", r.covered_fraction},
+      {"covered_min_views", kCoveredMinViews},
       {"num_gaussians", facts.num_gaussians},
       {"render_ms", r.render_ms},
       {"floaters",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
@@ -47,6 +48,40 @@ at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& 
     counts += seen.to(at::kInt);
   }
   return counts;
+}
+
+at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
+                           const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
+                           double min_alpha) {
+  const std::string what = "<view coverage>";
+  if (camera.orthographic) {
+    throw Error(what, "camera", "a pinhole camera (pixels back-project along rays)",
+                "an orthographic one");
+  }
+  const std::vector<std::int64_t> shape = {camera.height, camera.width};
+  if (depth.sizes() != at::IntArrayRef(shape) || alpha.sizes() != at::IntArrayRef(shape)) {
+    throw Error(what, "depth / alpha",
+                "[" + std::to_string(camera.height) + ", " + std::to_string(camera.width) +
+                    "] images of the camera",
+                "[" + std::to_string(depth.numel()) + "] and [" + std::to_string(alpha.numel()) +
+                    "] values");
+  }
+  const auto opts = depth.options().dtype(at::kDouble);
+  const at::Tensor z = depth.detach().to(at::kDouble);
+  // Pixel centres at +0.5 (the rasterizer's convention), to camera coordinates at depth z.
+  const at::Tensor u = at::arange(camera.width, opts).add(0.5).view({1, -1});
+  const at::Tensor v = at::arange(camera.height, opts).add(0.5).view({-1, 1});
+  const at::Tensor cam = at::stack(
+      {(u - camera.cx) / camera.fx * z, (v - camera.cy) / camera.fy * z, z}, 2).view({-1, 3});
+  // World x = R^T (x_c - t), with R^T's rows R's columns.
+  const double q[4] = {camera.qvec[0], camera.qvec[1], camera.qvec[2], camera.qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  const at::Tensor rows = at::tensor(std::vector<double>(R, R + 9), opts).view({3, 3});
+  const at::Tensor t = at::tensor(std::vector<double>(camera.tvec.begin(), camera.tvec.end()), opts);
+  const at::Tensor world = at::matmul(cam - t, rows);
+  const at::Tensor counts = viewCounts(world, cameras).view(shape);
+  return at::where(alpha.detach() >= min_alpha, counts, at::zeros_like(counts));
 }
 
 at::Tensor floaterMask(const at::Tensor& means, const at::Tensor& log_scales,

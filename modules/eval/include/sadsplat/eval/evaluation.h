@@ -25,11 +25,20 @@ struct FloaterCensus {
 /// \brief Counts the floaters of the trainer's model against the scene's cameras.
 FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& scene);
 
+/// \brief How many training views must see a pixel's surface for EvalResult::psnr_covered.
+constexpr int kCoveredMinViews = 2;
+
 /// \brief Everything measured on the test views.
 struct EvalResult {
   ConfusionMatrix confusion{1};
   double psnr = 0;  ///< mean over test views
   double ssim = 0;  ///< mean over test views
+  /// PSNR over the covered pixels only: those whose surface point (back-projected at the
+  /// model's expected depth) at least kCoveredMinViews training views see. Mean over the views
+  /// with a covered pixel; NaN when none has one. Where a capture leaves the ground of a held-out
+  /// view unseen (the ends of a survey strip), `psnr` scores extrapolation; this does not.
+  double psnr_covered = 0;
+  double covered_fraction = 0;  ///< covered pixels / evaluated pixels (inside the views' masks)
   /// Mean time to render one test view as evaluation renders it (RGB, features, depth), in ms:
   /// 3 renders per view after a warm-up, each waited for (on CUDA, includes one small copy).
   double render_ms = 0;

@@ -23,6 +23,17 @@ double sceneExtent(const std::vector<RasterCamera>& cameras);
 /// the device of `means`.
 at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras);
 
+/// \brief Per pixel of a view rendered through `camera`, how many of `cameras` see the surface
+/// point the pixel shows: the pixel's centre back-projected to its expected `depth` ([H, W],
+/// camera z, as RenderResult::depth), then counted as viewCounts() counts a centre. int32 [H, W]
+/// on the device of `depth`; 0 where `alpha` ([H, W]) is below `min_alpha` (no surface there).
+/// What a held-out view can fairly be scored on: pixels whose surface no training view sees are
+/// extrapolation, not reconstruction.
+/// \throws sadsplat::Error for an orthographic `camera` or shapes that do not match it
+at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
+                           const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
+                           double min_alpha = 0.5);
+
 /// \brief The floaters of a model: Gaussians seen by fewer than `min_views` cameras, or whose
 /// largest scale (standard deviation, world units) exceeds `max_scale`. bool [N] (true = floater).
 /// `log_scales` [N, 3] as the trainer stores them. min_views <= 0 or max_scale <= 0 turns that
