@@ -63,8 +63,11 @@ try:
 except Exception as e:
     print(name, "unreadable", e); sys.exit()
 miou = "%6.2f" % (100 * m["miou"]) if m.get("miou") is not None else "  none"
-print("%-24s mIoU %s  PSNR %6.2f  SSIM %.3f  gaussians %8d  train %5.1f s" % (
-    name, miou, m["psnr"], m["ssim"], m["num_gaussians"], m["train_seconds"]))
+covered = ("  covered %6.2f (%2.0f %%)" % (m["psnr_covered"], 100 * m["covered_fraction"])
+           if m.get("psnr_covered") is not None else "")
+large = m.get("floaters", {}).get("larger_than_10pct_extent")
+print("%-24s mIoU %s  PSNR %6.2f%s  SSIM %.3f  gaussians %8d  large %s  train %5.1f s" % (
+    name, miou, m["psnr"], covered, m["ssim"], m["num_gaussians"], large, m["train_seconds"]))
 PY
 }
 
