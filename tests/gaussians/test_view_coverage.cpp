@@ -93,6 +93,34 @@ TEST(ViewCoverage, PixelsCountTheTrainingViewsThatSeeTheirSurface) {
                Error);
 }
 
+TEST(ViewCoverage, SparseDepthIsTheMedianPerBlockFilledFromTheNearestBlock) {
+  // Camera at x = 0 (100x100, f = 100), blocks of 10 pixels. Points at depth 5 project into
+  // columns 0-9 (x = -2.4 .. -2.1 at z = 5: u = 2 .. 8), a far point alone in its block;
+  // points at depth 10 into columns 90-99; one point behind the camera and one outside the image.
+  std::vector<double> xyz;
+  for (double y : {-0.2, 0.0, 0.2}) {
+    for (double x : {-2.4, -2.3, -2.1}) xyz.insert(xyz.end(), {x, y, 5.0});
+    for (double x : {4.2, 4.5}) xyz.insert(xyz.end(), {x, y, 10.0});
+  }
+  xyz.insert(xyz.end(), {-20.0, 0.0, 50.0});   // (u, v) = (10, 50): block (5, 1), alone
+  xyz.insert(xyz.end(), {0.0, 0.0, -5.0});     // behind
+  xyz.insert(xyz.end(), {100.0, 0.0, 5.0});    // outside
+  const at::Tensor points =
+      at::tensor(xyz, at::kDouble).view({-1, 3}).to(at::kFloat);
+  const at::Tensor depth = gaussians::sparseDepthImage(points, viewCamera(0), 10);
+  ASSERT_TRUE(depth.defined());
+  ASSERT_EQ(depth.sizes(), at::IntArrayRef({100, 100}));
+  EXPECT_FLOAT_EQ(depth[50][5].item<float>(), 5.0f);    // its own block
+  EXPECT_FLOAT_EQ(depth[55][15].item<float>(), 50.0f);  // the lone far point's block
+  EXPECT_FLOAT_EQ(depth[50][95].item<float>(), 10.0f);
+  EXPECT_FLOAT_EQ(depth[0][0].item<float>(), 5.0f);     // empty: the nearest filled block
+  EXPECT_FLOAT_EQ(depth[99][85].item<float>(), 10.0f);
+  // Nothing in front and inside: no depth.
+  EXPECT_FALSE(gaussians::sparseDepthImage(at::tensor({0.0, 0.0, -5.0}).view({1, 3}),
+                                           viewCamera(0), 10)
+                   .defined());
+}
+
 TEST(ViewCoverage, SceneExtentIsTheCamerasRadiusTimes1point1) {
   // Centres (0, 0, 0) and (2, 0, 0): mean (1, 0, 0), radius 1.
   EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0), viewCamera(2)}), 1.1, 1e-12);

@@ -103,6 +103,14 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   for (const io::View& v : scene.views) {
     if (v.train) training.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
   }
+  at::Tensor points;
+  if (!scene.points.empty()) {
+    std::vector<float> xyz;
+    xyz.reserve(3 * scene.points.size());
+    for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+    points = at::tensor(xyz).view({-1, 3});
+  }
+  result.covered_depth = "sparse points";
   const bool semantic = !scene.classes.empty();
   for (const io::View& view : scene.views) {
     if (any_test && !view.test) continue;
@@ -148,11 +156,19 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                         at::TensorOptions().dtype(at::kByte))
               .to(r.rgb.device())
               .gt(0);
+      // The capture's depth (its sparse points) where it has one, so that every model is
+      // scored on the same pixels; else the model's own.
+      const gaussians::RasterCamera camera = gaussians::RasterCamera::fromPinhole(view.camera);
+      const at::Tensor sparse =
+          points.defined() ? gaussians::sparseDepthImage(points, camera) : at::Tensor();
       const at::Tensor covered =
-          gaussians::pixelViewCounts(r.depth, r.alpha, gaussians::RasterCamera::fromPinhole(
-                                                             view.camera), training)
+          (sparse.defined()
+               ? gaussians::pixelViewCounts(sparse.to(r.rgb.device()),
+                                            at::ones_like(r.alpha), camera, training)
+               : gaussians::pixelViewCounts(r.depth, r.alpha, camera, training))
                   .ge(kCoveredMinViews) &
           inside;
+      if (!sparse.defined()) result.covered_depth = "model";
       const double n = covered.sum().item<double>();
       evaluated_pixels += inside.sum().item<double>();
       covered_pixels += n;
@@ -224,6 +240,7 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
        std::isnan(r.psnr_covered) ? nlohmann::json(nullptr) : nlohmann::json(r.psnr_covered)},
       {"covered_fraction", r.covered_fraction},
       {"covered_min_views", kCoveredMinViews},
+      {"covered_depth", r.covered_depth},
       {"num_gaussians", facts.num_gaussians},
       {"render_ms", r.render_ms},
       {"floaters",

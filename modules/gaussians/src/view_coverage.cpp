@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
@@ -82,6 +83,64 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
   const at::Tensor world = at::matmul(cam - t, rows);
   const at::Tensor counts = viewCounts(world, cameras).view(shape);
   return at::where(alpha.detach() >= min_alpha, counts, at::zeros_like(counts));
+}
+
+at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera, int cell) {
+  if (points.dim() != 2 || points.size(1) != 3) {
+    throw Error("<view coverage>", "sparse points", "a [P, 3] tensor",
+                std::to_string(points.dim()) + "-d");
+  }
+  cell = std::max(1, cell);
+  const int W = camera.width, H = camera.height;
+  const int cols = (W + cell - 1) / cell, rows = (H + cell - 1) / cell;
+  const at::Tensor p = points.detach().to(at::kCPU, at::kDouble).contiguous();
+  const double* xyz = p.data_ptr<double>();
+  const double q[4] = {camera.qvec[0], camera.qvec[1], camera.qvec[2], camera.qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  std::vector<std::vector<double>> depths(static_cast<std::size_t>(cols) * rows);
+  for (std::int64_t i = 0; i < p.size(0); ++i) {
+    const double* x = xyz + 3 * i;
+    double c[3];
+    for (int k = 0; k < 3; ++k) {
+      c[k] = R[3 * k] * x[0] + R[3 * k + 1] * x[1] + R[3 * k + 2] * x[2] + camera.tvec[k];
+    }
+    if (!(c[2] > camera.near_plane)) continue;
+    const double u = camera.fx * c[0] / c[2] + camera.cx, v = camera.fy * c[1] / c[2] + camera.cy;
+    if (!(u >= 0 && u < W && v >= 0 && v < H)) continue;
+    depths[static_cast<std::size_t>(static_cast<int>(v) / cell) * cols + static_cast<int>(u) / cell]
+        .push_back(c[2]);
+  }
+  std::vector<double> cell_depth(depths.size(), 0.0);
+  std::vector<int> filled;
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    std::vector<double>& d = depths[k];
+    if (d.empty()) continue;
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    cell_depth[k] = d[d.size() / 2];
+    filled.push_back(static_cast<int>(k));
+  }
+  if (filled.empty()) return at::Tensor();
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    if (!depths[k].empty()) continue;
+    const int r = static_cast<int>(k) / cols, c = static_cast<int>(k) % cols;
+    int best = filled.front();
+    long best_d2 = -1;
+    for (int f : filled) {  // a few hundred blocks per view: the direct search is enough
+      const long dr = f / cols - r, dc = f % cols - c, d2 = dr * dr + dc * dc;
+      if (best_d2 < 0 || d2 < best_d2) best = f, best_d2 = d2;
+    }
+    cell_depth[k] = cell_depth[static_cast<std::size_t>(best)];
+  }
+  at::Tensor image = at::empty({H, W}, at::kFloat);
+  float* out = image.data_ptr<float>();
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      out[static_cast<std::size_t>(y) * W + x] =
+          static_cast<float>(cell_depth[static_cast<std::size_t>(y / cell) * cols + x / cell]);
+    }
+  }
+  return image;
 }
 
 at::Tensor floaterMask(const at::Tensor& means, const at::Tensor& log_scales,

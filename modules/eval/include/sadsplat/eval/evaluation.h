@@ -33,12 +33,15 @@ struct EvalResult {
   ConfusionMatrix confusion{1};
   double psnr = 0;  ///< mean over test views
   double ssim = 0;  ///< mean over test views
-  /// PSNR over the covered pixels only: those whose surface point (back-projected at the
-  /// model's expected depth) at least kCoveredMinViews training views see. Mean over the views
-  /// with a covered pixel; NaN when none has one. Where a capture leaves the ground of a held-out
-  /// view unseen (the ends of a survey strip), `psnr` scores extrapolation; this does not.
+  /// PSNR over the covered pixels only: those whose surface point at least kCoveredMinViews
+  /// training views see. The surface point: the pixel back-projected at the depth of the scene's
+  /// sparse points (gaussians::sparseDepthImage: the same pixels for every model), or at the
+  /// model's expected depth in a view no sparse point falls into. Mean over the views with a
+  /// covered pixel; NaN when none has one. Where a capture leaves the ground of a held-out view
+  /// unseen (the ends of a survey strip), `psnr` scores extrapolation; this does not.
   double psnr_covered = 0;
   double covered_fraction = 0;  ///< covered pixels / evaluated pixels (inside the views' masks)
+  std::string covered_depth;    ///< "sparse points", or "model" when a view used the model's
   /// Mean time to render one test view as evaluation renders it (RGB, features, depth), in ms:
   /// 3 renders per view after a warm-up, each waited for (on CUDA, includes one small copy).
   double render_ms = 0;

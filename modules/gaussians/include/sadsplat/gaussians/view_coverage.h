@@ -34,6 +34,13 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                            const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
                            double min_alpha = 0.5);
 
+/// \brief A coarse depth image of a view from a scene's sparse points ([P, 3], world): the
+/// median camera z of the points that project into each `cell` x `cell` pixel block; blocks
+/// without a point take the depth of the nearest block with one. float [H, W] on the CPU, or an
+/// undefined tensor when no point lies in front of the camera and inside its image. Depth that
+/// belongs to the capture, not to a model: what pixelViewCounts() needs to score models alike.
+at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera, int cell = 32);
+
 /// \brief The floaters of a model: Gaussians seen by fewer than `min_views` cameras, or whose
 /// largest scale (standard deviation, world units) exceeds `max_scale`. bool [N] (true = floater).
 /// `log_scales` [N, 3] as the trainer stores them. min_views <= 0 or max_scale <= 0 turns that
