@@ -137,6 +137,42 @@ TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
   EXPECT_TRUE(std::isfinite(stats.rgb_loss));
 }
 
+// scale_limit_from: no bound before that iteration; at it, the Gaussians above the limit are
+// split (more rows, every state consistent) and from then on none exceeds it.
+TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : scene_.views) {
+    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  const double extent = gaussians::sceneExtent(cameras);
+  TrainConfig config = small(60);
+  const auto largest = [](const Trainer& t) {
+    return t.parameters().log_scales.detach().max().exp().item<double>();
+  };
+  const auto above = [](const Trainer& t, double bound) {
+    return (std::get<0>(t.parameters().log_scales.detach().max(1)).exp() > bound)
+        .sum()
+        .item<std::int64_t>();
+  };
+  const double limit = 0.5 * largest(Trainer(scene_, config)) / extent;
+  config.scale_limit = limit;
+  config.scale_limit_from = 30;
+  Trainer late(scene_, config);
+  for (int i = 0; i < 29; ++i) late.step(false);
+  const std::int64_t large = above(late, limit * extent);
+  ASSERT_GT(large, 0) << "no Gaussian above the limit before it holds: the test shows nothing";
+  const std::int64_t before = late.numGaussians();
+  late.step(false);  // iteration 30: split, then clamped
+  EXPECT_GE(late.numGaussians(), before + large);  // each split adds at least one row
+  EXPECT_LE(largest(late), limit * extent);
+  late.checkConsistency();
+  for (int i = 30; i < 60; ++i) {
+    late.step(false);
+    ASSERT_LE(largest(late), limit * extent) << "after step " << i + 1;
+  }
+  EXPECT_TRUE(std::isfinite(late.step().rgb_loss));
+}
+
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label
 // map); returns how many views got them.
 int pseudoLabelTheUnlabelledViews(io::Scene& scene) {

@@ -68,6 +68,18 @@ TEST(ViewCoverage, PixelsCountTheTrainingViewsThatSeeTheirSurface) {
   EXPECT_EQ(counts[99][99].item<int>(), 2);
   EXPECT_EQ(counts[7][70].item<int>(), 0);
   EXPECT_EQ(counts.eq(2).sum().item<int>(), 60 * 100 - 1);
+  // In blocks of 4 (column 40 starts one), and of 3 (columns 39-41 share pixel 40's count; the
+  // last block, column 99, is cut by the image's edge: its own pixel stands for it).
+  EXPECT_TRUE(at::equal(gaussians::pixelViewCounts(depth, alpha, viewCamera(0),
+                                                   {viewCamera(0), viewCamera(2)}, 0.5, 4),
+                        counts));
+  const at::Tensor by3 = gaussians::pixelViewCounts(depth, alpha, viewCamera(0),
+                                                    {viewCamera(0), viewCamera(2)}, 0.5, 3);
+  ASSERT_EQ(by3.sizes(), at::IntArrayRef({100, 100}));
+  EXPECT_EQ(by3[50][38].item<int>(), 1);
+  EXPECT_EQ(by3[50][39].item<int>(), 2);
+  EXPECT_EQ(by3[99][99].item<int>(), 2);
+  EXPECT_EQ(by3[7][70].item<int>(), 0);
 
   // A rotated, moved camera sees every pixel it back-projects (a transposed rotation would not):
   // 90 degrees about x, then 30 about y, centre away from the origin.

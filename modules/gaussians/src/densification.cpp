@@ -53,7 +53,8 @@ class DefaultDensification : public DensificationStrategy {
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
     const TrainConfig& c = config_;
-    if (c.scale_limit > 0) {
+    if (c.scale_limit > 0 && done >= c.scale_limit_from) {
+      if (done == c.scale_limit_from) splitAbove(params, c.scale_limit * extent_, done, resize);
       // A projection onto the bound (Adam's moments stay as they are). 1e-6 below it, so that
       // exp() of the float log-scale never rounds above the bound (it did by 6e-8 of it).
       params["scales"].value.clamp_max_(std::log(c.scale_limit * extent_) - 1e-6);
@@ -179,6 +180,22 @@ class DefaultDensification : public DensificationStrategy {
     if (!large.any().item<bool>()) return;
     const at::Tensor idx = large.nonzero().squeeze(1);
     resize(large.logical_not(), splitRows(params, idx, scales, iteration, 11));
+    grad_accum_.zero_();
+    denom_.zero_();
+    max_radii_.zero_();
+  }
+
+  // Splits every Gaussian larger than `bound` (world units) until none is, in at most kRounds
+  // rounds of 3DGS's split (each: two samples, scales / 1.6); the clamp takes what is left.
+  void splitAbove(ParameterStore& params, double bound, int iteration, const Resize& resize) {
+    constexpr int kRounds = 8;
+    for (int round = 0; round < kRounds; ++round) {
+      const at::Tensor scales = params["scales"].value.detach().exp();
+      const at::Tensor large = std::get<0>(scales.max(1)) > bound;
+      if (!large.any().item<bool>()) break;
+      const at::Tensor idx = large.nonzero().squeeze(1);
+      resize(large.logical_not(), splitRows(params, idx, scales, iteration, 101 + round));
+    }
     grad_accum_.zero_();
     denom_.zero_();
     max_radii_.zero_();

@@ -166,6 +166,10 @@ const std::vector<TrainOption> kOptions = {
      "no Gaussian's scale exceeds this x the scene extent: log-scales clamped after every step "
      "(0: off)",
      "--scale-limit", 0, kInf},
+    {"scale_limit_from", &C::scale_limit_from,
+     "the iteration from which scale_limit holds; Gaussians above it are split there first (0: "
+     "from the start, no split)",
+     "--scale-limit-from", 0, kInf},
     {"seed", &C::seed, "random seed", "--seed"},
     {"init", &C::init,
      "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "

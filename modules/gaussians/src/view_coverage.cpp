@@ -53,7 +53,7 @@ at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& 
 
 at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                            const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
-                           double min_alpha) {
+                           double min_alpha, int stride) {
   const std::string what = "<view coverage>";
   if (camera.orthographic) {
     throw Error(what, "camera", "a pinhole camera (pixels back-project along rays)",
@@ -67,11 +67,21 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                 "[" + std::to_string(depth.numel()) + "] and [" + std::to_string(alpha.numel()) +
                     "] values");
   }
+  stride = std::max(1, stride);
   const auto opts = depth.options().dtype(at::kDouble);
-  const at::Tensor z = depth.detach().to(at::kDouble);
+  // One pixel of each stride x stride block (its centre, rounded down; inside the image for a
+  // block the edge cuts) stands for the block.
+  const std::int64_t first = (stride - 1) / 2;
+  const auto lopts = opts.dtype(at::kLong);
+  const at::Tensor cols = at::arange(0, camera.width, stride, lopts).add(first).clamp_max(
+      camera.width - 1);
+  const at::Tensor rows_idx = at::arange(0, camera.height, stride, lopts).add(first).clamp_max(
+      camera.height - 1);
+  const at::Tensor z =
+      depth.detach().to(at::kDouble).index_select(0, rows_idx).index_select(1, cols);
   // Pixel centres at +0.5 (the rasterizer's convention), to camera coordinates at depth z.
-  const at::Tensor u = at::arange(camera.width, opts).add(0.5).view({1, -1});
-  const at::Tensor v = at::arange(camera.height, opts).add(0.5).view({-1, 1});
+  const at::Tensor u = cols.to(at::kDouble).add(0.5).view({1, -1});
+  const at::Tensor v = rows_idx.to(at::kDouble).add(0.5).view({-1, 1});
   const at::Tensor cam = at::stack(
       {(u - camera.cx) / camera.fx * z, (v - camera.cy) / camera.fy * z, z}, 2).view({-1, 3});
   // World x = R^T (x_c - t), with R^T's rows R's columns.
@@ -81,7 +91,14 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
   const at::Tensor rows = at::tensor(std::vector<double>(R, R + 9), opts).view({3, 3});
   const at::Tensor t = at::tensor(std::vector<double>(camera.tvec.begin(), camera.tvec.end()), opts);
   const at::Tensor world = at::matmul(cam - t, rows);
-  const at::Tensor counts = viewCounts(world, cameras).view(shape);
+  at::Tensor counts = viewCounts(world, cameras).view({rows_idx.size(0), cols.size(0)});
+  if (stride > 1) {
+    counts = counts.repeat_interleave(stride, 0)
+                 .repeat_interleave(stride, 1)
+                 .narrow(0, 0, camera.height)
+                 .narrow(1, 0, camera.width)
+                 .contiguous();
+  }
   return at::where(alpha.detach() >= min_alpha, counts, at::zeros_like(counts));
 }
 

@@ -87,6 +87,11 @@ struct TrainConfig {
   /// 0.1 x the extent) do not form; smaller ones densify into what they would have covered.
   /// 0 = off.
   double scale_limit = 0.0;
+  /// The iteration from which scale_limit holds (0: from the start). At it, every Gaussian
+  /// larger than the limit is first split (3DGS's split, repeated up to 8 times: scales / 1.6
+  /// each), so that what it covered stays covered; the clamp then keeps them within the limit.
+  /// Late (e.g. iterations - 1000), the training and the drop run as without a limit until then.
+  int scale_limit_from = 0;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
   // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the

@@ -28,11 +28,13 @@ at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& 
 /// camera z, as RenderResult::depth), then counted as viewCounts() counts a centre. int32 [H, W]
 /// on the device of `depth`; 0 where `alpha` ([H, W]) is below `min_alpha` (no surface there).
 /// What a held-out view can fairly be scored on: pixels whose surface no training view sees are
-/// extrapolation, not reconstruction.
+/// extrapolation, not reconstruction. `stride` > 1 back-projects one pixel per stride x stride
+/// block (the one at its centre, rounded down) and gives its count to the whole block: stride^2
+/// times less work for large images and many cameras.
 /// \throws sadsplat::Error for an orthographic `camera` or shapes that do not match it
 at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                            const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
-                           double min_alpha = 0.5);
+                           double min_alpha = 0.5, int stride = 1);
 
 /// \brief A coarse depth image of a view from a scene's sparse points ([P, 3], world): the
 /// median camera z of the points that project into each `cell` x `cell` pixel block; blocks
