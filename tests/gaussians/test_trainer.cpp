@@ -122,12 +122,14 @@ TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
   const auto largest = [](const Trainer& t) {
     return t.parameters().log_scales.detach().max().exp().item<double>();
   };
+  config.scale_limit = 0;  // off
   Trainer free(scene_, config);
   const double limit = 0.5 * largest(free) / extent;  // half the largest initial scale
   for (int i = 0; i < 60; ++i) free.step(false);
   EXPECT_GT(largest(free), limit * extent * 1.05);
 
   config.scale_limit = limit;
+  config.scale_limit_from = 0;  // from the start
   Trainer bounded(scene_, config);
   for (int i = 0; i < 60; ++i) {
     bounded.step(false);
@@ -171,6 +173,10 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
     ASSERT_LE(largest(late), limit * extent) << "after step " << i + 1;
   }
   EXPECT_TRUE(std::isfinite(late.step().rgb_loss));
+  // The default: a limit of 0.1 x the extent from iterations - iterations / 7 on.
+  const Trainer by_default(scene_, small(70));
+  EXPECT_EQ(by_default.config().scale_limit, 0.1);
+  EXPECT_EQ(by_default.config().scale_limit_from, 60);
 }
 
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label

@@ -84,6 +84,7 @@ TrainConfig TrainConfig::forGlobalBatch(int views) const {
   c.recovery_iterations = steps(recovery_iterations);
   c.lambda_l0_from = steps(lambda_l0_from);
   c.lambda_l0_ramp = steps(lambda_l0_ramp);
+  c.scale_limit_from = steps(scale_limit_from);
   const double lr = std::sqrt(static_cast<double>(views));
   for (double* rate :
        {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest, &c.lr_opacity,
@@ -168,8 +169,8 @@ const std::vector<TrainOption> kOptions = {
      "--scale-limit", 0, kInf},
     {"scale_limit_from", &C::scale_limit_from,
      "the iteration from which scale_limit holds; Gaussians above it are split there first (0: "
-     "from the start, no split)",
-     "--scale-limit-from", 0, kInf},
+     "from the start, no split; -1: iterations - iterations / 7, 6000 of 7000)",
+     "--scale-limit-from", -1, kInf},
     {"seed", &C::seed, "random seed", "--seed"},
     {"init", &C::init,
      "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "

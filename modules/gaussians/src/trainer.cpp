@@ -84,6 +84,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
     s.device = at::Device(at::kCUDA, 0);
   }
   if (s.config.densify_until < 0) s.config.densify_until = config.iterations / 2;
+  if (s.config.scale_limit_from < 0) {
+    s.config.scale_limit_from = config.iterations - config.iterations / 7;
+  }
   s.num_classes = static_cast<int>(scene.classes.size());
   // A scene without classes trains plain 3DGS: no features, no decoder rows, no semantic loss.
   if (s.num_classes == 0) s.config.feature_dim = 0;

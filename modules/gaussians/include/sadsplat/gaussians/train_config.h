@@ -82,16 +82,16 @@ struct TrainConfig {
   double large_split_scale = 0.0;
   int large_split_last = 500;
   /// Not 3DGS: no Gaussian's scale (standard deviation along any axis) exceeds scale_limit x
-  /// the scene extent. The log-scales are clamped after every optimiser step (a projection onto
-  /// the bound), so the large, blurry Gaussians that the floater census counts (larger than
-  /// 0.1 x the extent) do not form; smaller ones densify into what they would have covered.
-  /// 0 = off.
-  double scale_limit = 0.0;
-  /// The iteration from which scale_limit holds (0: from the start). At it, every Gaussian
-  /// larger than the limit is first split (3DGS's split, repeated up to 8 times: scales / 1.6
-  /// each), so that what it covered stays covered; the clamp then keeps them within the limit.
-  /// Late (e.g. iterations - 1000), the training and the drop run as without a limit until then.
-  int scale_limit_from = 0;
+  /// the scene extent from iteration scale_limit_from on. The log-scales are clamped after every
+  /// optimiser step (a projection onto the bound), so the large, blurry Gaussians that the
+  /// floater census counts (larger than 0.1 x the extent) do not stay. 0 = off.
+  double scale_limit = 0.1;
+  /// The iteration from which scale_limit holds. At it, every Gaussian larger than the limit is
+  /// first split (3DGS's split, repeated up to 8 times: scales / 1.6 each), so that what it
+  /// covered stays covered; the clamp then keeps them within the limit. Until then the training
+  /// and the drop run as without a limit. -1 (default): iterations - iterations / 7 (6000 of
+  /// 7000); 0: from the start, without a split (the large ones are clamped as they form).
+  int scale_limit_from = -1;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
   // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
