@@ -249,6 +249,8 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
     EXPECT_TRUE(nonBlank(run + "/report/" + png)) << png;
   }
   EXPECT_NE(md.find("| mIoU (%) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| PSNR on covered pixels (dB) | "), std::string::npos) << md;
+  EXPECT_EQ(md.find("| PSNR on covered pixels (dB) | - |"), std::string::npos) << md;  // a value
   EXPECT_NE(md.find("| | full/run | base/run |"), std::string::npos) << md;
   EXPECT_NE(md.find("](../panels/view_002.png)"), std::string::npos) << md;
   EXPECT_NE(md.find("| 10 | "), std::string::npos) << md;  // the drop event at iteration 10

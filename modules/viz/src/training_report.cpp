@@ -174,6 +174,8 @@ std::string writeTrainingReport(const ReportOptions& options) {
   row("mAcc (%)", "macc", 100, 2);
   row("OA (%)", "oacc", 100, 2);
   row("PSNR (dB)", "psnr", 1, 2);
+  row("PSNR on covered pixels (dB)", "psnr_covered", 1, 2);
+  row("covered pixels (%)", "covered_fraction", 100, 1);
   row("SSIM", "ssim", 1, 4);
   row("Gaussians", "num_gaussians", 1, 0);
   row("iterations", "iterations", 1, 0);
