@@ -166,7 +166,9 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
   ASSERT_GT(large, 0) << "no Gaussian above the limit before it holds: the test shows nothing";
   const std::int64_t before = late.numGaussians();
   late.step(false);  // iteration 30: split, then clamped
-  EXPECT_GE(late.numGaussians(), before + large);  // each split adds at least one row
+  // Each split adds a row, a quarter of the model at most.
+  EXPECT_GE(late.numGaussians(), before + std::min(large, before / 4));
+  EXPECT_LE(late.numGaussians(), before + before / 4);
   EXPECT_LE(largest(late), limit * extent);
   late.checkConsistency();
   for (int i = 30; i < 60; ++i) {
@@ -174,6 +176,15 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
     ASSERT_LE(largest(late), limit * extent) << "after step " << i + 1;
   }
   EXPECT_TRUE(std::isfinite(late.step().rgb_loss));
+  // Every Gaussian above a tiny limit: the split stops at a quarter more rows; the clamp holds.
+  config.scale_limit = 1e-6;
+  Trainer tiny(scene_, config);
+  for (int i = 0; i < 29; ++i) tiny.step(false);
+  const std::int64_t rows = tiny.numGaussians();
+  tiny.step(false);
+  EXPECT_EQ(tiny.numGaussians(), rows + rows / 4);
+  EXPECT_LE(largest(tiny), 1e-6 * extent);
+  tiny.checkConsistency();
   // The default: a limit of 0.1 x the extent from iterations - iterations / 7 on.
   const Trainer by_default(scene_, small(70));
   EXPECT_EQ(by_default.config().scale_limit, 0.1);

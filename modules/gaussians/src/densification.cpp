@@ -186,15 +186,28 @@ class DefaultDensification : public DensificationStrategy {
   }
 
   // Splits every Gaussian larger than `bound` (world units) until none is, in at most kRounds
-  // rounds of 3DGS's split (each: two samples, scales / 1.6); the clamp takes what is left.
+  // rounds of 3DGS's split (each: two samples, scales / 1.6); the clamp takes what is left. The
+  // split adds at most a quarter of the model's rows (and stays within max_gaussians): past that,
+  // a round splits its largest Gaussians only, so a scene of huge splats cannot blow up the model.
   void splitAbove(ParameterStore& params, double bound, int iteration, const Resize& resize) {
     constexpr int kRounds = 8;
-    for (int round = 0; round < kRounds; ++round) {
+    const std::int64_t budget =
+        std::min<std::int64_t>(params.rows() / 4, config_.max_gaussians - params.rows());
+    std::int64_t added = 0;
+    for (int round = 0; round < kRounds && added < budget; ++round) {
       const at::Tensor scales = params["scales"].value.detach().exp();
-      const at::Tensor large = std::get<0>(scales.max(1)) > bound;
-      if (!large.any().item<bool>()) break;
-      const at::Tensor idx = large.nonzero().squeeze(1);
-      resize(large.logical_not(), splitRows(params, idx, scales, iteration, 101 + round));
+      const at::Tensor largest = std::get<0>(scales.max(1));
+      const at::Tensor large = largest > bound;
+      const std::int64_t count = large.sum().item<std::int64_t>();
+      if (count == 0) break;
+      at::Tensor split = large;
+      if (count > budget - added) {  // the largest that fit: each split adds one row
+        const at::Tensor top = std::get<1>(largest.topk(budget - added));
+        split = at::zeros_like(large).index_fill_(0, top, true);
+      }
+      const at::Tensor idx = split.nonzero().squeeze(1);
+      added += idx.size(0);
+      resize(split.logical_not(), splitRows(params, idx, scales, iteration, 101 + round));
     }
     grad_accum_.zero_();
     denom_.zero_();

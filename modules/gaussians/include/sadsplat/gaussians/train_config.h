@@ -87,8 +87,9 @@ struct TrainConfig {
   /// floater census counts (larger than 0.1 x the extent) do not stay. 0 = off.
   double scale_limit = 0.1;
   /// The iteration from which scale_limit holds. At it, every Gaussian larger than the limit is
-  /// first split (3DGS's split, repeated up to 8 times: scales / 1.6 each), so that what it
-  /// covered stays covered; the clamp then keeps them within the limit. Until then the training
+  /// first split (3DGS's split, repeated up to 8 times: scales / 1.6 each; the split adds at
+  /// most a quarter of the model, the largest first), so that what it covered stays covered; the
+  /// clamp then keeps them within the limit. Until then the training
   /// and the drop run as without a limit. -1 (default): iterations - iterations / 7 (6000 of
   /// 7000); 0: from the start, without a split (the large ones are clamped as they form).
   int scale_limit_from = -1;
