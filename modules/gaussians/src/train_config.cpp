@@ -164,8 +164,8 @@ const std::vector<TrainOption> kOptions = {
     {"large_split_last", &C::large_split_last,
      "the last iterations without large-Gaussian splits", nullptr, 0, kInf},
     {"scale_limit", &C::scale_limit,
-     "no Gaussian's scale exceeds this x the scene extent: log-scales clamped after every step "
-     "(0: off)",
+     "no Gaussian's scale exceeds this x the scene extent from scale_limit_from on: log-scales "
+     "clamped after every step (0: off)",
      "--scale-limit", 0, kInf},
     {"scale_limit_from", &C::scale_limit_from,
      "the iteration from which scale_limit holds; Gaussians above it are split there first (0: "
