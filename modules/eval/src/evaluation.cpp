@@ -68,6 +68,16 @@ void writePanel(const std::string& path, const io::View& view, const at::Tensor&
 }
 #endif
 
+// The cameras of every view of the scene, or of its training views only.
+std::vector<gaussians::RasterCamera> camerasOf(const io::Scene& scene, bool training_only) {
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : scene.views) {
+    if (v.train || !training_only)
+      cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  return cameras;
+}
+
 // Coverage is counted once per 4 x 4 pixels (the sparse depth is per 32 x 32): 16 times less
 // work for surveys of many large photos.
 constexpr int kCoverageStride = 4;
@@ -75,11 +85,8 @@ constexpr int kCoverageStride = 4;
 }  // namespace
 
 FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& scene) {
-  std::vector<gaussians::RasterCamera> all, training;
-  for (const io::View& v : scene.views) {
-    all.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-    if (v.train) training.push_back(all.back());
-  }
+  const std::vector<gaussians::RasterCamera> all = camerasOf(scene, false);
+  const std::vector<gaussians::RasterCamera> training = camerasOf(scene, true);
   const gaussians::GaussianParams g = trainer.parameters();
   FloaterCensus census;
   census.extent = gaussians::sceneExtent(all);
@@ -103,10 +110,7 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   double psnr_sum = 0, ssim_sum = 0, render_seconds = 0;
   double covered_psnr_sum = 0, covered_pixels = 0, evaluated_pixels = 0;
   int covered_views = 0;
-  std::vector<gaussians::RasterCamera> training;
-  for (const io::View& v : scene.views) {
-    if (v.train) training.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-  }
+  const std::vector<gaussians::RasterCamera> training = camerasOf(scene, true);
   at::Tensor points;
   if (!scene.points.empty()) {
     std::vector<float> xyz;
@@ -129,9 +133,9 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     }
     const std::size_t pixels = static_cast<std::size_t>(view.camera.width) * view.camera.height;
     // Ignore everywhere when the view has no label map: the image metrics still count.
-    std::vector<std::uint8_t> labels =
-        view.labels.empty() ? std::vector<std::uint8_t>(pixels, io::kIgnoreLabel)
-                            : view.labels.pixels;
+    std::vector<std::uint8_t> labels = view.labels.empty()
+                                           ? std::vector<std::uint8_t>(pixels, io::kIgnoreLabel)
+                                           : view.labels.pixels;
     std::vector<std::uint8_t> pred8(pixels, io::kIgnoreLabel);
     if (semantic) {
       const at::Tensor pred = trainer.predictClasses(r).to(at::kCPU).contiguous();
@@ -155,11 +159,10 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     const at::Tensor rgb = r.rgb.clamp(0, 1);
     psnr_sum += gaussians::psnr(rgb, gt);
     {
-      const at::Tensor inside =
-          at::from_blob(const_cast<std::uint8_t*>(view.mask.pixels.data()), {H, W},
-                        at::TensorOptions().dtype(at::kByte))
-              .to(r.rgb.device())
-              .gt(0);
+      const at::Tensor inside = at::from_blob(const_cast<std::uint8_t*>(view.mask.pixels.data()),
+                                              {H, W}, at::TensorOptions().dtype(at::kByte))
+                                    .to(r.rgb.device())
+                                    .gt(0);
       // The capture's depth (its sparse points) where it has one, so that every model is
       // scored on the same pixels; else the model's own.
       const gaussians::RasterCamera camera = gaussians::RasterCamera::fromPinhole(view.camera);
@@ -171,15 +174,14 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                                             camera, training, 0.5, kCoverageStride)
                : gaussians::pixelViewCounts(r.depth, r.alpha, camera, training, 0.5,
                                             kCoverageStride))
-                  .ge(kCoveredMinViews) &
+              .ge(kCoveredMinViews) &
           inside;
       if (!sparse.defined()) result.covered_depth = "model";
       const double n = covered.sum().item<double>();
       evaluated_pixels += inside.sum().item<double>();
       covered_pixels += n;
       if (n > 0) {
-        const double mse =
-            ((rgb - gt).pow(2).sum(2) * covered).sum().item<double>() / (3.0 * n);
+        const double mse = ((rgb - gt).pow(2).sum(2) * covered).sum().item<double>() / (3.0 * n);
         covered_psnr_sum += mse > 0 ? -10.0 * std::log10(mse) : 99.0;
         ++covered_views;
       }
@@ -200,8 +202,7 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   if (!semantic) {
     result.miou_note = "no classes (the scene has no classes.json): image metrics only";
   } else if (result.labelled_views == 0) {
-    result.miou_note = std::string("no label map on any ") +
-                       (any_test ? "test" : "") +
+    result.miou_note = std::string("no label map on any ") + (any_test ? "test" : "") +
                        " view: add labels/ (or import annotations) for mIoU";
   }
   result.psnr = psnr_sum / result.views.size();
@@ -230,7 +231,9 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
   for (const auto& c : classes) names.push_back(c.name);
   // No labelled pixel scored: the class metrics are null (not 0) and the note says why.
   const bool scored = r.miou_note.empty();
-  const auto metric = [&](double v) { return scored ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const auto metric = [&](double v) {
+    return scored ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
   const nlohmann::json j = {
       {"miou", metric(r.confusion.meanIou())},
       {"macc", metric(r.confusion.meanAccuracy())},

@@ -104,9 +104,8 @@ class DefaultDensification : public DensificationStrategy {
   }
 
  private:
-  void densifyAndPrune(ParameterStore& params,
-                       const std::function<at::Tensor()>& effective_opacity, bool prune_big,
-                       int iteration, const Resize& resize) {
+  void densifyAndPrune(ParameterStore& params, const std::function<at::Tensor()>& effective_opacity,
+                       bool prune_big, int iteration, const Resize& resize) {
     const TrainConfig& c = config_;
     const at::Tensor avg = grad_accum_ / denom_.clamp_min(1);
     const at::Tensor scales = params["scales"].value.detach().exp();
@@ -134,9 +133,7 @@ class DefaultDensification : public DensificationStrategy {
     }
     keep = keep & remove.logical_not();
     resize(keep, extra);
-    grad_accum_.zero_();  // the statistics start again with the new rows
-    denom_.zero_();
-    max_radii_.zero_();
+    clearStatistics();  // the statistics start again with the new rows
   }
 
   // Split: two samples from each Gaussian of `idx`, scales divided by 1.6 (3DGS); the new rows
@@ -180,9 +177,7 @@ class DefaultDensification : public DensificationStrategy {
     if (!large.any().item<bool>()) return;
     const at::Tensor idx = large.nonzero().squeeze(1);
     resize(large.logical_not(), splitRows(params, idx, scales, iteration, 11));
-    grad_accum_.zero_();
-    denom_.zero_();
-    max_radii_.zero_();
+    clearStatistics();
   }
 
   // Splits every Gaussian larger than `bound` (world units) until none is, in at most kRounds
@@ -209,6 +204,11 @@ class DefaultDensification : public DensificationStrategy {
       added += idx.size(0);
       resize(split.logical_not(), splitRows(params, idx, scales, iteration, 101 + round));
     }
+    clearStatistics();
+  }
+
+  // After rows change, the accumulated screen-space statistics start again.
+  void clearStatistics() {
     grad_accum_.zero_();
     denom_.zero_();
     max_radii_.zero_();

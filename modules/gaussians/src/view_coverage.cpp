@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sadsplat/common/error.h"
@@ -10,6 +11,39 @@
 
 namespace sadsplat {
 namespace gaussians {
+namespace {
+
+// The world-to-camera rotation R ([3, 3], one row per camera axis) and translation t ([3]) of a
+// camera, as double tensors: x_c = R x + t.
+std::pair<at::Tensor, at::Tensor> cameraPose(const RasterCamera& c, const at::TensorOptions& opts) {
+  const double q[4] = {c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]};
+  double R[9];
+  raster::quatToRotation(q, R);
+  return {at::tensor(std::vector<double>(R, R + 9), opts).view({3, 3}),
+          at::tensor(std::vector<double>(c.tvec.begin(), c.tvec.end()), opts)};
+}
+
+// Where a camera sees world points (`m`, [N, 3] double): pixel coordinates, camera z, and
+// whether each point lies beyond the near plane and inside the image.
+struct Projection {
+  at::Tensor u, v, z, seen;
+};
+
+Projection project(const at::Tensor& m, const RasterCamera& c) {
+  const auto [R, t] = cameraPose(c, m.options());
+  const at::Tensor cam = at::matmul(m, R.t()) + t;
+  const at::Tensor x = cam.select(1, 0), y = cam.select(1, 1), z = cam.select(1, 2);
+  const at::Tensor in_front = z > c.near_plane;
+  const at::Tensor zs = at::where(in_front, z, at::ones_like(z));
+  Projection p;
+  p.u = c.fx * x / zs + c.cx;
+  p.v = c.fy * y / zs + c.cy;
+  p.z = z;
+  p.seen = in_front & (p.u >= 0) & (p.u < c.width) & (p.v >= 0) & (p.v < c.height);
+  return p;
+}
+
+}  // namespace
 
 double sceneExtent(const std::vector<RasterCamera>& cameras) {
   if (cameras.empty()) return 1e-3;
@@ -33,21 +67,7 @@ at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& 
   }
   const at::Tensor m = means.detach().to(at::kDouble);
   at::Tensor counts = at::zeros({means.size(0)}, means.options().dtype(at::kInt));
-  for (const RasterCamera& c : cameras) {
-    const double q[4] = {c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]};
-    double R[9];
-    raster::quatToRotation(q, R);
-    // Camera coordinates x_c = R x + t, one row of R per axis.
-    const at::Tensor rows = at::tensor(std::vector<double>(R, R + 9), m.options()).view({3, 3});
-    const at::Tensor t = at::tensor(std::vector<double>(c.tvec.begin(), c.tvec.end()), m.options());
-    const at::Tensor cam = at::matmul(m, rows.t()) + t;
-    const at::Tensor x = cam.select(1, 0), y = cam.select(1, 1), z = cam.select(1, 2);
-    const at::Tensor in_front = z > c.near_plane;
-    const at::Tensor zs = at::where(in_front, z, at::ones_like(z));
-    const at::Tensor u = c.fx * x / zs + c.cx, v = c.fy * y / zs + c.cy;
-    const at::Tensor seen = in_front & (u >= 0) & (u < c.width) & (v >= 0) & (v < c.height);
-    counts += seen.to(at::kInt);
-  }
+  for (const RasterCamera& c : cameras) counts += project(m, c).seen.to(at::kInt);
   return counts;
 }
 
@@ -73,24 +93,21 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
   // block the edge cuts) stands for the block.
   const std::int64_t first = (stride - 1) / 2;
   const auto lopts = opts.dtype(at::kLong);
-  const at::Tensor cols = at::arange(0, camera.width, stride, lopts).add(first).clamp_max(
-      camera.width - 1);
-  const at::Tensor rows_idx = at::arange(0, camera.height, stride, lopts).add(first).clamp_max(
-      camera.height - 1);
+  const at::Tensor cols =
+      at::arange(0, camera.width, stride, lopts).add(first).clamp_max(camera.width - 1);
+  const at::Tensor rows_idx =
+      at::arange(0, camera.height, stride, lopts).add(first).clamp_max(camera.height - 1);
   const at::Tensor z =
       depth.detach().to(at::kDouble).index_select(0, rows_idx).index_select(1, cols);
   // Pixel centres at +0.5 (the rasterizer's convention), to camera coordinates at depth z.
   const at::Tensor u = cols.to(at::kDouble).add(0.5).view({1, -1});
   const at::Tensor v = rows_idx.to(at::kDouble).add(0.5).view({-1, 1});
-  const at::Tensor cam = at::stack(
-      {(u - camera.cx) / camera.fx * z, (v - camera.cy) / camera.fy * z, z}, 2).view({-1, 3});
-  // World x = R^T (x_c - t), with R^T's rows R's columns.
-  const double q[4] = {camera.qvec[0], camera.qvec[1], camera.qvec[2], camera.qvec[3]};
-  double R[9];
-  raster::quatToRotation(q, R);
-  const at::Tensor rows = at::tensor(std::vector<double>(R, R + 9), opts).view({3, 3});
-  const at::Tensor t = at::tensor(std::vector<double>(camera.tvec.begin(), camera.tvec.end()), opts);
-  const at::Tensor world = at::matmul(cam - t, rows);
+  const at::Tensor cam =
+      at::stack({(u - camera.cx) / camera.fx * z, (v - camera.cy) / camera.fy * z, z}, 2)
+          .view({-1, 3});
+  // World x = R^T (x_c - t): as rows, (x_c - t) R.
+  const auto [R, t] = cameraPose(camera, opts);
+  const at::Tensor world = at::matmul(cam - t, R);
   at::Tensor counts = viewCounts(world, cameras).view({rows_idx.size(0), cols.size(0)});
   if (stride > 1) {
     counts = counts.repeat_interleave(stride, 0)
@@ -110,23 +127,16 @@ at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera
   cell = std::max(1, cell);
   const int W = camera.width, H = camera.height;
   const int cols = (W + cell - 1) / cell, rows = (H + cell - 1) / cell;
-  const at::Tensor p = points.detach().to(at::kCPU, at::kDouble).contiguous();
-  const double* xyz = p.data_ptr<double>();
-  const double q[4] = {camera.qvec[0], camera.qvec[1], camera.qvec[2], camera.qvec[3]};
-  double R[9];
-  raster::quatToRotation(q, R);
+  const Projection p = project(points.detach().to(at::kCPU, at::kDouble), camera);
+  const auto u = p.u.accessor<double, 1>(), v = p.v.accessor<double, 1>(),
+             z = p.z.accessor<double, 1>();
+  const auto seen = p.seen.accessor<bool, 1>();
   std::vector<std::vector<double>> depths(static_cast<std::size_t>(cols) * rows);
-  for (std::int64_t i = 0; i < p.size(0); ++i) {
-    const double* x = xyz + 3 * i;
-    double c[3];
-    for (int k = 0; k < 3; ++k) {
-      c[k] = R[3 * k] * x[0] + R[3 * k + 1] * x[1] + R[3 * k + 2] * x[2] + camera.tvec[k];
-    }
-    if (!(c[2] > camera.near_plane)) continue;
-    const double u = camera.fx * c[0] / c[2] + camera.cx, v = camera.fy * c[1] / c[2] + camera.cy;
-    if (!(u >= 0 && u < W && v >= 0 && v < H)) continue;
-    depths[static_cast<std::size_t>(static_cast<int>(v) / cell) * cols + static_cast<int>(u) / cell]
-        .push_back(c[2]);
+  for (std::int64_t i = 0; i < p.z.size(0); ++i) {
+    if (!seen[i]) continue;
+    depths[static_cast<std::size_t>(static_cast<int>(v[i]) / cell) * cols +
+           static_cast<int>(u[i]) / cell]
+        .push_back(z[i]);
   }
   std::vector<double> cell_depth(depths.size(), 0.0);
   std::vector<int> filled;
