@@ -11,6 +11,7 @@
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/gaussians/view_coverage.h"
+#include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/scene_cache.h"
 #include "test_support/test_support.h"
 
@@ -189,6 +190,31 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
   const Trainer by_default(scene_, small(70));
   EXPECT_EQ(by_default.config().scale_limit, 0.1);
   EXPECT_EQ(by_default.config().scale_limit_from, 60);
+}
+
+// Adam drove log-scales to -51.7 over a 30k schedule, and sadsplat refused the model.ply it
+// wrote: every step keeps them within e^+-20 of the scene extent.
+TEST_P(TrainerOnDevice, LogScalesStayWithinTheBoundsTheModelReadersAccept) {
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : scene_.views) {
+    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  const double log_extent = std::log(gaussians::sceneExtent(cameras));
+  TrainConfig config = small(10);
+  config.scale_limit = 0;  // the upper bound here is the span's, not the scale limit's
+  Trainer trainer(scene_, config);
+  trainer.step(false);
+  const at::Tensor log_scales = trainer.parameters().log_scales.detach();
+  log_scales[0].fill_(-60.0);  // shares the trainer's storage
+  log_scales[1].fill_(60.0);
+  trainer.step(false);
+  const at::Tensor after = trainer.parameters().log_scales.detach().cpu();
+  EXPECT_NEAR(after.min().item<double>(), log_extent - 20, 1e-4);
+  EXPECT_NEAR(after.max().item<double>(), log_extent + 20, 1e-4);
+  test::TempDir dir;
+  io::writeGaussians(dir.file("model.ply"), trainer.toCloud());
+  EXPECT_EQ(io::readGaussians(dir.file("model.ply")).size(),
+            static_cast<std::size_t>(trainer.numGaussians()));
 }
 
 // Gives every unlabelled training view one kept pseudo-label target per class (from its label
