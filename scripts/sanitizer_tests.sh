@@ -2,8 +2,8 @@
 # The test suite once more, built with AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/;
 # -O0 -g1, the gaussians module -O1: see below). Any ASan/UBSan report or leak in sadsplat's code
 # fails the run (LeakSanitizer suppressions for third-party libraries in tests/sanitizers/). The
-# CUDA sources and the install/package test are left out (no GPU here; the package test builds a
-# second project).
+# CUDA sources, the benchmark programs (no test runs them; the Release build compiles them) and
+# the install/package test are left out (no GPU here; the package test builds a second project).
 #   bash scripts/sanitizer_tests.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 # gaussians (CPU rasterizer, SSIM, Adam), stays at -O1 (modules/gaussians/CMakeLists.txt).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O0 -g1" \
   -DCMAKE_C_FLAGS_DEBUG="-O0 -g1" -DSADSPLAT_SANITIZE=address,undefined \
-  -DSADSPLAT_WITH_CUDA=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
+  -DSADSPLAT_WITH_CUDA=OFF -DSADSPLAT_BUILD_BENCHMARKS=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build-asan
 supp=$(pwd)/tests/sanitizers
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_odr_violation=0:allocator_may_return_null=1"

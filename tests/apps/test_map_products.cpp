@@ -53,7 +53,8 @@ class MapProducts : public ::testing::Test {
     if (!geo::haveGdal()) GTEST_SKIP() << "built without GDAL";
     if (test::runCommand("gdalinfo --version") != 0) GTEST_SKIP() << "no gdalinfo (gdal-bin)";
   }
-  // Each test is its own process (ctest): a run is trained when a test first asks for it.
+  // ctest runs the suite as one process (tests/CMakeLists.txt): a run is trained when a test
+  // first asks for it, then shared.
   static std::string trained(const std::string& scene) {
     const std::string run = dir_->file(scene + "_run");
     if (!io::pathExists(run + "/checkpoint.bin")) {
