@@ -100,6 +100,37 @@ FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& 
   return census;
 }
 
+namespace {
+
+// The scene's sparse points as an [N, 3] tensor (undefined when it has none).
+at::Tensor sparsePoints(const io::Scene& scene) {
+  if (scene.points.empty()) return at::Tensor();
+  std::vector<float> xyz;
+  xyz.reserve(3 * scene.points.size());
+  for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+  return at::tensor(xyz).view({-1, 3});
+}
+
+// The pixels of `view` whose surface at least kCoveredMinViews training views see. The surface
+// depth is the capture's (its sparse points) where a point falls into the view, so that every
+// model is scored on the same pixels; else the model's own (then *from_sparse is false).
+at::Tensor coveredPixels(const io::View& view, const gaussians::RenderResult& r,
+                         const at::Tensor& points,
+                         const std::vector<gaussians::RasterCamera>& training, bool* from_sparse) {
+  const gaussians::RasterCamera camera = gaussians::RasterCamera::fromPinhole(view.camera);
+  const at::Tensor sparse =
+      points.defined() ? gaussians::sparseDepthImage(points, camera) : at::Tensor();
+  *from_sparse = sparse.defined();
+  const at::Tensor counts =
+      sparse.defined()
+          ? gaussians::pixelViewCounts(sparse.to(r.rgb.device()), at::ones_like(r.alpha), camera,
+                                       training, 0.5, kCoverageStride)
+          : gaussians::pixelViewCounts(r.depth, r.alpha, camera, training, 0.5, kCoverageStride);
+  return counts.ge(kCoveredMinViews);
+}
+
+}  // namespace
+
 EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                     const std::string& panel_dir) {
   EvalResult result;
@@ -111,13 +142,7 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   double covered_psnr_sum = 0, covered_pixels = 0, evaluated_pixels = 0;
   int covered_views = 0;
   const std::vector<gaussians::RasterCamera> training = camerasOf(scene, true);
-  at::Tensor points;
-  if (!scene.points.empty()) {
-    std::vector<float> xyz;
-    xyz.reserve(3 * scene.points.size());
-    for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
-    points = at::tensor(xyz).view({-1, 3});
-  }
+  const at::Tensor points = sparsePoints(scene);
   result.covered_depth = "sparse points";
   const bool semantic = !scene.classes.empty();
   for (const io::View& view : scene.views) {
@@ -163,20 +188,9 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                                               {H, W}, at::TensorOptions().dtype(at::kByte))
                                     .to(r.rgb.device())
                                     .gt(0);
-      // The capture's depth (its sparse points) where it has one, so that every model is
-      // scored on the same pixels; else the model's own.
-      const gaussians::RasterCamera camera = gaussians::RasterCamera::fromPinhole(view.camera);
-      const at::Tensor sparse =
-          points.defined() ? gaussians::sparseDepthImage(points, camera) : at::Tensor();
-      const at::Tensor covered =
-          (sparse.defined()
-               ? gaussians::pixelViewCounts(sparse.to(r.rgb.device()), at::ones_like(r.alpha),
-                                            camera, training, 0.5, kCoverageStride)
-               : gaussians::pixelViewCounts(r.depth, r.alpha, camera, training, 0.5,
-                                            kCoverageStride))
-              .ge(kCoveredMinViews) &
-          inside;
-      if (!sparse.defined()) result.covered_depth = "model";
+      bool from_sparse = true;
+      const at::Tensor covered = coveredPixels(view, r, points, training, &from_sparse) & inside;
+      if (!from_sparse) result.covered_depth = "model";
       const double n = covered.sum().item<double>();
       evaluated_pixels += inside.sum().item<double>();
       covered_pixels += n;
