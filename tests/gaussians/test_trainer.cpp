@@ -192,8 +192,9 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
   EXPECT_EQ(by_default.config().scale_limit_from, 60);
 }
 
-// Adam drove log-scales to -51.7 over a 30k schedule, and sadsplat refused the model.ply it
-// wrote: every step keeps them within e^+-20 of the scene extent.
+// Adam drove log-scales to -51.7 over a 30k schedule, and the training ended with an error instead
+// of its model.ply (the writer refuses what the readers refuse, |log-scale| > 50): every step keeps
+// them within e^+-20 of the scene extent.
 TEST_P(TrainerOnDevice, LogScalesStayWithinTheBoundsTheModelReadersAccept) {
   std::vector<gaussians::RasterCamera> cameras;
   for (const io::View& v : scene_.views) {

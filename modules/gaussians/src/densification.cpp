@@ -59,7 +59,7 @@ class DefaultDensification : public DensificationStrategy {
     const TrainConfig& c = config_;
     // Every log-scale stays within e^+-kLogScaleSpan of the scene extent, and within what the
     // model's readers accept: Adam keeps shrinking a Gaussian whose gradient keeps one sign, and
-    // over a 30k schedule log-scales reached -51.7 (a model.ply sadsplat then refused to read).
+    // over a 30k schedule log-scales reached -51.7 (the model writer then refused the model).
     // e^-20 of the extent is far below a pixel of any view, so the floor changes no image. A
     // projection (Adam's moments stay as they are), as the scale limit below.
     const double log_extent = std::log(extent_);
