@@ -7,16 +7,12 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/densification_stats.h"
 #include "sadsplat/gaussians/trainer.h"
-#include "sadsplat/io/gaussian_checks.h"
 
 namespace sadsplat {
 namespace gaussians {
 namespace {
 
 double logit(double p) { return std::log(p / (1 - p)); }
-
-// How far (in e-folds) a Gaussian's scale may stray from the scene extent, either way.
-constexpr double kLogScaleSpan = 20.0;
 
 class DefaultDensification : public DensificationStrategy {
  public:
@@ -57,21 +53,12 @@ class DefaultDensification : public DensificationStrategy {
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
     const TrainConfig& c = config_;
-    // Every log-scale stays within e^+-kLogScaleSpan of the scene extent, and within what the
-    // model's readers accept: Adam keeps shrinking a Gaussian whose gradient keeps one sign, and
-    // over a 30k schedule log-scales reached -51.7 (the model writer then refused the model).
-    // e^-20 of the extent is far below a pixel of any view, so the floor changes no image. A
-    // projection (Adam's moments stay as they are), as the scale limit below.
-    const double log_extent = std::log(extent_);
-    double upper = std::min(log_extent + kLogScaleSpan, io::kMaxAbsLogScale - 1.0);
     if (c.scale_limit > 0 && done >= c.scale_limit_from) {
       if (done == c.scale_limit_from) splitAbove(params, c.scale_limit * extent_, done, resize);
-      // 1e-6 below the limit, so that exp() of the float log-scale never rounds above it (it
-      // did by 6e-8 of it).
-      upper = std::min(upper, std::log(c.scale_limit * extent_) - 1e-6);
+      // A projection onto the bound (Adam's moments stay as they are). 1e-6 below it, so that
+      // exp() of the float log-scale never rounds above the bound (it did by 6e-8 of it).
+      params["scales"].value.clamp_max_(std::log(c.scale_limit * extent_) - 1e-6);
     }
-    params["scales"].value.clamp_(std::max(log_extent - kLogScaleSpan, 1.0 - io::kMaxAbsLogScale),
-                                  upper);
     if (done > c.densify_until) {
       // Not 3DGS: after densification, Gaussians that grew beyond large_split_scale x the extent
       // are split (not pruned: they fill surfaces), until the last refinement iterations.

@@ -22,6 +22,7 @@
 #include "sadsplat/gaussians/semantic_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/view_coverage.h"
+#include "sadsplat/io/gaussian_checks.h"
 #include "training_views.h"
 
 namespace sadsplat {
@@ -30,6 +31,22 @@ namespace gaussians {
 at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
   return at::detail::createCPUGenerator(mixBits(seed ^ mixBits(purpose ^ mixBits(iteration))));
 }
+
+namespace {
+
+// Every log-scale stays within e^+-20 of the scene extent, and within what the model's writer and
+// readers accept (io::kMaxAbsLogScale): Adam keeps shrinking a Gaussian whose gradient keeps one
+// sign, and over a 30k schedule log-scales reached -51.7 (the writer then refused the model).
+// e^-20 of the extent is far below a pixel of any view, so the bound changes no image. A
+// projection after the optimiser step (Adam's moments stay as they are).
+void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
+  constexpr double kSpan = 20.0;
+  const double log_extent = std::log(extent);
+  log_scales.clamp_(std::max(log_extent - kSpan, 1.0 - io::kMaxAbsLogScale),
+                    std::min(log_extent + kSpan, io::kMaxAbsLogScale - 1.0));
+}
+
+}  // namespace
 
 // The trainer composes the units that do the work (gsplat's shape): the parameters with their
 // Adam moments (parameter_store.h), the densification strategy (densification.h), the drop's
@@ -252,6 +269,7 @@ StepStats Trainer::step(bool read_losses) {
     s.drop.addL0Gradient(s.params, it);  // the balanced rule's L0 force (else a no-op)
     enterPhase(profile, "optimiser");
     s.params.adamStep();
+    holdLogScalesNearExtent(s.params["scales"].value, s.extent);
     s.iteration = it + 1;
     const int done = s.iteration;
     enterPhase(profile, "drop");
