@@ -29,6 +29,14 @@ const std::string kSceneCache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_sce
 class TrainerTest : public ::testing::Test {
  protected:
   void SetUp() override { scene_ = io::readSceneCache(kSceneCache); }
+  // The fixture scene's extent, as the trainer computes it (from every view's camera).
+  double sceneExtent() const {
+    std::vector<gaussians::RasterCamera> cameras;
+    for (const io::View& v : scene_.views) {
+      cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+    }
+    return gaussians::sceneExtent(cameras);
+  }
   static TrainConfig small(int iterations, const std::string& device = "cpu") {
     TrainConfig c;
     c.iterations = iterations;
@@ -115,11 +123,7 @@ TEST_P(TrainerOnDevice, LargeGaussiansAreSplitAfterDensificationWhenAsked) {
 // scale_limit bounds every Gaussian's scale by the limit x the scene extent after every step; off,
 // the scales grow past it (the bound is what keeps them, not the scene).
 TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
-  std::vector<gaussians::RasterCamera> cameras;
-  for (const io::View& v : scene_.views) {
-    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-  }
-  const double extent = gaussians::sceneExtent(cameras);  // as the trainer's (floater test below)
+  const double extent = sceneExtent();
   TrainConfig config = small(60);
   const auto largest = [](const Trainer& t) {
     return t.parameters().log_scales.detach().max().exp().item<double>();
@@ -144,11 +148,7 @@ TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
 // scale_limit_from: no bound before that iteration; at it, the Gaussians above the limit are
 // split (more rows, every state consistent) and from then on none exceeds it.
 TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
-  std::vector<gaussians::RasterCamera> cameras;
-  for (const io::View& v : scene_.views) {
-    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-  }
-  const double extent = gaussians::sceneExtent(cameras);
+  const double extent = sceneExtent();
   TrainConfig config = small(60);
   const auto largest = [](const Trainer& t) {
     return t.parameters().log_scales.detach().max().exp().item<double>();
@@ -196,11 +196,7 @@ TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {
 // of its model.ply (the writer refuses what the readers refuse, |log-scale| > 50): every step keeps
 // them within e^+-20 of the scene extent.
 TEST_P(TrainerOnDevice, LogScalesStayWithinTheBoundsTheModelReadersAccept) {
-  std::vector<gaussians::RasterCamera> cameras;
-  for (const io::View& v : scene_.views) {
-    cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-  }
-  const double log_extent = std::log(gaussians::sceneExtent(cameras));
+  const double log_extent = std::log(sceneExtent());
   TrainConfig config = small(10);
   config.scale_limit = 0;  // the upper bound here is the span's, not the scale limit's
   Trainer trainer(scene_, config);
