@@ -356,6 +356,19 @@ struct CollapseRun {
   double psnr = 0;  // mean over every view of the scene, rendered as evaluation renders
 };
 
+// The mean PSNR over every view of the scene, rendered as evaluation renders them.
+double meanPsnr(const gaussians::Trainer& trainer, const io::Scene& scene) {
+  double sum = 0;
+  for (const io::View& v : scene.views) {
+    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
+                                        {v.camera.height, v.camera.width, 3}, at::kByte)
+                              .to(at::kFloat)
+                              .div(255);
+    sum += gaussians::psnr(trainer.renderView(v).rgb.clamp(0, 1), gt);
+  }
+  return sum / scene.views.size();
+}
+
 // The tiny scene with the drop's pressure far past what it can bear (lambda_l0 = 5, gates that
 // learn fast, drops every 25 iterations): the regime in which the paper's rule empties a model.
 CollapseRun trainUnderPressure(const std::string& drop, const std::string& rule) {
@@ -369,13 +382,7 @@ CollapseRun trainUnderPressure(const std::string& drop, const std::string& rule)
   for (int i = 0; i < c.iterations; ++i) trainer.step();
   CollapseRun run;
   run.gaussians = trainer.numGaussians();
-  for (const io::View& v : scene.views) {
-    const at::Tensor gt = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
-                                        {v.camera.height, v.camera.width, 3}, at::kByte)
-                              .to(at::kFloat)
-                              .div(255);
-    run.psnr += gaussians::psnr(trainer.renderView(v).rgb.clamp(0, 1), gt) / scene.views.size();
-  }
+  run.psnr = meanPsnr(trainer, scene);
   return run;
 }
 
@@ -397,6 +404,24 @@ TEST(DropStrategy, TheBalancedRuleKeepsAModelThePapersRuleEmpties) {
                                                        << net1.gaussians;
   EXPECT_LT(balanced.gaussians, net1.gaussians);
   EXPECT_GT(balanced.psnr, net1.psnr - 1) << "balanced " << balanced.psnr << " Net-1 " << net1.psnr;
+}
+
+TEST(DropStrategy, TheGuardDoesNotTakeAnOpacityResetForTheDropsCost) {
+  // The balanced rule without L0 force (strength 0), drop events every 25 iterations from 25,
+  // opacity resets after iterations 50, 100 and 150: the resets raise the image error between
+  // drop events, the drop does not. The guard compares fixed views and not across a reset, so
+  // the pressure stays 1 at every step.
+  const io::Scene scene = tinyScene();
+  gaussians::TrainConfig c = tinyDropConfig(200, "full", 25);
+  c.lambda_l0_from = 25;
+  c.l0_strength = 0;
+  c.opacity_reset_interval = 50;
+  c.densify_until = 150;
+  gaussians::Trainer trainer(scene, c);
+  trainer.setDropStrategy(makeDropStrategy(c));
+  for (int i = 0; i < c.iterations; ++i) {
+    ASSERT_EQ(trainer.step().drop_pressure, 1.0) << "after iteration " << trainer.iteration();
+  }
 }
 
 }  // namespace

@@ -16,6 +16,8 @@ namespace {
 // log_alpha of a gate folded into its opacity: sigmoid(20) * 1.2 - 0.1 > 1, so the deterministic
 // gate is exactly 1, and so is every training sample (the noise's logit is clamped to +-13.8).
 constexpr double kSettledLogAlpha = 20.0;
+// guard_[3] of the guard's present state (older checkpoints held a count >= 0 there).
+constexpr double kGuardVersion = -2.0;
 
 }  // namespace
 
@@ -80,14 +82,31 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
   grad.add_(force);
 }
 
-void DropState::observeRgbLoss(int done, double rgb_loss) {
-  if (!drop_ || !balanced() || config_.drop_guard <= 0 || !std::isfinite(rgb_loss)) return;
-  if (done < config_.lambda_l0_from) return;  // no drop events before (dropIfDue)
-  // Readings in the second half of each drop interval: the level the model has settled to.
-  const int interval = config_.drop_interval;
-  if (interval <= 0 || done % interval <= interval / 2) return;
-  guard_[2] += rgb_loss;
-  guard_[3] += 1;
+bool DropState::guardProbeDue(int done) const {
+  // Drop events of the balanced rule start with the L0 force (dropIfDue).
+  return drop_ && balanced() && config_.drop_guard > 0 && done < recoveryStart() &&
+         done >= config_.lambda_l0_from && drop_->dropNow(done);
+}
+
+bool DropState::openedByReset(int from, int to) const {
+  // The densification resets the opacities after iteration r when r is a multiple of the interval
+  // and r <= densify_until (densification.cpp), after the drop event of r and so after its
+  // reading: the resets between the readings of `from` and `to` are those of from .. to - 1.
+  const int interval = config_.opacity_reset_interval;
+  if (interval <= 0) return false;
+  const int last = std::min(to - 1, config_.densify_until);
+  const int first_multiple = (std::max(from, 1) + interval - 1) / interval * interval;
+  return first_multiple <= last;
+}
+
+void DropState::observeGuardProbe(int done, double probe_mse) {
+  if (!std::isfinite(probe_mse)) return;
+  // The reference is the lowest reading since the last opacity reset: a drop whose cost the
+  // training has not won back by the next event halves the pressure again.
+  const bool fresh = guard_[1] < 0 || openedByReset(static_cast<int>(guard_[2]), done);
+  if (!fresh && probe_mse > guard_[1] * (1 + config_.drop_guard)) guard_[0] *= 0.5;
+  guard_[1] = fresh ? probe_mse : std::min(guard_[1], probe_mse);
+  guard_[2] = done;
 }
 
 bool DropState::refreshesL0Weights(int it) const {
@@ -114,13 +133,6 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
   if (balanced() && done < config_.lambda_l0_from) return decision;
   DropInputs in;
   if (balanced()) {
-    if (config_.drop_guard > 0 && guard_[3] > 0) {
-      // The guard: the loss before this event against the loss before the previous one.
-      const double window = guard_[2] / guard_[3];
-      if (guard_[1] > 0 && window > guard_[1] * (1 + config_.drop_guard)) guard_[0] *= 0.5;
-      guard_[1] = window;
-    }
-    guard_[2] = guard_[3] = 0;
     in.max_removed = static_cast<std::int64_t>(
         std::floor(config_.drop_max_fraction * guard_[0] * static_cast<double>(params.rows())));
   }
@@ -204,7 +216,7 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
   l0_weights_ = a.tensors.count("l0_weights") ? a.tensor("l0_weights", path).to(device)
                                               : at::ones_like(confidence_);
   // Checkpoints written before the balanced rule have no guard state: a fresh guard.
-  guard_ = {1.0, -1.0, 0.0, 0.0};
+  guard_ = {1.0, -1.0, 0.0, kGuardVersion};
   if (a.tensors.count("drop_guard")) {
     const at::Tensor g = a.tensor("drop_guard", path).to(at::kCPU).contiguous();
     if (g.numel() != 4 || g.scalar_type() != at::kLong) {
@@ -215,6 +227,8 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
     if (!(guard_[0] > 0 && guard_[0] <= 1)) {
       throw Error(path, "drop_guard pressure", "a value in (0, 1]", std::to_string(guard_[0]));
     }
+    // Written before the fixed probe views: the pressure holds, the next reading starts afresh.
+    if (guard_[3] != kGuardVersion) guard_ = {guard_[0], -1.0, 0.0, kGuardVersion};
   }
 }
 

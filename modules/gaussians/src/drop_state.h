@@ -49,9 +49,15 @@ class DropState {
   // gradient), l0_strength x pressure x (the mean |log_alpha gradient| over those Gaussians) x
   // dP_nonzero / (the mean dP_nonzero over them).
   void addL0Gradient(ParameterStore& params, int it) const;
-  // The balanced rule's guard: the training RGB loss read after iteration `done` (losses are
-  // read on a fixed schedule, so a resumed run sees the readings an uninterrupted one does).
-  void observeRgbLoss(int done, double rgb_loss);
+  // The balanced rule's guard reads the model before each of its drop events: whether the event
+  // after iteration `done` wants a reading (the trainer then hands it to observeGuardProbe).
+  bool guardProbeDue(int done) const;
+  // The reading before the event after iteration `done`: the mean squared error of the probe
+  // views (guardProbeViews) rendered as evaluation renders them, so that two readings differ by
+  // what training and dropping changed, not by which views the steps drew. A reading more than
+  // drop_guard above the lowest since the last opacity reset (a reset raises the error by
+  // itself) halves the pressure.
+  void observeGuardProbe(int done, double probe_mse);
   // The factor on the L0 strength and the drop cap that the guard has left (1 at the start).
   double pressure() const { return guard_[0]; }
 
@@ -91,9 +97,11 @@ class DropState {
   at::Tensor confidence_;  // [N] last semantic confidence computed by the drop (0 before)
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
   bool balanced() const { return config_.drop_rule == "balanced"; }
-  // The guard's state: pressure, the mean RGB loss of the window before the previous drop event
-  // (< 0: none yet), the sum and count of the readings in the current window.
-  std::array<double, 4> guard_{1.0, -1.0, 0.0, 0.0};
+  bool openedByReset(int from, int to) const;
+  // The guard's state: pressure, the lowest reading since the last opacity reset (< 0: none
+  // yet), the iteration of the last reading, and a version tag (kGuardVersion; checkpoints written before the
+  // fixed probe views held a window of training losses here and start a fresh reading).
+  std::array<double, 4> guard_{1.0, -1.0, 0.0, -2.0};
 };
 
 }  // namespace gaussians

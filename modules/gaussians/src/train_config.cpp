@@ -224,8 +224,9 @@ const std::vector<TrainOption> kOptions = {
     {"drop_max_fraction", &C::drop_max_fraction,
      "balanced rule: the largest share of the Gaussians one drop event removes", nullptr, 0, 1},
     {"drop_guard", &C::drop_guard,
-     "balanced rule: relative rise of the training RGB loss between drop events that halves the "
-     "L0 strength and the cap (0: off)",
+     "balanced rule: relative rise of the mean squared error of four fixed training views "
+     "(rendered as for evaluation) from one drop event to the next that halves the L0 strength "
+     "and the cap; not across an opacity reset (0: off)",
      nullptr, 0, kInf},
 };
 

@@ -46,6 +46,13 @@ void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
                     std::min(log_extent + kSpan, io::kMaxAbsLogScale - 1.0));
 }
 
+// The keys whose -1 means "from the number of iterations", resolved.
+TrainConfig withScheduleResolved(TrainConfig c) {
+  if (c.densify_until < 0) c.densify_until = c.iterations / 2;
+  if (c.scale_limit_from < 0) c.scale_limit_from = c.iterations - c.iterations / 7;
+  return c;
+}
+
 }  // namespace
 
 // The trainer composes the units that do the work (gsplat's shape): the parameters with their
@@ -53,7 +60,8 @@ void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
 // state over the schedule (drop_state.h) and the views (training_views.h); step() reads as views
 // -> render -> losses -> backward -> statistics -> optimiser -> drop -> densification.
 struct Trainer::State {
-  explicit State(const TrainConfig& c) : config(c), drop(c) {}
+  // The drop state sees the schedule as the trainer runs it (its guard needs the opacity resets).
+  explicit State(const TrainConfig& c) : config(withScheduleResolved(c)), drop(config) {}
 
   TrainConfig config;
   at::Device device{at::kCPU};
@@ -84,6 +92,30 @@ struct Trainer::State {
     return std::min(config.max_sh_degree, iteration / std::max(1, config.sh_increase_interval));
   }
 
+  // The mean squared error of the drop guard's probe views, rendered as evaluation renders them
+  // (deterministic gates, no features).
+  double guardProbeError() const {
+    c10::AutoGradMode no_grad(false);
+    RenderSettings settings;
+    settings.sh_degree = shDegree();
+    settings.background = config.background;
+    settings.features = false;
+    settings.depth = false;
+    GaussianParams g = params.gaussians();
+    g.opacity_gate = drop.evaluationGate(params, iteration);
+    const std::vector<int> probe = views.guardProbeViews();
+    if (probe.empty()) return std::numeric_limits<double>::quiet_NaN();
+    at::Tensor sum;
+    for (int v : probe) {
+      const at::Tensor rgb = render(g, views.cameras[v], settings).rgb.clamp(0, 1);
+      const at::Tensor mask = views.masks[v].unsqueeze(2);
+      const at::Tensor mse =
+          ((rgb - views.images[v]).square() * mask).sum() / (3 * mask.sum()).clamp_min(1);
+      sum = sum.defined() ? sum + mse : mse;
+    }
+    return sum.item<double>() / static_cast<double>(probe.size());
+  }
+
   at::Tensor decode(const at::Tensor& features) const {
     return at::linear(features, params["decoder_w"].value, params["decoder_b"].value);
   }
@@ -99,10 +131,6 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
       throw Error("<config>", "device", "cpu (no CUDA device or no CUDA build here)", "cuda");
     }
     s.device = at::Device(at::kCUDA, 0);
-  }
-  if (s.config.densify_until < 0) s.config.densify_until = config.iterations / 2;
-  if (s.config.scale_limit_from < 0) {
-    s.config.scale_limit_from = config.iterations - config.iterations / 7;
   }
   s.num_classes = static_cast<int>(scene.classes.size());
   // A scene without classes trains plain 3DGS: no features, no decoder rows, no semantic loss.
@@ -273,6 +301,7 @@ StepStats Trainer::step(bool read_losses) {
     s.iteration = it + 1;
     const int done = s.iteration;
     enterPhase(profile, "drop");
+    if (gated && s.drop.guardProbeDue(done)) s.drop.observeGuardProbe(done, s.guardProbeError());
     if (gated) {
       stats.drop = s.drop.dropIfDue(done, s.params, s.views, s.resizer(), &stats.dropped);
     }
@@ -311,7 +340,6 @@ StepStats Trainer::step(bool read_losses) {
     stats.rgb_loss = value[1] / value[3];
     stats.semantic_loss = value[2] / batch;
     stats.loss = value[0];
-    s.drop.observeRgbLoss(s.iteration, stats.rgb_loss);
   } else {
     stats.loss = stats.rgb_loss = stats.semantic_loss = std::numeric_limits<double>::quiet_NaN();
   }

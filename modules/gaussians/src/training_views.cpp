@@ -10,6 +10,14 @@
 namespace sadsplat {
 namespace gaussians {
 
+std::vector<int> TrainingViews::guardProbeViews() const {
+  const std::size_t n = train_views.size();
+  const std::size_t k = std::min<std::size_t>(n, kGuardProbeViews);
+  std::vector<int> probe;
+  for (std::size_t i = 0; i < k; ++i) probe.push_back(train_views[i * n / k]);
+  return probe;
+}
+
 std::vector<RasterCamera> TrainingViews::trainingCameras() const {
   std::vector<RasterCamera> training;
   for (int v : train_views) training.push_back(cameras[v]);

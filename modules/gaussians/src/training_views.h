@@ -20,6 +20,8 @@ struct ViewRole {
   bool decoder_learns = false;
 };
 
+constexpr int kGuardProbeViews = 4;
+
 struct TrainingViews {
   std::vector<RasterCamera> cameras;        // every view of the scene
   std::vector<at::Tensor> images;           // [H, W, 3] float in [0, 1] (training views only)
@@ -31,6 +33,9 @@ struct TrainingViews {
   std::vector<int> train_views, labelled_views;
 
   std::vector<RasterCamera> trainingCameras() const;
+  // The training views the drop's guard renders (a fixed set, so its readings are comparable):
+  // up to kGuardProbeViews spread evenly over the training views.
+  std::vector<int> guardProbeViews() const;
   ViewRole role(int v, const TrainConfig& config) const;
 };
 
