@@ -146,6 +146,29 @@ TEST(Distributed, TwoNcclRanksOnTwoGpusTrainLikeOneGpuWithTwoViewsPerStep) {
   expectTwoRanksTrainLikeOneProcess("cuda");
 }
 
+TEST(Distributed, TwoRanksDropTogetherWithTheGuardReading) {
+  if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
+  // The balanced drop with its guard: before each drop event every rank renders the guard's
+  // views and the ranks average the reading, so every rank halves the pressure at the same event
+  // and removes the same rows (ranks that disagreed would all-reduce tensors of different sizes).
+  test::TempDir dir;
+  test::writeFile(dir.file("cfg.json"),
+                  "{\"drop_interval\": 10, \"lambda_l0_from\": 10, \"l0_strength\": 3, "
+                  "\"checkpoint_interval\": 0}");
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " train " + kTinySceneCache +
+                                 " --iterations 40 --drop structure --nproc 2 --config " +
+                                 dir.file("cfg.json") + " --out " + dir.file("run"),
+                             &out),
+            0)
+      << out;
+  EXPECT_EQ(std::regex_search(out, std::regex(R"(\[drop\] iteration 30: removed \d+)")), true)
+      << out;
+  const auto model = io::readGaussianPly(dir.file("run/model.ply"));
+  EXPECT_GT(model.size(), 0u);
+  EXPECT_LT(model.size(), 400u) << "the drop removed some of the 400 initial Gaussians";
+}
+
 TEST(Distributed, BatchScheduleTakesTheSameViewsInFewerSteps) {
   if (!haveGloo()) GTEST_SKIP() << "no c10d Gloo in this build";
   test::TempDir dir;

@@ -93,7 +93,8 @@ struct Trainer::State {
   }
 
   // The mean squared error of the drop guard's probe views, rendered as evaluation renders them
-  // (deterministic gates, no features).
+  // (deterministic gates, no features). Every rank renders the same views of the same model; the
+  // mean over the ranks makes their guards agree to the bit, so their drop events stay alike.
   double guardProbeError() const {
     c10::AutoGradMode no_grad(false);
     RenderSettings settings;
@@ -113,7 +114,12 @@ struct Trainer::State {
           ((rgb - views.images[v]).square() * mask).sum() / (3 * mask.sum()).clamp_min(1);
       sum = sum.defined() ? sum + mse : mse;
     }
-    return sum.item<double>() / static_cast<double>(probe.size());
+    at::Tensor mean = (sum / static_cast<double>(probe.size())).reshape({1}).contiguous();
+    if (collective) {
+      collective->sum(mean);
+      mean = mean / collective->size();
+    }
+    return mean.item<double>();
   }
 
   at::Tensor decode(const at::Tensor& features) const {
