@@ -16,8 +16,6 @@ namespace {
 // log_alpha of a gate folded into its opacity: sigmoid(20) * 1.2 - 0.1 > 1, so the deterministic
 // gate is exactly 1, and so is every training sample (the noise's logit is clamped to +-13.8).
 constexpr double kSettledLogAlpha = 20.0;
-// guard_[3] of the guard's present state (older checkpoints held a count >= 0 there).
-constexpr double kGuardVersion = -2.0;
 
 }  // namespace
 

@@ -98,10 +98,12 @@ class DropState {
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
   bool balanced() const { return config_.drop_rule == "balanced"; }
   bool openedByReset(int from, int to) const;
+  // guard_[3] of the guard's present state (checkpoints written before the fixed probe views held
+  // a count of training-loss readings >= 0 there, and start a fresh reading).
+  static constexpr double kGuardVersion = -2.0;
   // The guard's state: pressure, the lowest reading since the last opacity reset (< 0: none
-  // yet), the iteration of the last reading, and a version tag (kGuardVersion; checkpoints written before the
-  // fixed probe views held a window of training losses here and start a fresh reading).
-  std::array<double, 4> guard_{1.0, -1.0, 0.0, -2.0};
+  // yet), the iteration of the last reading, and kGuardVersion.
+  std::array<double, 4> guard_{1.0, -1.0, 0.0, kGuardVersion};
 };
 
 }  // namespace gaussians
