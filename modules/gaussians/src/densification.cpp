@@ -71,7 +71,7 @@ class DefaultDensification : public DensificationStrategy {
     if (done > c.densify_from && done % c.densify_interval == 0) {
       densifyAndPrune(params, effective_opacity, done > c.opacity_reset_interval, done, resize);
     }
-    if (c.opacity_reset_interval > 0 && done % c.opacity_reset_interval == 0) {
+    if (resetsOpacitiesAfter(c, done)) {
       Parameter& o = params["opacity"];
       o.value.clamp_max_(logit(0.01));
       o.m.zero_();
@@ -221,6 +221,11 @@ class DefaultDensification : public DensificationStrategy {
 };
 
 }  // namespace
+
+bool resetsOpacitiesAfter(const TrainConfig& c, int done) {
+  return c.opacity_reset_interval > 0 && done <= c.densify_until &&
+         done % c.opacity_reset_interval == 0;
+}
 
 DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent) {
   return std::make_shared<DefaultDensification>(config, extent);

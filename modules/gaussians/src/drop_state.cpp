@@ -87,14 +87,12 @@ bool DropState::guardProbeDue(int done) const {
 }
 
 bool DropState::openedByReset(int from, int to) const {
-  // The densification resets the opacities after iteration r when r is a multiple of the interval
-  // and r <= densify_until (densification.cpp), after the drop event of r and so after its
-  // reading: the resets between the readings of `from` and `to` are those of from .. to - 1.
-  const int interval = config_.opacity_reset_interval;
-  if (interval <= 0) return false;
-  const int last = std::min(to - 1, config_.densify_until);
-  const int first_multiple = (std::max(from, 1) + interval - 1) / interval * interval;
-  return first_multiple <= last;
+  // A reset after iteration r comes after the drop event of r and so after its reading: the
+  // resets between the readings of `from` and `to` are those after from .. to - 1.
+  for (int r = from; r < to; ++r) {
+    if (resetsOpacitiesAfter(config_, r)) return true;
+  }
+  return false;
 }
 
 void DropState::observeGuardProbe(int done, double probe_mse) {

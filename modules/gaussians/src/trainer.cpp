@@ -92,18 +92,28 @@ struct Trainer::State {
     return std::min(config.max_sh_degree, iteration / std::max(1, config.sh_increase_interval));
   }
 
+  // The model as evaluation renders it: deterministic gates, the SH degree reached so far.
+  GaussianParams evaluationGaussians() const {
+    GaussianParams g = params.gaussians();
+    g.opacity_gate = drop.evaluationGate(params, iteration);
+    return g;
+  }
+  RenderSettings evaluationSettings() const {
+    RenderSettings settings;
+    settings.sh_degree = shDegree();
+    settings.background = config.background;
+    return settings;
+  }
+
   // The mean squared error of the drop guard's probe views, rendered as evaluation renders them
   // (deterministic gates, no features). Every rank renders the same views of the same model; the
   // mean over the ranks makes their guards agree to the bit, so their drop events stay alike.
   double guardProbeError() const {
     c10::AutoGradMode no_grad(false);
-    RenderSettings settings;
-    settings.sh_degree = shDegree();
-    settings.background = config.background;
+    RenderSettings settings = evaluationSettings();
     settings.features = false;
     settings.depth = false;
-    GaussianParams g = params.gaussians();
-    g.opacity_gate = drop.evaluationGate(params, iteration);
+    const GaussianParams g = evaluationGaussians();
     const std::vector<int> probe = views.guardProbeViews();
     if (probe.empty()) return std::numeric_limits<double>::quiet_NaN();
     at::Tensor sum;
@@ -371,11 +381,7 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera) const {
 RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;
-  RenderSettings settings;
-  settings.sh_degree = s.shDegree();
-  settings.background = s.config.background;
-  GaussianParams g = s.params.gaussians();
-  g.opacity_gate = s.drop.evaluationGate(s.params, s.iteration);
+  GaussianParams g = s.evaluationGaussians();
   if (keep.defined()) {
     if (keep.dim() != 1 || keep.size(0) != g.means.size(0)) {
       throw Error("<render>", "keep mask", "one flag per Gaussian (" +
@@ -384,7 +390,7 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor&
     const at::Tensor k = keep.to(g.means.device(), g.means.scalar_type());
     g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
   }
-  return render(g, camera, settings);
+  return render(g, camera, s.evaluationSettings());
 }
 
 at::Tensor Trainer::predictClasses(const RenderResult& r) const {

@@ -63,5 +63,9 @@ class DensificationStrategy {
 /// opacity_reset_interval / max_screen_radius / max_gaussians; `extent` is the scene's.
 DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent);
 
+/// \brief Whether the default strategy resets the opacities after iteration `done`: a multiple of
+/// opacity_reset_interval up to densify_until (resolved, not -1).
+bool resetsOpacitiesAfter(const TrainConfig& config, int done);
+
 }  // namespace gaussians
 }  // namespace sadsplat
