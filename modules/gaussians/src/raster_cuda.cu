@@ -355,6 +355,11 @@ __device__ __forceinline__ float warpSum(float v) {
 // shared memory, then lane l computes the channel gradients of Gaussian l of that group from the
 // warp's 32 pixel gradients (also in shared memory) and adds them with one atomic per channel.
 // Dynamic shared memory: kWarps * 32 * D floats of pixel gradients.
+//
+// The opacity gradient needs, per Gaussian, the dot product of the pixel gradient with the colour
+// accumulated behind it, sum_c accum[c] * dL/dpixel[c]. The pixel gradient is the same for every
+// Gaussian of the pixel, so the dot product follows the same recurrence as the colour
+// (accum <- a * value + (1 - a) * accum) and is carried as one scalar instead of D accumulators.
 constexpr int kWarps = kBlock / 32;
 
 template <int CH>
@@ -390,15 +395,16 @@ __global__ void __launch_bounds__(kBlock)
   const float final_trans = inside ? 1.f - alpha_fwd[pix] : 1.f;
   const int last = inside ? last_fwd[pix] : 0;
   const float ga_out = inside ? g_alpha[pix] : 0.f;
-  float accum[CH], last_value[CH];
+  float gpix[CH];  // this pixel's gradient, also in shared memory for the channel products
 #pragma unroll
   for (int c = 0; c < CH; ++c) {
-    accum[c] = 0.f;
-    last_value[c] = 0.f;
+    gpix[c] = c < D && inside ? g_image[pix * D + c] : 0.f;
+    if (c < D) my_gpix[c] = gpix[c];
   }
-  for (int c = 0; c < D; ++c) my_gpix[c] = inside ? g_image[pix * D + c] : 0.f;
   float trans = final_trans;
   float last_alpha = 0.f;
+  float behind = 0.f;     // sum_c (colour accumulated behind the current Gaussian)[c] * gpix[c]
+  float last_dot = 0.f;   // sum_c (value of the Gaussian visited before)[c] * gpix[c]
   // List entries behind every pixel's last contributor add nothing: start at the block's
   // largest `last` instead of the list's end (at 1M Gaussians most of a tile's list lies there).
   __shared__ int s_end;
@@ -433,16 +439,14 @@ __global__ void __launch_bounds__(kBlock)
           trans = trans / (1.f - alpha);
           w = alpha * trans;
           const float* v = values + static_cast<int64_t>(g) * D;
-          float g_a = 0.f;
+          float dot = 0.f;
 #pragma unroll
           for (int c = 0; c < CH; ++c) {
-            if (c < D) {
-              accum[c] = last_alpha * last_value[c] + (1.f - last_alpha) * accum[c];
-              last_value[c] = v[c];
-              g_a += (v[c] - accum[c]) * my_gpix[c];
-            }
+            if (c < D) dot += v[c] * gpix[c];
           }
-          g_a = g_a * trans + ga_out * final_trans / (1.f - alpha);
+          behind = last_alpha * last_dot + (1.f - last_alpha) * behind;
+          const float g_a = (dot - behind) * trans + ga_out * final_trans / (1.f - alpha);
+          last_dot = dot;
           last_alpha = alpha;
           pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a, g_mean,
                              g_conic, &g_op);
@@ -464,15 +468,25 @@ __global__ void __launch_bounds__(kBlock)
       if (lane == 0) s_used[warp][slot] = any;
       if (slot == 31 || j == count - 1) {
         __syncwarp();
-        // Lane l: Gaussian j - slot + l of this group.
+        // Lane l: Gaussian j - slot + l of this group; its D sums stay in registers while the
+        // 32 pixels are visited once each.
         if (lane <= slot && s_used[warp][lane]) {
-          const int g = s_id[j - slot + lane];
-          float* out = g_values + static_cast<int64_t>(g) * D;
-          for (int c = 0; c < D; ++c) {
-            float sum = 0.f;
-#pragma unroll 8
-            for (int p = 0; p < 32; ++p) sum += s_weight[warp][p][lane] * warp_gpix[p * D + c];
-            atomicAdd(out + c, sum);
+          float sum[CH];
+#pragma unroll
+          for (int c = 0; c < CH; ++c) sum[c] = 0.f;
+          for (int p = 0; p < 32; ++p) {
+            const float wp = s_weight[warp][p][lane];
+            if (wp == 0.f) continue;
+            const float* gp = warp_gpix + p * D;
+#pragma unroll
+            for (int c = 0; c < CH; ++c) {
+              if (c < D) sum[c] += wp * gp[c];
+            }
+          }
+          float* out = g_values + static_cast<int64_t>(s_id[j - slot + lane]) * D;
+#pragma unroll
+          for (int c = 0; c < CH; ++c) {
+            if (c < D) atomicAdd(out + c, sum[c]);
           }
         }
         __syncwarp();
@@ -617,9 +631,10 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
   cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t D = values.size(1);
   RasterResult out;
-  out.image = at::zeros({height, width, D}, values.options());
-  out.alpha = at::zeros({height, width}, values.options());
-  out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
+  // Every pixel is written by the kernel (the tiles cover the image): no fill needed.
+  out.image = at::empty({height, width, D}, values.options());
+  out.alpha = at::empty({height, width}, values.options());
+  out.last = at::empty({height, width}, values.options().dtype(at::kInt));
   out.binning =
       binGaussians(means2d, conics, radii, opacities, depths, width, height, stream);
   const int tiles_x = tileGrid(width, height).first;
