@@ -142,6 +142,24 @@ TEST(Rasterizer, GradientsOfEveryInputMatchFiniteDifferences) {
   expectGradientsMatchFiniteDifferences(randomScene(5, 3, 1), cam, settings, 1e-5);
 }
 
+TEST(Rasterizer, BlackAndGreyBackgroundsComposeLikeAColouredOne) {
+  // Black and grey take their own paths (no colour tensor): the same image as rgb + (1 - alpha)
+  // * background, and gradients that match finite differences.
+  const RasterCamera cam = frontCamera(16, 16, 22.0);
+  const GaussianParams g = randomScene(5, 2, 7);
+  RenderSettings black;
+  const auto r0 = gaussians::render(g, cam, black);
+  RenderSettings grey;
+  grey.background = {0.4f, 0.4f, 0.4f};
+  const auto r1 = gaussians::render(g, cam, grey);
+  const at::Tensor expected = r0.rgb + (1 - r0.alpha).unsqueeze(2) * 0.4f;
+  EXPECT_LT((r1.rgb - expected).abs().max().item<double>(), 1e-6);
+  EXPECT_GT((r1.rgb - r0.rgb).abs().max().item<double>(), 0.1);  // the grey is there
+  EXPECT_TRUE(r0.rgb.is_contiguous());
+  expectGradientsMatchFiniteDifferences(g, cam, black, 1e-5);
+  expectGradientsMatchFiniteDifferences(g, cam, grey, 1e-5);
+}
+
 TEST(Rasterizer, GradientsWithATiltedOffCentreCameraMatchFiniteDifferences) {
   RasterCamera cam = frontCamera(16, 12, 18.0);
   cam.cx = 7.3;

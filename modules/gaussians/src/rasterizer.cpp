@@ -4,6 +4,7 @@
 
 #include <torch/csrc/autograd/custom_function.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -358,6 +359,26 @@ std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at:
   return {out[0], out[1]};
 }
 
+namespace {
+
+// The background where the Gaussians leave a pixel uncovered: rgb + (1 - alpha) * background.
+// No device tensor is made for it on the way: a blocking host-to-device copy of the three values
+// waited for the GPU's queue once per render. Black (the default) adds nothing (the same values
+// as adding zeros), a grey is a scalar, a colour is copied without blocking.
+at::Tensor composeBackground(const at::Tensor& rgb, const at::Tensor& alpha,
+                             const std::array<float, 3>& background) {
+  const auto [r, g, b] = background;
+  if (r == 0 && g == 0 && b == 0) return rgb.contiguous();
+  const at::Tensor uncovered = (1.0 - alpha).unsqueeze(2);
+  if (r == g && g == b) return rgb + uncovered * double(r);
+  const at::Tensor colour =
+      at::tensor({double(r), double(g), double(b)}, rgb.options().device(at::kCPU))
+          .to(rgb.device(), /*non_blocking=*/true);
+  return rgb + uncovered * colour;
+}
+
+}  // namespace
+
 RenderResult render(const GaussianParams& g, const RasterCamera& camera,
                     const RenderSettings& settings) {
   validateCamera(camera);
@@ -396,12 +417,8 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   auto [image, alpha] = rasterizeToPixels(means2d, conics, opacities, values, radii, depths,
                                           camera.width, camera.height);
   const int64_t C = features.size(1);
-  const at::Tensor background =
-      at::tensor({double(settings.background[0]), double(settings.background[1]),
-                  double(settings.background[2])},
-                 g.means.options());
   RenderResult result;
-  result.rgb = image.slice(2, 0, 3) + (1.0 - alpha).unsqueeze(2) * background;
+  result.rgb = composeBackground(image.slice(2, 0, 3), alpha, settings.background);
   result.features = image.slice(2, 3, 3 + C);
   if (settings.depth) {
     const at::Tensor depth_sum = image.select(2, 3 + C);
