@@ -7,7 +7,9 @@
 #   bench  the CUDA rasterizer tests of this tree, then both rasterizer benchmarks alternating
 #   train  SCENE at 800x450, 7000 iterations, --drop DROP (on the scene with the built-in
 #          pseudo-labels when PL=1), one training at a time, alternating; nvidia-smi samples the
-#          GPU's utilisation during this tree's last pass (util.csv)
+#          GPU's utilisation during this tree's last pass (util.csv); EVAL=1 evaluates the first
+#          pass of each side (eval_new.json, eval_base.json). Caches already in /tmp/sadsplat-scenes
+#          (<scene>_800x450.cache and, with PL=1, <scene>_800x450_pl.cache) are used as they are
 # $OUT gets ab_bench.txt or ab_train.txt, and the logs.
 set -uo pipefail
 source "$(dirname "$0")/lib.sh"
@@ -51,6 +53,11 @@ case "$mode" in
           > "$OUT/train_${side}_$pass.log" 2>&1
         [ -n "$sampler" ] && kill "$sampler"
         echo "$side pass $pass: $(train_summary "$OUT/train_${side}_$pass.log")" >> "$summary"
+        if [ "${EVAL:-0}" = 1 ] && [ "$pass" = 1 ]; then
+          "$b" eval "$run" > "$OUT/eval_$side.json" 2>/dev/null &&
+            python3 -c 'import json, sys; m = json.load(open(sys.argv[1])); print(sys.argv[2], "eval: PSNR %.2f dB, mIoU %s, %d Gaussians" % (m["psnr"], m["miou"], m["num_gaussians"]))' \
+              "$OUT/eval_$side.json" "$side" >> "$summary"
+        fi
       done
     done
     (cd "$OUT" && tar czf ab_train_logs.tgz --remove-files train_*.log) ;;
