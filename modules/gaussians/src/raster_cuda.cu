@@ -403,8 +403,8 @@ __global__ void __launch_bounds__(kBlock)
   }
   float trans = final_trans;
   float last_alpha = 0.f;
-  float behind = 0.f;     // sum_c (colour accumulated behind the current Gaussian)[c] * gpix[c]
-  float last_dot = 0.f;   // sum_c (value of the Gaussian visited before)[c] * gpix[c]
+  float behind = 0.f;    // sum_c (colour accumulated behind the current Gaussian)[c] * gpix[c]
+  float last_dot = 0.f;  // sum_c (value of the Gaussian visited before)[c] * gpix[c]
   // List entries behind every pixel's last contributor add nothing: start at the block's
   // largest `last` instead of the list's end (at 1M Gaussians most of a tile's list lies there).
   __shared__ int s_end;
