@@ -54,9 +54,8 @@ case "$mode" in
         [ -n "$sampler" ] && kill "$sampler"
         echo "$side pass $pass: $(train_summary "$OUT/train_${side}_$pass.log")" >> "$summary"
         if [ "${EVAL:-0}" = 1 ] && [ "$pass" = 1 ]; then
-          "$b" eval "$run" > "$OUT/eval_$side.json" 2>/dev/null &&
-            python3 -c 'import json, sys; m = json.load(open(sys.argv[1])); print(sys.argv[2], "eval: PSNR %.2f dB, mIoU %s, %d Gaussians" % (m["psnr"], m["miou"], m["num_gaussians"]))' \
-              "$OUT/eval_$side.json" "$side" >> "$summary"
+          "$b" eval "$run" > "$OUT/eval_$side.json" 2>/dev/null
+          metrics_line "$side" "$OUT/eval_$side.json" >> "$summary"
         fi
       done
     done

@@ -56,23 +56,6 @@ mode="${1:?usage: experiments.sh one|profile|runs|table ...}"; shift
 export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=$SADSPLAT_BIN
 
-metrics_line() {  # NAME METRICS_JSON
-  python3 - "$@" <<'PY'
-import json, sys
-name, path = sys.argv[1:3]
-try:
-    m = json.load(open(path))
-except Exception as e:
-    print(name, "unreadable", e); sys.exit()
-miou = "%6.2f" % (100 * m["miou"]) if m.get("miou") is not None else "  none"
-covered = ("  covered %6.2f (%2.0f %%)" % (m["psnr_covered"], 100 * m["covered_fraction"])
-           if m.get("psnr_covered") is not None else "")
-large = m.get("floaters", {}).get("larger_than_10pct_extent")
-print("%-24s mIoU %s  PSNR %6.2f%s  SSIM %.3f  gaussians %8d  large %s  train %5.1f s" % (
-    name, miou, m["psnr"], covered, m["ssim"], m["num_gaussians"], large, m["train_seconds"]))
-PY
-}
-
 mode_one() {
   local scene="$1" iterations="${2:-7000}"; shift $(( $# < 2 ? $# : 2 ))
   local cache; cache=$(scene_cache "$scene") || return 1

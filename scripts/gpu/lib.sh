@@ -14,6 +14,7 @@
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
 #   deadline_start SECONDS       start the call's clock; seconds_left prints what is left
 #   run_until_deadline CMD...    run CMD, killed at the deadline; returns its status
+#   metrics_line NAME JSON       one line of a run's `sadsplat eval` metrics
 # Variables: OUT (results folder, default /tmp/sadsplat-gpu-out), SADSPLAT_BIN (build-gpu/bin/sadsplat).
 
 OUT="${OUT:-/tmp/sadsplat-gpu-out}"
@@ -127,4 +128,21 @@ run_until_deadline() {
 # The last "trained in X s" and "gaussians N" of a training log (progress lines end in \r).
 train_summary() {
   echo "$(tr '\r' '\n' < "$1" | grep -o 'trained in [0-9.]* s' | tail -1) $(tr '\r' '\n' < "$1" | grep -o 'gaussians [0-9]*' | tail -1)"
+}
+
+metrics_line() {  # NAME METRICS_JSON
+  python3 - "$@" <<'PY'
+import json, sys
+name, path = sys.argv[1:3]
+try:
+    m = json.load(open(path))
+except Exception as e:
+    print(name, "unreadable", e); sys.exit()
+miou = "%6.2f" % (100 * m["miou"]) if m.get("miou") is not None else "  none"
+covered = ("  covered %6.2f (%2.0f %%)" % (m["psnr_covered"], 100 * m["covered_fraction"])
+           if m.get("psnr_covered") is not None else "")
+large = m.get("floaters", {}).get("larger_than_10pct_extent")
+print("%-24s mIoU %s  PSNR %6.2f%s  SSIM %.3f  gaussians %8d  large %s  train %5.1f s" % (
+    name, miou, m["psnr"], covered, m["ssim"], m["num_gaussians"], large, m["train_seconds"]))
+PY
 }
