@@ -34,24 +34,24 @@ summary="$OUT/kernels_$tag.txt"
 
 # 1. Plain training, utilisation sampled (PLAIN=0 leaves it out).
 if [ "${PLAIN:-1}" = 1 ]; then
-nvidia-smi --query-gpu=utilization.gpu --format=csv,noheader,nounits -lms 200 > "$work/util.txt" &
-smi=$!
-start=$(date +%s%N)
-"$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$iterations" --out "$work/plain" "$@" \
-  > "$work/plain.log" 2>&1
-wall_ms=$(( ($(date +%s%N) - start) / 1000000 ))
-kill "$smi" 2>/dev/null
-{
-  echo "# $tag: $scene, $iterations iterations, args: $*"
-  echo "plain training: process wall $wall_ms ms, $(train_summary "$work/plain.log")"
-  python3 - "$work/util.txt" <<'PY'
+  nvidia-smi --query-gpu=utilization.gpu --format=csv,noheader,nounits -lms 200 > "$work/util.txt" &
+  smi=$!
+  start=$(date +%s%N)
+  "$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$iterations" --out "$work/plain" "$@" \
+    > "$work/plain.log" 2>&1
+  wall_ms=$(( ($(date +%s%N) - start) / 1000000 ))
+  kill "$smi" 2>/dev/null
+  {
+    echo "# $tag: $scene, $iterations iterations, args: $*"
+    echo "plain training: process wall $wall_ms ms, $(train_summary "$work/plain.log")"
+    python3 - "$work/util.txt" <<'PY'
 import sys
 v = [int(x) for x in open(sys.argv[1]).read().split() if x.isdigit()]
 busy = [x for x in v if x > 0]
 print(f"nvidia-smi utilisation (200 ms samples): {len(v)} samples, mean of nonzero samples "
       f"{sum(busy) / max(len(busy), 1):.1f} %")
 PY
-} | tee "$summary"
+  } | tee "$summary"
 else
   wall_ms=0; : > "$summary"
 fi
@@ -76,10 +76,19 @@ for line in open(sys.argv[1]):
 json.dump(keys, open(sys.argv[2], "w"))
 print("short runs keep", keys)
 PY
-ncu_run_short() { timeout 200 "$ncu_bin" --clock-control none --metrics gpu__time_duration.sum \
-  --csv --page raw --print-units base --launch-skip "$count_skip" --log-file "$work/count_$1.csv" \
-  "$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$1" --config "$work/schedule.json" \
-  --out "$work/count_$1" "${@:2}" > "$work/count_$1.log" 2>&1; }
+# ncu_times CSV SKIP COUNT TIMEOUT_S train args...: times each kernel of launches SKIP ..
+# SKIP + COUNT (COUNT 0: all) of one training, one row per launch in CSV.
+ncu_times() {
+  local csv="$1" skip="$2" count="$3" limit="$4"; shift 4
+  local range=(--launch-skip "$skip"); [ "$count" -gt 0 ] && range+=(--launch-count "$count")
+  timeout "$limit" "$ncu_bin" --clock-control none --metrics gpu__time_duration.sum --csv \
+    --page raw --print-units base "${range[@]}" --log-file "$csv" "$SADSPLAT_BIN" train "$scene" \
+    --device cuda "$@"
+}
+ncu_run_short() {
+  ncu_times "$work/count_$1.csv" "$count_skip" 0 200 --iterations "$1" \
+    --config "$work/schedule.json" --out "$work/count_$1" "${@:2}" > "$work/count_$1.log" 2>&1
+}
 ncu_run_short 10 "$@"
 ncu_run_short 20 "$@"
 k10=$(count_rows "$work/count_10.csv")
@@ -92,16 +101,14 @@ echo "kernels timed after the first $count_skip: 10 iterations $k10, 20 iteratio
 # 3. The window.
 skip=$(( setup + at * per_it ))
 count=$(( window * per_it ))
-timeout "${WINDOW_TIMEOUT_S:-300}" "$ncu_bin" --clock-control none --metrics gpu__time_duration.sum --csv --page raw \
-  --print-units base --launch-skip "$skip" --launch-count "$count" --log-file "$OUT/kernels_$tag.csv" \
-  "$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$iterations" --out "$work/window" "$@" \
-  > "$work/window.log" 2>&1
+ncu_times "$OUT/kernels_$tag.csv" "$skip" "$count" "${WINDOW_TIMEOUT_S:-300}" \
+  --iterations "$iterations" --out "$work/window" "$@" > "$work/window.log" 2>&1
 echo "window: launches $skip .. $(( skip + count )) (~iterations $at .. $(( at + window )))" | tee -a "$summary"
-python3 - "$OUT/kernels_$tag.csv" "$window" "$wall_ms" "$iterations" <<'PY' | tee -a "$summary"
+python3 - "$OUT/kernels_$tag.csv" "$wall_ms" "$iterations" <<'PY' | tee -a "$summary"
 import csv, re, sys
 from collections import defaultdict
 rows = list(csv.reader(open(sys.argv[1])))
-window, wall_ms, iterations = int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+wall_ms, iterations = float(sys.argv[2]), int(sys.argv[3])
 head = next(r for r in rows if "Kernel Name" in r)
 name_i, t_i = head.index("Kernel Name"), head.index("gpu__time_duration.sum")
 total = defaultdict(float)
