@@ -22,6 +22,9 @@ mkdir -p "$OUT"
 GPU_DEPS_PREFIX=/tmp/sadsplat-deps
 SADSPLAT_BIN="${SADSPLAT_BIN:-$PWD/build-gpu/bin/sadsplat}"
 SCENES_DIR=/tmp/sadsplat-scenes
+# The unpacked Debian libraries (gpu_unpack_deps) on the search path of every script that sources
+# this file, so a binary built earlier in the same call runs.
+export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 export PYTORCH_CUDA_ALLOC_CONF="${PYTORCH_CUDA_ALLOC_CONF:-expandable_segments:True}"
 # NVLink multicast stays off, also in the ranks the launcher starts (they inherit this).
 export NCCL_NVLS_ENABLE=0 TORCH_SYMM_MEM_DISABLE_MULTICAST=1 NVSHMEM_DISABLE_NVLS=1

@@ -145,6 +145,26 @@ def read_cache(path):
     return classes, views, points
 
 
+def read_cache_once(path):
+    """read_cache, keeping the decoded scene beside the cache (CACHE.decoded.pt) so that a second
+    run on the same cache skips the pure-NumPy decode (~50-100 s for 70 views at 800x450). The copy
+    is used only while it is newer than the cache."""
+    import os
+    copy = path + ".decoded.pt"
+    try:
+        if os.path.getmtime(copy) >= os.path.getmtime(path):
+            return torch.load(copy)
+    except Exception:  # missing, stale or unreadable: decode
+        pass
+    decoded = read_cache(path)
+    try:
+        torch.save(decoded, copy + ".tmp")
+        os.replace(copy + ".tmp", copy)
+    except Exception:  # a read-only folder or a type torch cannot save: decode again next time
+        pass
+    return decoded
+
+
 def viewmat(v):
     w, x, y, z = v["q"]
     R = torch.tensor([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -242,7 +262,7 @@ def main():
     dev = torch.device("cuda")
     torch.manual_seed(args.seed)
     t_load = time.time()
-    classes, views, pts = read_cache(args.cache)
+    classes, views, pts = read_cache_once(args.cache)
     C = len(classes)
     vm = [viewmat(v) for v in views]
     extent = scene_extent(vm)
