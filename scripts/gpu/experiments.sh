@@ -295,7 +295,12 @@ mode_scene() {
     fi
     f="$work/results/ortho_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
-    echo "    flags: ${spec#*:}; $(train_summary "$work/results/train_$name.log"); drops: $(tr '\r' '\n' < "$work/results/train_$name.log" | grep -c '^\[drop\]')" >> "$summary"
+    f="$work/results/train_$name.log"
+    if [ -f "$f" ]; then
+      echo "    flags: ${spec#*:}; $(train_summary "$f"); drops: $(tr '\r' '\n' < "$f" | grep -c '^\[drop\]')" >> "$summary"
+    else
+      echo "    flags: ${spec#*:}; not started" >> "$summary"
+    fi
   done
   tar -czf "$OUT/scene_$tag.tgz" -C "$work" results
   cat "$summary"
