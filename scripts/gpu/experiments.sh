@@ -18,8 +18,9 @@
 #       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
 #       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
 #       summary says at which iteration it stopped). The deadline counts from the start, scene
-#       making included: three KIND_SEED_pl scenes made at once on a 16-core GPU machine took ~5
-#       minutes (2026-11-26) — make them first, or carry a cache made elsewhere
+#       making included: caches are made one at a time on the machine (lib.sh; city_0 with its
+#       pseudo-labels ~30 s on an H100 machine; several made at once took 150-300 s, 2026-11-26)
+#       — give the deadline room for them, or carry a cache made elsewhere
 #
 # RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
 #   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set

@@ -95,12 +95,17 @@ scene_cache() {
   # One maker per cache: calls running side by side wait for it (flock).
   local lock; exec {lock}> "$cache.lock"; flock "$lock"
   if [ ! -f "$cache" ]; then
+    # One cache made at a time on the machine (scene or pseudo-labels, whichever caller): two
+    # pseudo-labelled scenes made at once took > 150 s on a 16-core H100 machine (2026-11-26),
+    # one alone ~30 s with its synth.
+    local making; exec {making}> "$SCENES_DIR/.making.lock"; flock "$making"
     local args
     if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
     else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
     "$bin" synth "${args[@]}" --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" \
-      > "$OUT/synth_${scene}_$size.log" 2>&1 || { echo "synth $scene failed" >&2; flock -u "$lock"; return 1; }
+      > "$OUT/synth_${scene}_$size.log" 2>&1 || { echo "synth $scene failed" >&2; flock -u "$lock"; exec {making}>&-; return 1; }
     mv "$cache.part" "$cache"
+    exec {making}>&-
   fi
   flock -u "$lock"; exec {lock}>&-
   echo "$cache"
@@ -110,11 +115,15 @@ pl_cache() {
   local cache="$1" bin="${2:-$SADSPLAT_BIN}"; shift $(( $# < 2 ? $# : 2 ))
   local tag=""; [ $# -gt 0 ] && tag="_$(echo "$*" | md5sum | cut -c1-8)"
   local pl="${cache%.cache}_pl$tag.cache"
+  mkdir -p "$SCENES_DIR"
   local lock; exec {lock}> "$pl.lock"; flock "$lock"
   if [ ! -f "$pl" ]; then
+    # One cache made at a time (see scene_cache).
+    local making; exec {making}> "$SCENES_DIR/.making.lock"; flock "$making"
     "$bin" pseudo-labels "$cache" --out "$pl.part" "$@" > "$OUT/pseudo_labels_$(basename "${pl%.cache}").log" 2>&1 ||
-      { echo "pseudo-labels of $cache failed" >&2; flock -u "$lock"; return 1; }
+      { echo "pseudo-labels of $cache failed" >&2; flock -u "$lock"; exec {making}>&-; return 1; }
     mv "$pl.part" "$pl"
+    exec {making}>&-
   fi
   flock -u "$lock"; exec {lock}>&-
   echo "$pl"
