@@ -21,7 +21,6 @@ iterations="${1:-7000}"
 gpus="${2:-2}"
 out="$OUT"
 [ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
-export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=$SADSPLAT_BIN
 work=/tmp/sadsplat-distributed
 mkdir -p "$work"

@@ -54,7 +54,6 @@ set -uo pipefail
 source "$(dirname "$0")/lib.sh"
 mode="${1:?usage: experiments.sh one|profile|runs|table ...}"; shift
 [ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
-export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=$SADSPLAT_BIN
 
 mode_one() {

@@ -66,7 +66,6 @@ smoke_done=0
 echo "gsplat build: rc $gs_ok, $(( $(date +%s) - gs_start )) s; $(tail -1 "$work/logs/build_gsplat.log")" | tee -a "$summary"
 [ -z "$prebuilt" ] && find /tmp/gsplat-ext -name '*.so' -exec cp {} "$out/" \;
 wait $sadsplat_build || { tail -30 "$work/logs/build_sadsplat.log"; }
-export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 bin=build-gpu/bin/sadsplat
 echo "builds done at $(( $(date +%s) - start )) s" | tee -a "$summary"
 

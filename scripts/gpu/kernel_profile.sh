@@ -24,7 +24,6 @@ window="${4:-5}"
 shift $(( $# < 4 ? $# : 4 ))
 iterations="${ITERATIONS:-7000}"
 [ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
-export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 export PATH=/usr/local/cuda/bin:$PATH
 ncu_bin=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1)
 [ -n "$ncu_bin" ] || { echo "ncu not found" >&2; exit 1; }

@@ -12,6 +12,7 @@
 #                                seed and size under /tmp/sadsplat-scenes; KIND_SEED e.g. city_0,
 #                                or city-xl for the large preset)
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
+#   make_cache PATH LOG CMD...   run CMD (writing PATH.part) once per PATH, one maker per machine
 #   deadline_start SECONDS       start the call's clock; seconds_left prints what is left
 #   run_until_deadline CMD...    run CMD, killed at the deadline; returns its status
 #   metrics_line NAME JSON       one line of a run's `sadsplat eval` metrics
@@ -39,7 +40,6 @@ gpu_unpack_deps() {
     for deb in .deps/debs/*.deb; do dpkg -x "$deb" "$GPU_DEPS_PREFIX"; done
     echo "$stamp" > "$GPU_DEPS_PREFIX/.unpacked"
   fi
-  export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
 }
 
 gpu_build() {
@@ -74,9 +74,7 @@ gpu_build() {
     [ $rc = 0 ] || tail -30 "$OUT/gpu_build${2:-}.log"
     exit $rc
   )
-  local rc=$?
-  export LD_LIBRARY_PATH="$GPU_DEPS_PREFIX/usr/lib/x86_64-linux-gnu:${LD_LIBRARY_PATH:-}"
-  return $rc
+  return $?
 }
 
 # BASE is a source tarball of the baseline: git archive --format=tar REV | gzip > .deps/base_src.tgz
@@ -88,26 +86,33 @@ gpu_baseline() {
   gpu_build /tmp/ab-base _base
 }
 
-scene_cache() {
-  local scene="$1" size="${2:-800x450}" bin="${3:-$SADSPLAT_BIN}"
-  local cache="$SCENES_DIR/${scene}_${size}.cache"
+# make_cache PATH LOG CMD...: runs CMD (which writes PATH.part) unless PATH exists, then renames
+# PATH.part to PATH. Callers asking for one PATH side by side wait for the first (a lock per cache);
+# and one cache is made at a time on the machine (scene or pseudo-labels, whichever caller): two
+# pseudo-labelled scenes made at once took > 150 s on a 16-core H100 machine (2026-11-26), one
+# alone ~30 s with its synth.
+make_cache() {
+  local path="$1" log="$2"; shift 2
   mkdir -p "$SCENES_DIR"
-  # One maker per cache: calls running side by side wait for it (flock).
-  local lock; exec {lock}> "$cache.lock"; flock "$lock"
-  if [ ! -f "$cache" ]; then
-    # One cache made at a time on the machine (scene or pseudo-labels, whichever caller): two
-    # pseudo-labelled scenes made at once took > 150 s on a 16-core H100 machine (2026-11-26),
-    # one alone ~30 s with its synth.
-    local making; exec {making}> "$SCENES_DIR/.making.lock"; flock "$making"
-    local args
-    if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
-    else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
-    "$bin" synth "${args[@]}" --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" \
-      > "$OUT/synth_${scene}_$size.log" 2>&1 || { echo "synth $scene failed" >&2; flock -u "$lock"; exec {making}>&-; return 1; }
-    mv "$cache.part" "$cache"
+  local lock making rc=0
+  exec {lock}> "$path.lock"; flock "$lock"
+  if [ ! -f "$path" ]; then
+    exec {making}> "$SCENES_DIR/.making.lock"; flock "$making"
+    "$@" > "$log" 2>&1 && mv "$path.part" "$path" || rc=1
     exec {making}>&-
   fi
-  flock -u "$lock"; exec {lock}>&-
+  exec {lock}>&-
+  return $rc
+}
+
+scene_cache() {
+  local scene="$1" size="${2:-800x450}" bin="${3:-$SADSPLAT_BIN}"
+  local cache="$SCENES_DIR/${scene}_${size}.cache" args
+  if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
+  else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
+  make_cache "$cache" "$OUT/synth_${scene}_$size.log" "$bin" synth "${args[@]}" \
+    --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" ||
+    { echo "synth $scene failed" >&2; return 1; }
   echo "$cache"
 }
 
@@ -115,17 +120,9 @@ pl_cache() {
   local cache="$1" bin="${2:-$SADSPLAT_BIN}"; shift $(( $# < 2 ? $# : 2 ))
   local tag=""; [ $# -gt 0 ] && tag="_$(echo "$*" | md5sum | cut -c1-8)"
   local pl="${cache%.cache}_pl$tag.cache"
-  mkdir -p "$SCENES_DIR"
-  local lock; exec {lock}> "$pl.lock"; flock "$lock"
-  if [ ! -f "$pl" ]; then
-    # One cache made at a time (see scene_cache).
-    local making; exec {making}> "$SCENES_DIR/.making.lock"; flock "$making"
-    "$bin" pseudo-labels "$cache" --out "$pl.part" "$@" > "$OUT/pseudo_labels_$(basename "${pl%.cache}").log" 2>&1 ||
-      { echo "pseudo-labels of $cache failed" >&2; flock -u "$lock"; exec {making}>&-; return 1; }
-    mv "$pl.part" "$pl"
-    exec {making}>&-
-  fi
-  flock -u "$lock"; exec {lock}>&-
+  make_cache "$pl" "$OUT/pseudo_labels_$(basename "${pl%.cache}").log" \
+    "$bin" pseudo-labels "$cache" --out "$pl.part" "$@" ||
+    { echo "pseudo-labels of $cache failed" >&2; return 1; }
   echo "$pl"
 }
 
