@@ -537,6 +537,60 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
   EXPECT_GT(narrower, boxes / 5) << narrower << " of " << boxes;
 }
 
+TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
+  // The CUDA backward skips a Gaussian for a warp's 16 x 2 pixels when alphaMayReach says no: in
+  // float, as the kernel runs it, no pixel centre of a skipped rectangle may have a non-zero
+  // pixelAlpha; and the test must skip rectangles (it is not "always yes").
+  using gaussians::raster::alphaMayReach;
+  const gaussians::raster::Camera<double> cam = binningTestCamera();
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int reached = 0, skipped = 0;
+  for (int k = 0; k < 80; ++k) {
+    const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
+    const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
+    const double stretch = k % 2 ? 10 + 30 * (1 + u(rng)) / 2 : 1;
+    const double log_scale[3] = {std::log((0.005 + 0.02 * (1 + u(rng))) * stretch),
+                                 std::log(0.005 + 0.02 * (1 + u(rng))),
+                                 std::log(0.005 + 0.02 * (1 + u(rng)))};
+    gaussians::raster::Projected<double> p;
+    if (!gaussians::raster::projectGaussian(mean, quat, log_scale, cam, &p)) continue;
+    const float m[2] = {float(p.mean2d[0]), float(p.mean2d[1])};
+    const float conic[3] = {float(p.conic[0]), float(p.conic[1]), float(p.conic[2])};
+    for (float opacity : {1.f / 300, 1.f / 255, 0.0045f, 0.05f, 0.5f, 1.f}) {
+      // Rectangles of 16 x 2 pixel centres on a grid around the mean, out to 1.5 radii.
+      const int reach = p.radius * 3 / 2 + 16;
+      for (int y0 = int(m[1]) - reach; y0 <= int(m[1]) + reach; y0 += 2) {
+        for (int x0 = int(m[0]) - reach; x0 <= int(m[0]) + reach; x0 += 16) {
+          bool any = false;
+          for (int y = y0; y < y0 + 2 && !any; ++y) {
+            for (int x = x0; x < x0 + 16 && !any; ++x) {
+              float G = 0.f;
+              bool clamped = false;
+              any = gaussians::raster::pixelAlpha(m, conic, opacity, x + 0.5f, y + 0.5f, &G,
+                                                  &clamped) != 0.f;
+            }
+          }
+          const bool may = alphaMayReach(m, conic, opacity, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f,
+                                         y0 + 1.5f);
+          if (any) {
+            ++reached;
+            EXPECT_TRUE(may) << "Gaussian " << k << " opacity " << opacity << " at " << x0
+                             << ", " << y0;
+          }
+          skipped += !may;
+        }
+      }
+    }
+  }
+  EXPECT_GT(reached, 2000);
+  EXPECT_GT(skipped, 2000);
+  const float m[2] = {10.f, 10.f}, round[3] = {0.1f, 0.f, 0.1f};
+  EXPECT_FALSE(alphaMayReach(m, round, 1.f / 300, 0.5f, 0.5f, 15.5f, 1.5f));  // too faint
+  EXPECT_FALSE(alphaMayReach(m, round, 1.f, 100.5f, 0.5f, 115.5f, 1.5f));     // too far
+  EXPECT_TRUE(alphaMayReach(m, round, 1.f, 0.5f, 9.5f, 15.5f, 10.5f));        // on the mean
+}
+
 // Without features and depth (what training renders for a view with no semantic loss) the colour,
 // alpha and every colour gradient are those of the full render; features get no gradient.
 TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {

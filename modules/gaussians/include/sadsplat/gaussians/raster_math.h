@@ -12,6 +12,7 @@
 /// checks; the CUDA backend uses float.
 
 #include <cmath>
+#include <limits>
 
 #if defined(__CUDACC__)
 #define SADSPLAT_HD __host__ __device__ __forceinline__
@@ -406,24 +407,53 @@ SADSPLAT_HD int alphaExtent(int radius, T opacity) {
   return static_cast<int>(mceil(k * T(radius)));
 }
 
-/// The binning box, half-widths (*rx, *ry): alphaExtent's square cut to the axis-aligned box of the
-/// ellipse where alpha can reach kMinAlpha. opacity * exp(-d^T C d / 2) >= 1/255 (C the conic)
-/// needs d^T C d <= 2 ln(255 opacity) = k^2, and that ellipse spans k sqrt(S_xx) across and
-/// k sqrt(S_yy) down, S = C^-1 (S_xx = C_yy / det C). An elongated Gaussian's square box
-/// (3 sigma of its long axis both ways) holds many tiles its ellipse never reaches; renders are
-/// unchanged (a pixel outside the box has alpha < kMinAlpha, which pixelAlpha skips).
+/// Half-widths (*sx, *sy) of the axis-aligned box around the ellipse where a Gaussian of this
+/// opacity and conic can reach kMinAlpha: opacity * exp(-d^T C d / 2) >= 1/255 (C the conic) needs
+/// d^T C d <= 2 ln(255 opacity) = k^2, and that ellipse spans k sqrt(S_xx) across and k sqrt(S_yy)
+/// down, S = C^-1 (S_xx = C_yy / det C). 1 % margin on the opacity, against rounding at the
+/// threshold. Returns false when no pixel can reach kMinAlpha; *sx = *sy = +inf when the conic is
+/// not positive definite (no bound).
+template <typename T>
+SADSPLAT_HD bool alphaEllipseHalfWidths(T opacity, const T conic[3], T* sx, T* sy) {
+  const T q = opacity * T(1.01 / kMinAlpha);
+  if (!(q > T(1))) return false;
+  const T det = conic[0] * conic[2] - conic[1] * conic[1];
+  if (!(det > T(0))) {
+    *sx = *sy = std::numeric_limits<T>::infinity();
+    return true;
+  }
+  const T k2 = T(2) * mlog(q);
+  *sx = msqrt(k2 * conic[2] / det);
+  *sy = msqrt(k2 * conic[0] / det);
+  return true;
+}
+
+/// The binning box, half-widths (*rx, *ry): alphaExtent's square cut to alphaEllipseHalfWidths'
+/// box. An elongated Gaussian's square box (3 sigma of its long axis both ways) holds many tiles
+/// its ellipse never reaches; renders are unchanged (a pixel outside the box has alpha <
+/// kMinAlpha, which pixelAlpha skips).
 template <typename T>
 SADSPLAT_HD void alphaBox(int radius, T opacity, const T conic[3], int* rx, int* ry) {
   const int extent = alphaExtent(radius, opacity);
   *rx = *ry = extent;
   if (extent <= 0) return;
-  const T det = conic[0] * conic[2] - conic[1] * conic[1];
-  if (!(det > T(0))) return;
-  // The same 1 % margin on the opacity as alphaExtent.
-  const T k2 = T(2) * mlog(opacity * T(1.01 / kMinAlpha));
-  const T sx = msqrt(k2 * conic[2] / det), sy = msqrt(k2 * conic[0] / det);
+  T sx, sy;
+  if (!alphaEllipseHalfWidths(opacity, conic, &sx, &sy)) return;
   if (sx < T(extent)) *rx = static_cast<int>(mceil(sx));
   if (sy < T(extent)) *ry = static_cast<int>(mceil(sy));
+}
+
+/// Whether a Gaussian can reach kMinAlpha at any pixel centre of the rectangle [x0, x1] x [y0, y1]
+/// (centre coordinates): its alphaEllipseHalfWidths box meets the rectangle. Conservative: false
+/// only where pixelAlpha would return 0 at every centre of the rectangle.
+template <typename T>
+SADSPLAT_HD bool alphaMayReach(const T mean2d[2], const T conic[3], T opacity, T x0, T y0, T x1,
+                               T y1) {
+  T sx, sy;
+  if (!alphaEllipseHalfWidths(opacity, conic, &sx, &sy)) return false;
+  const T dx = mmax(mmax(x0 - mean2d[0], mean2d[0] - x1), T(0));
+  const T dy = mmax(mmax(y0 - mean2d[1], mean2d[1] - y1), T(0));
+  return dx <= sx && dy <= sy;
 }
 
 /// Alpha of a Gaussian at a pixel centre (px, py), or 0 when it is skipped (power > 0 or alpha
