@@ -46,6 +46,12 @@ gpu_build() {
   local src="${1:-.}"
   (
     cd "$src" || exit 1
+    # One build of a tree at a time: two scripts started together (e.g. two experiments.sh) both
+    # build; unlocked, they raced in one build-gpu/ and a link failed (2026-11-27). The second
+    # waits and finds the build up to date.
+    mkdir -p build-gpu
+    exec {build_lock}> build-gpu/.build.lock
+    flock "$build_lock"
     gpu_unpack_deps
     local torch_cmake=/opt/torch/.venv/lib/python3.12/site-packages/torch/share/cmake
     [ -d "$torch_cmake" ] || torch_cmake=$(python3 -c 'import torch; print(torch.utils.cmake_prefix_path)')
