@@ -432,6 +432,19 @@ gaussians::raster::Camera<double> binningTestCamera() {
   return cam;
 }
 
+// A random Gaussian in front of binningTestCamera(), projected into *p; odd k gives a needle (one
+// scale 10-40x the others). False when it does not project.
+bool randomBinningGaussian(std::mt19937& rng, int k, gaussians::raster::Projected<double>* p) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
+  const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
+  const double stretch = k % 2 ? 10 + 30 * (1 + u(rng)) / 2 : 1;
+  const double log_scale[3] = {std::log((0.005 + 0.02 * (1 + u(rng))) * stretch),
+                               std::log(0.005 + 0.02 * (1 + u(rng))),
+                               std::log(0.005 + 0.02 * (1 + u(rng)))};
+  return gaussians::raster::projectGaussian(mean, quat, log_scale, binningTestCamera(), p);
+}
+
 // |offset| (x, y) from the projected mean of every pixel centre around it (the 3-sigma box and 2
 // pixels more) where pixelAlpha is non-zero, cut at the 3-sigma box: past it an opaque Gaussian
 // can still reach 1/255 (out to ~3.3 sigma), and the rasterizer cuts it there by design (as the
@@ -500,20 +513,11 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
   // Gaussian stretched along one screen axis it is much narrower across that axis.
   using gaussians::raster::alphaBox;
   using gaussians::raster::alphaExtent;
-  const gaussians::raster::Camera<double> cam = binningTestCamera();
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1, 1);
   int narrower = 0, checked = 0, boxes = 0;
   for (int k = 0; k < 80; ++k) {
-    const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
-    const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
-    // Half of them needle-like: one scale 10-40x the others.
-    const double stretch = k % 2 ? 10 + 30 * (1 + u(rng)) / 2 : 1;
-    const double log_scale[3] = {std::log((0.005 + 0.02 * (1 + u(rng))) * stretch),
-                                 std::log(0.005 + 0.02 * (1 + u(rng))),
-                                 std::log(0.005 + 0.02 * (1 + u(rng)))};
     gaussians::raster::Projected<double> p;
-    if (!gaussians::raster::projectGaussian(mean, quat, log_scale, cam, &p)) continue;
+    if (!randomBinningGaussian(rng, k, &p)) continue;
     for (double opacity : {1.0 / 300, 1.0 / 255, 0.0045, 0.05, 0.5, 0.99, 1.0}) {
       const int extent = alphaExtent(p.radius, opacity);
       int rx = -1, ry = -1;
@@ -542,19 +546,11 @@ TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
   // float, as the kernel runs it, no pixel centre of a skipped rectangle may have a non-zero
   // pixelAlpha; and the test must skip rectangles (it is not "always yes").
   using gaussians::raster::alphaMayReach;
-  const gaussians::raster::Camera<double> cam = binningTestCamera();
   std::mt19937 rng(23);
-  std::uniform_real_distribution<double> u(-1, 1);
   int reached = 0, skipped = 0;
   for (int k = 0; k < 80; ++k) {
-    const double mean[3] = {0.3 * u(rng), 0.3 * u(rng), 2.5 + u(rng)};
-    const double quat[4] = {u(rng), u(rng), u(rng), u(rng)};
-    const double stretch = k % 2 ? 10 + 30 * (1 + u(rng)) / 2 : 1;
-    const double log_scale[3] = {std::log((0.005 + 0.02 * (1 + u(rng))) * stretch),
-                                 std::log(0.005 + 0.02 * (1 + u(rng))),
-                                 std::log(0.005 + 0.02 * (1 + u(rng)))};
     gaussians::raster::Projected<double> p;
-    if (!gaussians::raster::projectGaussian(mean, quat, log_scale, cam, &p)) continue;
+    if (!randomBinningGaussian(rng, k, &p)) continue;
     const float m[2] = {float(p.mean2d[0]), float(p.mean2d[1])};
     const float conic[3] = {float(p.conic[0]), float(p.conic[1]), float(p.conic[2])};
     for (float opacity : {1.f / 300, 1.f / 255, 0.0045f, 0.05f, 0.5f, 1.f}) {
@@ -571,12 +567,12 @@ TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
                                                   &clamped) != 0.f;
             }
           }
-          const bool may = alphaMayReach(m, conic, opacity, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f,
-                                         y0 + 1.5f);
+          const bool may =
+              alphaMayReach(m, conic, opacity, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f, y0 + 1.5f);
           if (any) {
             ++reached;
-            EXPECT_TRUE(may) << "Gaussian " << k << " opacity " << opacity << " at " << x0
-                             << ", " << y0;
+            EXPECT_TRUE(may) << "Gaussian " << k << " opacity " << opacity << " at " << x0 << ", "
+                             << y0;
           }
           skipped += !may;
         }
