@@ -76,6 +76,34 @@ TEST(StepProfile, NestedPhasesKeepTheirOwnTimeAndAddUpToTheTotal) {
   EXPECT_EQ(table.find("peak allocated"), std::string::npos);
 }
 
+TEST(StepProfile, EachPhaseCountsItsOwnOperatorCallsOnceWhateverTheNumberOfProfiles) {
+  StepProfile profile(at::Device(at::kCPU), StepProfile::Clock::kHost);
+  StepProfile other(at::Device(at::kCPU));  // a second live profile must not double the count
+  const at::Tensor x = at::ones({4});
+  profile.enter("three adds");
+  at::Tensor y = x;
+  for (int i = 0; i < 3; ++i) y = at::add(y, x);
+  profile.enter("no operator");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  profile.enter("outer");
+  {
+    const gaussians::ActiveProfileScope active(&profile);
+    const gaussians::ScopedPhase inner("inner");
+    y = at::mul(y, x);
+  }
+  y = at::sub(y, x);
+  y = at::sub(y, x);
+  profile.leave();
+  profile.countIteration();
+  EXPECT_EQ(profile.operatorCalls("three adds"), 3);
+  EXPECT_EQ(profile.operatorCalls("no operator"), 0);
+  EXPECT_EQ(profile.operatorCalls("outer / inner"), 1);
+  EXPECT_EQ(profile.operatorCalls("outer"), 2);  // its nested phase's call not counted twice
+  EXPECT_EQ(y[0].item<float>(), 2.0f);  // (1 + 3) * 1 - 2
+  EXPECT_NE(profile.table().find("| three adds | "), std::string::npos);
+  EXPECT_NE(profile.table().find(" | 3.0 |"), std::string::npos);
+}
+
 TEST(StepProfile, TheActiveProfileScopeRestoresThePreviousOne) {
   StepProfile a(at::Device(at::kCPU)), b(at::Device(at::kCPU));
   EXPECT_EQ(gaussians::activeProfile(), nullptr);
@@ -111,6 +139,7 @@ TEST(StepProfile, AProfiledTrainingTimesEveryPhaseAndGivesTheSameModel) {
   for (const char* phase : {"render forward", "losses forward", "backward", "optimiser",
                             "densify, prune, reset", "loss values to host"}) {
     EXPECT_GT(profile->seconds(phase), 0.0) << phase;
+    EXPECT_GT(profile->operatorCalls(phase), 0) << phase;
   }
   // The rasterizer's steps, nested in the trainer's phases (the CPU backward runs in this thread).
   for (const char* phase : {"render forward / project", "render forward / SH",

@@ -49,7 +49,11 @@ class TrainCommand : public Command {
         ->check(CLI::IsMember({"paper", "long"}));
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "
-                "and write RUN/profile.md");
+                "and count its ATen operator calls; writes RUN/profile.md");
+    c->add_flag("--profile-host", profile_host_,
+                "as --profile on the host's clock: no phase waits for the GPU, so each phase "
+                "gets the time the CPU spent issuing its work (or waiting for a value)")
+        ->excludes("--profile");
     const gaussians::TrainConfig defaults;
     for (const gaussians::TrainOption& o : gaussians::trainOptions()) {
       if (o.flag == nullptr) continue;
@@ -137,7 +141,8 @@ class TrainCommand : public Command {
     options.out = out_;
     options.scale = scale_;
     options.resume = resume_;
-    options.profile = profile_;
+    if (profile_) options.profile = gaussians::StepProfile::Clock::kDeviceWaited;
+    if (profile_host_) options.profile = gaussians::StepProfile::Clock::kHost;
     options.progress = quiet_rank ? nullptr : &std::cout;
     options.stop = &g_stop;
     installStopHandlers();
@@ -151,7 +156,7 @@ class TrainCommand : public Command {
  private:
   std::string scene_, out_, config_file_, schedule_ = "paper";
   double scale_ = 0.5;
-  bool resume_ = false, profile_ = false, batch_schedule_ = false;
+  bool resume_ = false, profile_ = false, profile_host_ = false, batch_schedule_ = false;
   int nproc_ = 0;
   std::map<const gaussians::TrainOption*, CLI::Option*> flags_;
   std::map<const gaussians::TrainOption*, std::string> values_;

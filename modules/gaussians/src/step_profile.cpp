@@ -1,8 +1,11 @@
 #include "sadsplat/gaussians/step_profile.h"
 
+#include <ATen/record_function.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <mutex>
 #include <numeric>
 
 #if SADSPLAT_HAVE_CUDA
@@ -15,6 +18,31 @@ namespace gaussians {
 namespace {
 
 std::atomic<StepProfile*> g_active{nullptr};
+
+// ATen operator calls of the whole process while at least one profile exists: one RecordFunction
+// callback (for every thread), added by the first profile and removed with the last.
+std::atomic<std::int64_t> g_operator_calls{0};
+std::mutex g_counter_mutex;
+int g_counting_profiles = 0;
+at::CallbackHandle g_counter_handle = 0;
+
+std::unique_ptr<at::ObserverContext> countOperatorCall(const at::RecordFunction&) {
+  g_operator_calls.fetch_add(1, std::memory_order_relaxed);
+  return nullptr;
+}
+
+void startCountingOperatorCalls() {
+  const std::lock_guard<std::mutex> lock(g_counter_mutex);
+  if (g_counting_profiles++ == 0) {
+    g_counter_handle = at::addGlobalCallback(
+        at::RecordFunctionCallback(countOperatorCall).scopes({at::RecordScope::FUNCTION}));
+  }
+}
+
+void stopCountingOperatorCalls() {
+  const std::lock_guard<std::mutex> lock(g_counter_mutex);
+  if (--g_counting_profiles == 0) at::removeCallback(g_counter_handle);
+}
 
 struct DevicePeaks {
   std::int64_t allocated = 0;
@@ -59,11 +87,14 @@ void synchronizeDevice(const at::Device& device) {
 StepProfile* activeProfile() { return g_active.load(); }
 void setActiveProfile(StepProfile* profile) { g_active.store(profile); }
 
-StepProfile::StepProfile(const at::Device& device) : device_(device) {
+StepProfile::StepProfile(const at::Device& device, Clock clock) : device_(device), clock_(clock) {
   const DevicePeaks before = devicePeaks(device_);
   peak_allocated_before_ = before.allocated;
   peak_reserved_before_ = before.reserved;
+  startCountingOperatorCalls();
 }
+
+StepProfile::~StepProfile() { stopCountingOperatorCalls(); }
 
 const StepProfile::Phase* StepProfile::find(const std::string& name) const {
   const auto it =
@@ -77,19 +108,24 @@ int StepProfile::indexOf(const std::string& name) {
   return static_cast<int>(phases_.size()) - 1;
 }
 
+bool StepProfile::waitsForDevice() const { return clock_ == Clock::kDeviceWaited; }
+
 void StepProfile::closeSlice() {
-  synchronizeDevice(device_);
+  if (waitsForDevice()) synchronizeDevice(device_);
   const auto now = std::chrono::steady_clock::now();
   if (stack_.empty()) return;
   Phase& p = phases_[static_cast<std::size_t>(stack_.back())];
   p.seconds += std::chrono::duration<double>(now - start_).count();
+  p.operator_calls += g_operator_calls.load() - calls_at_open_;
+  if (!waitsForDevice()) return;  // peaks read while the device runs would mean little
   const DevicePeaks peaks = devicePeaks(device_);
   p.peak_allocated = std::max(p.peak_allocated, peaks.allocated);
   peak_reserved_ = std::max(peak_reserved_, peaks.reserved);
 }
 
 void StepProfile::openSlice() {
-  resetDevicePeaks(device_);
+  if (waitsForDevice()) resetDevicePeaks(device_);
+  calls_at_open_ = g_operator_calls.load();
   start_ = std::chrono::steady_clock::now();  // closeSlice() has synchronised the device
 }
 
@@ -127,6 +163,11 @@ std::int64_t StepProfile::peakAllocatedBytes(const std::string& name) const {
   return p == nullptr ? 0 : p->peak_allocated;
 }
 
+std::int64_t StepProfile::operatorCalls(const std::string& name) const {
+  const Phase* p = find(name);
+  return p == nullptr ? 0 : p->operator_calls;
+}
+
 double StepProfile::totalSeconds() const {
   return std::accumulate(phases_.begin(), phases_.end(), 0.0,
                          [](double sum, const Phase& p) { return sum + p.seconds; });
@@ -135,16 +176,20 @@ double StepProfile::totalSeconds() const {
 std::string StepProfile::table() const {
   const double total = totalSeconds();
   const double per = 1000.0 / std::max(1, iterations_);
-  const bool memory = device_.is_cuda();
+  const bool memory = device_.is_cuda() && waitsForDevice();
   constexpr double kMiB = 1024.0 * 1024.0;
-  std::string out = memory ? "| phase | total s | ms / iteration | share | peak allocated MiB |\n"
-                             "|---|---|---|---|---|\n"
-                           : "| phase | total s | ms / iteration | share |\n|---|---|---|---|\n";
+  std::string out =
+      memory ? "| phase | total s | ms / iteration | share | operator calls / iteration | peak "
+               "allocated MiB |\n|---|---|---|---|---|---|\n"
+             : "| phase | total s | ms / iteration | share | operator calls / iteration |\n"
+               "|---|---|---|---|---|\n";
   char line[512];
-  std::int64_t peak = 0;
+  std::int64_t peak = 0, calls = 0;
   for (const Phase& p : phases_) {
-    std::snprintf(line, sizeof line, "| %s | %.3f | %.3f | %.1f %% |", p.name.c_str(), p.seconds,
-                  p.seconds * per, total > 0 ? 100.0 * p.seconds / total : 0.0);
+    std::snprintf(line, sizeof line, "| %s | %.3f | %.3f | %.1f %% | %.1f |", p.name.c_str(),
+                  p.seconds, p.seconds * per, total > 0 ? 100.0 * p.seconds / total : 0.0,
+                  static_cast<double>(p.operator_calls) / std::max(1, iterations_));
+    calls += p.operator_calls;
     out += line;
     if (memory) {
       std::snprintf(line, sizeof line, " %.0f |", p.peak_allocated / kMiB);
@@ -153,8 +198,9 @@ std::string StepProfile::table() const {
     out += "\n";
     peak = std::max(peak, p.peak_allocated);
   }
-  std::snprintf(line, sizeof line, "| **total** (%d iterations) | %.3f | %.3f | 100 %% |%s\n",
-                iterations_, total, total * per, memory ? " |" : "");
+  std::snprintf(line, sizeof line, "| **total** (%d iterations) | %.3f | %.3f | 100 %% | %.1f |%s\n",
+                iterations_, total, total * per,
+                static_cast<double>(calls) / std::max(1, iterations_), memory ? " |" : "");
   out += line;
   if (memory) {
     std::snprintf(line, sizeof line,

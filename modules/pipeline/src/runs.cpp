@@ -220,7 +220,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   gaussians::StepProfile::Ptr profile;
   if (o.profile) {
     profile = std::make_shared<gaussians::StepProfile>(
-        config.device == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU));
+        config.device == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU), *o.profile);
     trainer.setProfile(profile);
   }
   const auto start = Clock::now();
@@ -371,7 +371,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   if (o.progress) *o.progress << "\n";
   if (profile) {
     const std::string table = "Training time per phase (" + config.device +
-                              ", each phase boundary waits for the device):\n\n" + profile->table();
+                              (*o.profile == gaussians::StepProfile::Clock::kHost
+                                   ? ", the host's clock: no phase waits for the device"
+                                   : ", each phase boundary waits for the device") +
+                              "):\n\n" + profile->table();
     if (writer) writeText(o.out + "/profile.md", table);
     if (o.progress) *o.progress << table;
   }

@@ -6,6 +6,13 @@
 /// one (the CPU can no longer queue work ahead of the GPU); compare the total with an unprofiled
 /// run to see what the synchronisation itself costs.
 ///
+/// On the host's clock (`sadsplat train --profile-host`) no phase waits for the device: a phase
+/// gets the time the CPU spent issuing its work, and a phase that has to read a device value
+/// (the binning's intersection count) shows the wait for the GPU's queue. When the phases' host
+/// time adds up to the unprofiled run's wall time, the host, not the GPU, sets the pace.
+/// Either way each phase also counts the ATen operator calls it made (each costs host time in
+/// the dispatcher, and on a GPU usually one kernel launch).
+///
 /// Phases nest: library code deeper down (the rasterizer's steps, the SSIM) opens a
 /// ScopedPhase, which the active profile (setActiveProfile / ActiveProfileScope) records as
 /// "parent / name". A phase's time is its own (exclusive): the time of the phases nested in it
@@ -33,9 +40,18 @@ class StepProfile {
  public:
   using Ptr = std::shared_ptr<StepProfile>;
 
-  /// \param[in] device the device whose queue each phase boundary waits for; on CUDA the
-  /// device's memory peaks so far are kept as those "before the first phase"
-  explicit StepProfile(const at::Device& device);
+  /// \brief Which clock the phases run on.
+  enum class Clock {
+    kDeviceWaited,  ///< each boundary waits for the device: a phase gets its device work's time
+    kHost,          ///< no waits: a phase gets the host's time (see the file comment)
+  };
+
+  /// \param[in] device the device whose queue each phase boundary waits for (kDeviceWaited); on
+  /// CUDA the device's memory peaks so far are kept as those "before the first phase"
+  explicit StepProfile(const at::Device& device, Clock clock = Clock::kDeviceWaited);
+  ~StepProfile();
+  StepProfile(const StepProfile&) = delete;
+  StepProfile& operator=(const StepProfile&) = delete;
 
   /// \brief Ends the current phases (if any) and starts the top-level phase `name` (phases
   /// appear in the table in first-use order).
@@ -59,8 +75,12 @@ class StepProfile {
   double totalSeconds() const;
   /// \brief The largest device memory allocated while `name` ran (bytes; 0 on the CPU).
   std::int64_t peakAllocatedBytes(const std::string& name) const;
-  /// \brief A Markdown table: phase, total seconds, milliseconds per iteration, share (and on
-  /// CUDA the peak allocated MiB per phase, and the peaks of the whole run).
+  /// \brief ATen operator calls (nested ones included) made while `name` was the innermost
+  /// open phase, from any thread (the autograd engine's too).
+  std::int64_t operatorCalls(const std::string& name) const;
+  /// \brief A Markdown table: phase, total seconds, milliseconds per iteration, share, operator
+  /// calls per iteration (and on CUDA with device waits the peak allocated MiB per phase, and
+  /// the peaks of the whole run).
   std::string table() const;
 
  private:
@@ -68,13 +88,17 @@ class StepProfile {
     std::string name;
     double seconds = 0.0;
     std::int64_t peak_allocated = 0;
+    std::int64_t operator_calls = 0;
   };
   const Phase* find(const std::string& name) const;  // null when never timed
+  bool waitsForDevice() const;
   int indexOf(const std::string& name);              // find(), or a new phase
-  void closeSlice();  // waits for the device, credits the innermost phase with its time
+  void closeSlice();  // (waits for the device,) credits the innermost phase with its time
   void openSlice();   // starts the clock (and the device's peak memory counters) afresh
 
   at::Device device_;
+  Clock clock_;
+  std::int64_t calls_at_open_ = 0;  // the process's operator-call count when the slice opened
   std::vector<Phase> phases_;
   std::vector<int> stack_;
   std::chrono::steady_clock::time_point start_;

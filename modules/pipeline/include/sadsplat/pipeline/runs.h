@@ -12,6 +12,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -36,9 +37,10 @@ struct TrainRunOptions {
   /// Set (e.g. by a SIGINT / SIGTERM handler) to stop after the current iteration: the run
   /// writes its checkpoint and run.json, then throws TrainingInterrupted.
   const std::atomic<bool>* stop = nullptr;
-  /// Time every phase of every iteration (synchronising the device at each boundary) and write
-  /// the table to out/profile.md and to `progress`.
-  bool profile = false;
+  /// Time every phase of every iteration on this clock (gaussians::StepProfile::Clock: waiting
+  /// for the device at each boundary, or the host's clock) and write the table to out/profile.md
+  /// and to `progress`; none: no profile.
+  std::optional<gaussians::StepProfile::Clock> profile;
   /// Train as one rank of a data-parallel group (distributed::joinGroup); only rank 0 writes the
   /// run directory, every rank resumes from its checkpoint.
   gaussians::Collective::Ptr collective;
