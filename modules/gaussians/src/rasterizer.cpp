@@ -107,27 +107,34 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     const CameraParams cam = unpackCamera(ctx->saved_data["camera"].toDoubleVector());
     const at::Tensor g_m2 = orZeros(grads[0], at::empty({m.size(0), 2}, m.options()));
     const at::Tensor g_co = orZeros(grads[1], at::empty({m.size(0), 3}, m.options()));
-    const at::Tensor g_d = orZeros(grads[2], at::empty({m.size(0)}, m.options()));
     raster::ProjectionGrads g;
     if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
+      // Training renders no depth: the CUDA kernel takes its missing gradient as zeros.
       const c10::cuda::CUDAGuard guard(m.device());
+      const at::Tensor g_d = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
       g = raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d, currentStream(m));
 #else
       noCuda();
 #endif
     } else {
+      const at::Tensor g_d = orZeros(grads[2], at::empty({m.size(0)}, m.options()));
       g = raster::projectBackwardCpu(m, q, s, radii, cam, g_m2, g_co, g_d);
     }
     return {g.means, g.quats, g.log_scales, at::Tensor()};
   }
 };
 
+// Outputs {head, tail, alpha}: the image's first `split` channels as their own contiguous
+// image (RGB), the others as a view of the rasterizer's [H, W, D] output (features, depth), and
+// alpha. The backward writes the two parts' gradients into one [H, W, D] gradient image: slicing
+// the image outside would cost, per render, two zero-filled full-size images and their sum.
 struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   static variable_list forward(AutogradContext* ctx, const at::Tensor& means2d,
                                const at::Tensor& conics, const at::Tensor& opacities,
                                const at::Tensor& values, const at::Tensor& radii,
-                               const at::Tensor& depths, int64_t width, int64_t height) {
+                               const at::Tensor& depths, int64_t width, int64_t height,
+                               int64_t split) {
     const ScopedPhase phase("rasterize");
     const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
                      op = opacities.contiguous(), val = values.contiguous();
@@ -153,7 +160,9 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     ctx->saved_data["last"] = r.last;
     ctx->saved_data["tile_ranges"] = r.binning.tile_ranges;
     ctx->saved_data["gaussian_ids"] = r.binning.gaussian_ids;
-    return {r.image, r.alpha};
+    ctx->saved_data["split"] = split;
+    const int64_t D = r.image.size(2);
+    return {r.image.slice(2, 0, split).contiguous(), r.image.slice(2, split, D), r.alpha};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
@@ -165,22 +174,39 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     fwd.binning.tile_ranges = ctx->saved_data["tile_ranges"].toTensor();
     fwd.binning.gaussian_ids = ctx->saved_data["gaussian_ids"].toTensor();
     const at::Tensor& val = saved[3];
-    const at::Tensor g_img = orZeros(
-        grads[0], at::empty({fwd.alpha.size(0), fwd.alpha.size(1), val.size(1)}, val.options()));
-    const at::Tensor g_alpha = orZeros(grads[1], fwd.alpha);
+    const int64_t split = ctx->saved_data["split"].toInt(), D = val.size(1);
+    at::Tensor g_img;
+    if (split == 0 && grads[1].defined()) {
+      g_img = grads[1].contiguous();
+    } else {
+      g_img = at::empty({fwd.alpha.size(0), fwd.alpha.size(1), D}, val.options());
+      const std::array<std::pair<int64_t, int64_t>, 2> parts{{{0, split}, {split, D}}};
+      for (int k = 0; k < 2; ++k) {
+        if (parts[k].first == parts[k].second) continue;
+        at::Tensor part = g_img.slice(2, parts[k].first, parts[k].second);
+        if (grads[k].defined()) {
+          part.copy_(grads[k]);
+        } else {
+          part.zero_();
+        }
+      }
+    }
     raster::RasterGrads g;
     if (val.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
+      // Alpha without a gradient (a black background): the CUDA kernel takes it as zeros.
       const c10::cuda::CUDAGuard guard(val.device());
+      const at::Tensor g_alpha = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
       g = raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha,
                                         currentStream(val));
 #else
       noCuda();
 #endif
     } else {
+      const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha);
       g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
     }
-    return {g.means2d,    g.conics,     g.opacities,  g.values,
+    return {g.means2d,    g.conics,     g.opacities,  g.values,    at::Tensor(),
             at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };
@@ -345,18 +371,33 @@ std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Te
   return {out[0], out[1], out[2], out[3]};
 }
 
-std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at::Tensor& conics,
-                                            const at::Tensor& opacities, const at::Tensor& values,
-                                            const at::Tensor& radii, const at::Tensor& depths,
-                                            int width, int height) {
+namespace {
+
+// rasterizeToPixels with the image's first `split` channels apart (RasterizeFunction): returns
+// {head [H, W, split], tail [H, W, D - split], alpha [H, W]}.
+std::array<at::Tensor, 3> splitRasterize(const at::Tensor& means2d, const at::Tensor& conics,
+                                         const at::Tensor& opacities, const at::Tensor& values,
+                                         const at::Tensor& radii, const at::Tensor& depths,
+                                         int width, int height, int64_t split) {
   const int64_t n = means2d.size(0);
   expectTensor(conics, "conics", n, {3}, means2d);
   expectTensor(opacities, "opacities", n, {}, means2d);
   expectTensor(values, "values", n, {-1}, means2d);
   expectTensor(depths, "depths", n, {}, means2d);
   const auto out = RasterizeFunction::apply(means2d, conics, opacities, values, radii,
-                                            depths.detach(), width, height);
-  return {out[0], out[1]};
+                                            depths.detach(), width, height, split);
+  return {out[0], out[1], out[2]};
+}
+
+}  // namespace
+
+std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at::Tensor& conics,
+                                            const at::Tensor& opacities, const at::Tensor& values,
+                                            const at::Tensor& radii, const at::Tensor& depths,
+                                            int width, int height) {
+  const auto out = splitRasterize(means2d, conics, opacities, values, radii, depths, width,
+                                  height, 0);
+  return {out[1], out[2]};
 }
 
 namespace {
@@ -414,14 +455,16 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
     expectTensor(g.opacity_gate, "opacity_gate", n, {}, g.means);
     opacities = opacities * g.opacity_gate;
   }
-  auto [image, alpha] = rasterizeToPixels(means2d, conics, opacities, values, radii, depths,
-                                          camera.width, camera.height);
+  // RGB apart from the features (and depth): the losses' gradients reach the rasterizer without
+  // a slice backward of the whole image.
+  auto [rgb, rest, alpha] = splitRasterize(means2d, conics, opacities, values, radii, depths,
+                                           camera.width, camera.height, 3);
   const int64_t C = features.size(1);
   RenderResult result;
-  result.rgb = composeBackground(image.slice(2, 0, 3), alpha, settings.background);
-  result.features = image.slice(2, 3, 3 + C);
+  result.rgb = composeBackground(rgb, alpha, settings.background);
+  result.features = settings.depth ? rest.slice(2, 0, C) : rest;
   if (settings.depth) {
-    const at::Tensor depth_sum = image.select(2, 3 + C);
+    const at::Tensor depth_sum = rest.select(2, C);
     result.depth = at::where(alpha > 0, depth_sum / alpha.clamp_min(1e-10), at::zeros_like(alpha));
   }
   result.alpha = alpha;

@@ -257,14 +257,18 @@ StepStats Trainer::step(bool read_losses) {
     RenderResult r = render(g, s.views.cameras[v], settings);
     r.means2d.retain_grad();
     enterPhase(profile, "losses forward");
+    // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
+    // operations for the host to issue and for the autograd engine to run backwards.
     const at::Tensor& gt = s.views.images[v];
-    const at::Tensor mask = s.views.masks[v].unsqueeze(2);
-    const at::Tensor l1 = ((r.rgb - gt).abs() * mask).mean();
+    const bool masked = !s.views.mask_is_full[v];
+    const at::Tensor mask = masked ? s.views.masks[v].unsqueeze(2) : at::Tensor();
+    const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
+    const at::Tensor l1 = masking((r.rgb - gt).abs()).mean();
     const at::Tensor rgb_loss =
         (1 - c.lambda_ssim) * l1 +
-        c.lambda_ssim * (1 - (c.fused_ssim ? ssim(r.rgb * mask, gt * mask)
-                                           : ssimReference(r.rgb * mask, gt * mask)));
-    at::Tensor loss = c.lambda_rgb * rgb_loss;
+        c.lambda_ssim * (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
+                                           : ssimReference(masking(r.rgb), masking(gt))));
+    at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
     accumulate(rgb_sum, rgb_loss);
     if (role.semantic) {
       // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
@@ -276,7 +280,8 @@ StepStats Trainer::step(bool read_losses) {
       const at::Tensor sem = role.decoder_learns
                                  ? loss_of(r.features, labels, w, b)
                                  : loss_of(r.features, labels, w.detach(), b.detach());
-      loss = loss + s.views.semantic_weight[v] * sem;
+      const double weight = s.views.semantic_weight[v];
+      loss = loss + (weight == 1 ? sem : weight * sem);
       accumulate(sem_sum, sem);
     }
     total = total.defined() ? total + loss : loss;

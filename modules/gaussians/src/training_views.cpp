@@ -90,6 +90,7 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
     if (!v.train) {
       s.images.emplace_back();
       s.masks.emplace_back();
+      s.mask_is_full.push_back(0);
       s.labels.emplace_back();
       s.semantic_weight.push_back(0.0);
       s.confidence_maps.emplace_back();
@@ -106,6 +107,8 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
                           .div(255.0);
     s.images.push_back(rgb.to(device));
     s.masks.push_back(mask.to(device));
+    s.mask_is_full.push_back(std::all_of(v.mask.pixels.begin(), v.mask.pixels.end(),
+                                         [](std::uint8_t m) { return m == 255; }));
     // Semantic supervision (ground truth wins, then kept pseudo-labels) and the confidence map
     // of the drop (1 on ground-truth pixels, else the pseudo-label backend's max class score).
     at::Tensor labels, confidence;

@@ -26,6 +26,7 @@ struct TrainingViews {
   std::vector<RasterCamera> cameras;        // every view of the scene
   std::vector<at::Tensor> images;           // [H, W, 3] float in [0, 1] (training views only)
   std::vector<at::Tensor> masks;            // [H, W] float, 1 = valid pixel
+  std::vector<char> mask_is_full;           // every pixel valid: the mask multiplies nothing
   std::vector<at::Tensor> labels;           // [H, W] int64, -1 = not supervised (or undefined)
   std::vector<double> semantic_weight;      // lambda_semantic (ground truth) or lambda_pseudo
   std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (or undefined)
