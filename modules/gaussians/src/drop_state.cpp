@@ -8,6 +8,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
+#include "sadsplat/gaussians/l0_force.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -69,15 +70,8 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
   // at 1 gives log_alpha no gradient, but the L0 force acts on it as in the paper's rule.
   const at::Tensor opacity_grad = params["opacity"].value.grad();
   if (!opacity_grad.defined()) return;
-  const at::Tensor reached = (opacity_grad != 0).to(grad.dtype());
-  const at::Tensor rgb_force = (grad.abs() * reached).sum();
-  const at::Tensor l0_force = (direction * reached).sum();
-  // Both sums are over the same gates, so their ratio is the ratio of the means.
-  const at::Tensor scale = at::where(l0_force > 0, rgb_force / l0_force.clamp_min(1e-30),
-                                     at::zeros_like(l0_force));
-  at::Tensor force = direction * reached * (strength * scale);
-  if (config_.l0_importance > 0) force = force * l0_weights_;
-  grad.add_(force);
+  addBalancedL0Force(grad, direction, opacity_grad,
+                     config_.l0_importance > 0 ? l0_weights_ : at::Tensor(), strength);
 }
 
 bool DropState::guardProbeDue(int done) const {

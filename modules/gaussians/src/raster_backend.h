@@ -89,6 +89,7 @@ std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::
 ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
                                     const at::Tensor& log_scales, const CameraParams& cam,
                                     void* stream);
+// g_depths may be undefined (no depth gradient: zeros).
 ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& quats,
                                     const at::Tensor& log_scales, const at::Tensor& radii,
                                     const CameraParams& cam, const at::Tensor& g_means2d,
@@ -98,6 +99,7 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const at::Tensor& radii, const at::Tensor& depths, int width,
                                   int height, void* stream);
+// g_alpha may be undefined (no alpha gradient: zeros).
 RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const RasterResult& forward, const at::Tensor& g_image,

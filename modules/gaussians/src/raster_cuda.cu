@@ -44,6 +44,10 @@ __global__ void projectForwardKernel(int64_t n, const float* __restrict__ means,
   if (i >= n) return;
   Projected<float> p;
   if (!projectGaussian(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam, &p)) {
+    // Every output written (they are allocated without a fill).
+    means2d[2 * i] = means2d[2 * i + 1] = 0.f;
+    conics[3 * i] = conics[3 * i + 1] = conics[3 * i + 2] = 0.f;
+    depths[i] = 0.f;
     radii[i] = 0;
     return;
   }
@@ -62,10 +66,19 @@ __global__ void projectBackwardKernel(
     const float* __restrict__ g_means2d, const float* __restrict__ g_conics,
     const float* __restrict__ g_depths, float* g_means, float* g_quats, float* g_log_scales) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (i >= n || radii[i] <= 0) return;
-  projectGaussianBackward(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam, g_means2d + 2 * i,
-                          g_conics + 3 * i, g_depths[i], g_means + 3 * i, g_quats + 4 * i,
-                          g_log_scales + 3 * i);
+  if (i >= n) return;
+  // The gradients are allocated without a fill: every row starts at zero here, and
+  // projectGaussianBackward adds to it. g_depths may be null (no depth gradient).
+  float g_mean[3] = {0.f, 0.f, 0.f}, g_quat[4] = {0.f, 0.f, 0.f, 0.f};
+  float g_log_scale[3] = {0.f, 0.f, 0.f};
+  if (radii[i] > 0) {
+    projectGaussianBackward(means + 3 * i, quats + 4 * i, log_scales + 3 * i, cam,
+                            g_means2d + 2 * i, g_conics + 3 * i,
+                            g_depths != nullptr ? g_depths[i] : 0.f, g_mean, g_quat, g_log_scale);
+  }
+  for (int k = 0; k < 3; ++k) g_means[3 * i + k] = g_mean[k];
+  for (int k = 0; k < 4; ++k) g_quats[4 * i + k] = g_quat[k];
+  for (int k = 0; k < 3; ++k) g_log_scales[3 * i + k] = g_log_scale[k];
 }
 
 // ---- spherical harmonics ---------------------------------------------------------------------
@@ -564,7 +577,7 @@ __global__ void __launch_bounds__(kBlock)
   const int64_t pix = inside ? static_cast<int64_t>(py) * width + px : 0;
   const float final_trans = inside ? 1.f - alpha_fwd[pix] : 1.f;
   const int last = inside ? last_fwd[pix] : 0;
-  const float ga_out = inside ? g_alpha[pix] : 0.f;
+  const float ga_out = inside && g_alpha != nullptr ? g_alpha[pix] : 0.f;
   float* my_gpix = s_gpix + (static_cast<int64_t>(warp) * 32 + lane) * S;
   for (int c = 0; c < S; ++c) my_gpix[c] = c < D && inside ? g_image[pix * D + c] : 0.f;
   float trans = final_trans;
@@ -695,10 +708,11 @@ ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& q
   cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t n = means.size(0);
   ProjectionResult out;
-  out.means2d = at::zeros({n, 2}, means.options());
-  out.conics = at::zeros({n, 3}, means.options());
-  out.depths = at::zeros({n}, means.options());
-  out.radii = at::zeros({n}, means.options().dtype(at::kInt));
+  // The kernel writes every row, also those of culled Gaussians: no fills.
+  out.means2d = at::empty({n, 2}, means.options());
+  out.conics = at::empty({n, 3}, means.options());
+  out.depths = at::empty({n}, means.options());
+  out.radii = at::empty({n}, means.options().dtype(at::kInt));
   if (n == 0) return out;
   projectForwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
       n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
@@ -716,17 +730,19 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
   cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t n = means.size(0);
   ProjectionGrads g;
-  g.means = at::zeros_like(means);
-  g.quats = at::zeros_like(quats);
-  g.log_scales = at::zeros_like(log_scales);
+  // The kernel writes every row: no fills.
+  g.means = at::empty_like(means);
+  g.quats = at::empty_like(quats);
+  g.log_scales = at::empty_like(log_scales);
   if (n == 0) return g;
   check(g_means2d, "grad means2d");
   check(g_conics, "grad conics");
-  check(g_depths, "grad depths");
+  if (g_depths.defined()) check(g_depths, "grad depths");
   projectBackwardKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
       n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
       radii.data_ptr<int>(), toCamera<float>(cam), g_means2d.data_ptr<float>(),
-      g_conics.data_ptr<float>(), g_depths.data_ptr<float>(), g.means.data_ptr<float>(),
+      g_conics.data_ptr<float>(), g_depths.defined() ? g_depths.data_ptr<float>() : nullptr,
+      g.means.data_ptr<float>(),
       g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
   checkLaunch("projectBackwardKernel");
   return g;
@@ -804,16 +820,20 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
                                   const RasterResult& fwd, const at::Tensor& g_image,
                                   const at::Tensor& g_alpha, void* stream_ptr) {
   check(g_image, "grad image");
-  check(g_alpha, "grad alpha");
+  if (g_alpha.defined()) check(g_alpha, "grad alpha");
   cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
   const int64_t D = values.size(1);
   const int height = static_cast<int>(fwd.alpha.size(0));
   const int width = static_cast<int>(fwd.alpha.size(1));
+  // The kernel adds into the four gradients: one zero fill for all, contiguous parts of it.
+  const int64_t n = means2d.size(0);
+  const at::Tensor zeros = at::zeros({n * (2 + 3 + 1 + D)}, values.options());
   RasterGrads g;
-  g.means2d = at::zeros_like(means2d);
-  g.conics = at::zeros_like(conics);
-  g.opacities = at::zeros_like(opacities);
-  g.values = at::zeros_like(values);
+  g.means2d = zeros.narrow(0, 0, 2 * n).view({n, 2});
+  g.conics = zeros.narrow(0, 2 * n, 3 * n).view({n, 3});
+  g.opacities = zeros.narrow(0, 5 * n, n).view(opacities.sizes());
+  g.values = zeros.narrow(0, 6 * n, D * n).view({n, D});
+  const float* g_alpha_ptr = g_alpha.defined() ? g_alpha.data_ptr<float>() : nullptr;
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
 #define SADSPLAT_LAUNCH_BACKWARD(CH)                                                               \
@@ -823,7 +843,7 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
                  fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),              \
                  conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),  \
                  fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(), \
-                 g_alpha.data_ptr<float>(), g.means2d.data_ptr<float>(),                           \
+                 g_alpha_ptr, g.means2d.data_ptr<float>(),                                         \
                  g.conics.data_ptr<float>(), g.opacities.data_ptr<float>(),                        \
                  g.values.data_ptr<float>())
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_BACKWARD)
