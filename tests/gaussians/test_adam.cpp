@@ -122,5 +122,43 @@ TEST(Adam, CudaStepMatchesTheCpuStep) {
   EXPECT_TRUE(at::allclose(cx2.cpu(), x, 1e-5, 1e-6));
 }
 
+// Several tensors of different sizes, one without a gradient, more than one launch's worth.
+std::vector<gaussians::AdamTensors> adamProblem(const at::Device& device) {
+  at::manual_seed(9);
+  std::vector<gaussians::AdamTensors> tensors;
+  for (int k = 0; k < 19; ++k) {
+    const std::int64_t n = 1 + (k * 7919) % 70000;
+    gaussians::AdamTensors t;
+    t.value = at::randn({n}).to(device);
+    t.grad = k == 3 ? at::Tensor() : (at::randn({n}) * 1e-3).to(device);
+    t.m = (at::randn({n}) * 1e-4).to(device);
+    t.v = (at::rand({n}) * 1e-6).to(device);
+    t.lr = 1e-3 * (k + 1);
+    tensors.push_back(t);
+  }
+  return tensors;
+}
+
+void expectOneStepPerTensor(const at::Device& device) {
+  std::vector<gaussians::AdamTensors> many = adamProblem(device), one = adamProblem(device);
+  gaussians::adamSteps(many, 7);
+  for (gaussians::AdamTensors& t : one) adamStep(t.value, t.grad, t.m, t.v, t.lr, 7);
+  for (std::size_t k = 0; k < many.size(); ++k) {
+    EXPECT_TRUE(at::equal(many[k].value, one[k].value)) << "tensor " << k;
+    EXPECT_TRUE(at::equal(many[k].m, one[k].m)) << "tensor " << k;
+    EXPECT_TRUE(at::equal(many[k].v, one[k].v)) << "tensor " << k;
+  }
+  EXPECT_FALSE(at::equal(many[18].value, adamProblem(device)[18].value));  // it moved
+}
+
+TEST(Adam, SeveralTensorsAtOnceGetTheValuesOfOneStepPerTensor) {
+  expectOneStepPerTensor(at::Device(at::kCPU));
+}
+
+TEST(Adam, CudaStepOfSeveralTensorsInOneLaunchIsBitIdenticalToOneStepPerTensor) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  expectOneStepPerTensor(at::Device(at::kCUDA, 0));
+}
+
 }  // namespace
 }  // namespace sadsplat

@@ -2,6 +2,7 @@
 
 #include <ATen/Parallel.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -23,6 +24,7 @@ namespace adam {
 #if SADSPLAT_HAVE_CUDA
 void stepCuda(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v,
               const Coefficients<float>& c, void* stream);
+void stepManyCuda(const StepBatch& batch, void* stream);
 #endif
 }  // namespace adam
 
@@ -82,8 +84,11 @@ void updateRange(float* x, const float* g, float* m, float* v, const adam::Coeff
 
 }  // namespace
 
-void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
-              std::int64_t step, const AdamSettings& settings) {
+namespace {
+
+// The arguments' checks of adamStep; returns the gradient, contiguous (or undefined).
+at::Tensor checkedGradient(const at::Tensor& value, const at::Tensor& grad, const at::Tensor& m,
+                           const at::Tensor& v, std::int64_t step) {
   if (!value.defined() || !value.is_contiguous()) {
     throw Error("<adam>", "value", "a defined, contiguous tensor",
                 value.defined() ? "a non-contiguous tensor" : "an undefined tensor");
@@ -93,6 +98,49 @@ void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tens
   expectLike(v, value, "v");
   const at::Tensor g = grad.defined() ? grad.contiguous() : grad;
   if (g.defined()) expectLike(g, value, "grad");
+  return g;
+}
+
+}  // namespace
+
+void adamSteps(std::vector<AdamTensors>& tensors, std::int64_t step,
+               const AdamSettings& settings) {
+#if SADSPLAT_HAVE_CUDA
+  const bool batched =
+      !tensors.empty() && std::all_of(tensors.begin(), tensors.end(), [&](const AdamTensors& t) {
+        return t.value.defined() && t.value.is_cuda() && t.value.scalar_type() == at::kFloat &&
+               t.value.device() == tensors.front().value.device();
+      });
+  if (batched) {
+    const c10::cuda::CUDAGuard guard(tensors.front().value.device());
+    adam::StepBatch batch;
+    std::vector<at::Tensor> grads;  // contiguous copies stay alive until the launch
+    const auto launch = [&] {
+      adam::stepManyCuda(batch, c10::cuda::getCurrentCUDAStream().stream());
+      batch = adam::StepBatch();
+      grads.clear();
+    };
+    for (AdamTensors& t : tensors) {
+      grads.push_back(checkedGradient(t.value, t.grad, t.m, t.v, step));
+      const int k = batch.count++;
+      batch.value[k] = t.value.detach().data_ptr<float>();
+      batch.grad[k] = grads.back().defined() ? grads.back().data_ptr<float>() : nullptr;
+      batch.m[k] = t.m.data_ptr<float>();
+      batch.v[k] = t.v.data_ptr<float>();
+      batch.n[k] = t.value.numel();
+      batch.c[k] = coefficients<float>(t.lr, step, settings);
+      if (batch.count == adam::kMaxBatch) launch();
+    }
+    launch();
+    return;
+  }
+#endif
+  for (AdamTensors& t : tensors) adamStep(t.value, t.grad, t.m, t.v, t.lr, step, settings);
+}
+
+void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
+              std::int64_t step, const AdamSettings& settings) {
+  const at::Tensor g = checkedGradient(value, grad, m, v, step);
   // The update runs outside autograd: value is a leaf that requires grad.
   at::Tensor data = value.detach();
   if (value.is_cuda()) {

@@ -17,7 +17,35 @@ __global__ void stepKernel(float* value, const float* grad, float* m, float* v, 
   update(value + i, grad != nullptr ? grad[i] : 0.0f, m + i, v + i, c);
 }
 
+// One launch for several tensors: blockIdx.y picks the tensor, blocks stride over its elements.
+__global__ void stepManyKernel(StepBatch batch) {
+  const int k = blockIdx.y;
+  const int64_t n = batch.n[k];
+  float* value = batch.value[k];
+  const float* grad = batch.grad[k];
+  float* m = batch.m[k];
+  float* v = batch.v[k];
+  const Coefficients<float> c = batch.c[k];
+  for (int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n;
+       i += static_cast<int64_t>(gridDim.x) * blockDim.x) {
+    update(value + i, grad != nullptr ? grad[i] : 0.0f, m + i, v + i, c);
+  }
+}
+
 }  // namespace
+
+void stepManyCuda(const StepBatch& batch, void* stream_ptr) {
+  if (batch.count == 0) return;
+  constexpr int kThreads = 256, kMaxBlocks = 1024;
+  int64_t largest = 0;
+  for (int k = 0; k < batch.count; ++k) largest = batch.n[k] > largest ? batch.n[k] : largest;
+  if (largest == 0) return;
+  const int64_t blocks = (largest + kThreads - 1) / kThreads;
+  const dim3 grid(static_cast<unsigned>(blocks < kMaxBlocks ? blocks : kMaxBlocks),
+                  static_cast<unsigned>(batch.count));
+  stepManyKernel<<<grid, kThreads, 0, static_cast<cudaStream_t>(stream_ptr)>>>(batch);
+  checkCudaLaunch("<adam>", "stepManyKernel");
+}
 
 void stepCuda(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v,
               const Coefficients<float>& c, void* stream_ptr) {

@@ -46,6 +46,18 @@ SADSPLAT_ADAM_HD void update(T* value, T grad, T* m, T* v, const Coefficients<T>
   *value -= c.lr * ((m_new / c.correction1) / (std::sqrt(v_new / c.correction2) + c.eps));
 }
 
+/// The tensors of one multi-tensor launch on CUDA (passed by value as the kernel's argument).
+constexpr int kMaxBatch = 16;
+struct StepBatch {
+  float* value[kMaxBatch];
+  const float* grad[kMaxBatch];  // null: a zero gradient
+  float* m[kMaxBatch];
+  float* v[kMaxBatch];
+  std::int64_t n[kMaxBatch];
+  Coefficients<float> c[kMaxBatch];
+  int count = 0;
+};
+
 }  // namespace adam
 }  // namespace gaussians
 }  // namespace sadsplat

@@ -76,11 +76,15 @@ RowChange ParameterStore::resize(const at::Tensor& keep,
 void ParameterStore::adamStep() {
   // Adam (own, fused implementation so densification can reshape its state).
   ++adam_step_;
+  std::vector<AdamTensors> step;
   for (Parameter& q : params_) {
     const at::Tensor grad = q.value.grad();
     if (!grad.defined() && !q.steps_without_gradient) continue;
-    gaussians::adamStep(q.value, grad, q.m, q.v, q.lr, adam_step_);
-    if (grad.defined()) q.value.mutable_grad().reset();
+    step.push_back({q.value, grad, q.m, q.v, q.lr});
+  }
+  gaussians::adamSteps(step, adam_step_);  // one launch on CUDA
+  for (Parameter& q : params_) {
+    if (q.value.grad().defined()) q.value.mutable_grad().reset();
   }
 }
 

@@ -243,7 +243,8 @@ StepStats Trainer::step(bool read_losses) {
   at::Tensor total;
   // Loss values stay on the device until the end of the step: one host synchronisation per step.
   at::Tensor rgb_sum, sem_sum;
-  auto accumulate = [](at::Tensor& sum, const at::Tensor& value) {
+  auto accumulate = [read_losses](at::Tensor& sum, const at::Tensor& value) {
+    if (!read_losses) return;  // nobody reads them: two operations per render saved
     sum = sum.defined() ? sum + value.detach() : value.detach();
   };
   std::vector<RenderResult> renders;

@@ -8,6 +8,7 @@
 #include <ATen/ATen.h>
 
 #include <cstdint>
+#include <vector>
 
 namespace sadsplat {
 namespace gaussians {
@@ -30,6 +31,18 @@ struct AdamSettings {
 /// \throws sadsplat::Error when shapes, dtypes or devices differ
 void adamStep(at::Tensor& value, const at::Tensor& grad, at::Tensor& m, at::Tensor& v, double lr,
               std::int64_t step, const AdamSettings& settings = AdamSettings());
+
+/// \brief One tensor of adamSteps(): the arguments of adamStep() but the step and settings.
+struct AdamTensors {
+  at::Tensor value, grad, m, v;
+  double lr = 0;
+};
+
+/// \brief adamStep() for several tensors at one step count: the same values as one adamStep()
+/// per tensor; on CUDA (float32, one device) one kernel launch for up to 16 tensors instead of
+/// one per tensor.
+void adamSteps(std::vector<AdamTensors>& tensors, std::int64_t step,
+               const AdamSettings& settings = AdamSettings());
 
 }  // namespace gaussians
 }  // namespace sadsplat
