@@ -99,7 +99,7 @@ TEST(StepProfile, EachPhaseCountsItsOwnOperatorCallsOnceWhateverTheNumberOfProfi
   EXPECT_EQ(profile.operatorCalls("no operator"), 0);
   EXPECT_EQ(profile.operatorCalls("outer / inner"), 1);
   EXPECT_EQ(profile.operatorCalls("outer"), 2);  // its nested phase's call not counted twice
-  EXPECT_EQ(y[0].item<float>(), 2.0f);  // (1 + 3) * 1 - 2
+  EXPECT_EQ(y[0].item<float>(), 2.0f);           // (1 + 3) * 1 - 2
   EXPECT_NE(profile.table().find("| three adds | "), std::string::npos);
   EXPECT_NE(profile.table().find(" | 3.0 |"), std::string::npos);
 }

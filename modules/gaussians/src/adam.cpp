@@ -103,8 +103,7 @@ at::Tensor checkedGradient(const at::Tensor& value, const at::Tensor& grad, cons
 
 }  // namespace
 
-void adamSteps(std::vector<AdamTensors>& tensors, std::int64_t step,
-               const AdamSettings& settings) {
+void adamSteps(std::vector<AdamTensors>& tensors, std::int64_t step, const AdamSettings& settings) {
 #if SADSPLAT_HAVE_CUDA
   const bool batched =
       !tensors.empty() && std::all_of(tensors.begin(), tensors.end(), [&](const AdamTensors& t) {

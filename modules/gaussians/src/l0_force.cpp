@@ -39,8 +39,8 @@ void addBalancedL0ForceReference(at::Tensor& grad, const at::Tensor& direction,
   const at::Tensor rgb_force = (grad.abs() * reached).sum();
   const at::Tensor l0_force = (direction * reached).sum();
   // Both sums are over the same gates, so their ratio is the ratio of the means.
-  const at::Tensor scale = at::where(l0_force > 0, rgb_force / l0_force.clamp_min(1e-30),
-                                     at::zeros_like(l0_force));
+  const at::Tensor scale =
+      at::where(l0_force > 0, rgb_force / l0_force.clamp_min(1e-30), at::zeros_like(l0_force));
   at::Tensor force = direction * reached * (strength * scale);
   if (weights.defined()) force = force * weights;
   grad.add_(force);

@@ -72,8 +72,8 @@ void addCuda(float* grad, const float* direction, const float* opacity_grad, con
   if (n == 0) return;
   const int64_t blocks = (n + kThreads - 1) / kThreads;
   cudaMemsetAsync(sums, 0, 2 * sizeof(double), stream);
-  sumsKernel<<<static_cast<unsigned>(blocks < kMaxSumBlocks ? blocks : kMaxSumBlocks), kThreads,
-               0, stream>>>(n, grad, direction, opacity_grad, sums);
+  sumsKernel<<<static_cast<unsigned>(blocks < kMaxSumBlocks ? blocks : kMaxSumBlocks), kThreads, 0,
+               stream>>>(n, grad, direction, opacity_grad, sums);
   checkCudaLaunch("<L0 force>", "sumsKernel");
   applyKernel<<<static_cast<unsigned>(blocks), kThreads, 0, stream>>>(
       n, grad, direction, opacity_grad, weights, strength, sums);

@@ -395,8 +395,8 @@ std::array<at::Tensor, 2> rasterizeToPixels(const at::Tensor& means2d, const at:
                                             const at::Tensor& opacities, const at::Tensor& values,
                                             const at::Tensor& radii, const at::Tensor& depths,
                                             int width, int height) {
-  const auto out = splitRasterize(means2d, conics, opacities, values, radii, depths, width,
-                                  height, 0);
+  const auto out =
+      splitRasterize(means2d, conics, opacities, values, radii, depths, width, height, 0);
   return {out[1], out[2]};
 }
 

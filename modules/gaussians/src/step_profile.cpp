@@ -198,9 +198,10 @@ std::string StepProfile::table() const {
     out += "\n";
     peak = std::max(peak, p.peak_allocated);
   }
-  std::snprintf(line, sizeof line, "| **total** (%d iterations) | %.3f | %.3f | 100 %% | %.1f |%s\n",
-                iterations_, total, total * per,
-                static_cast<double>(calls) / std::max(1, iterations_), memory ? " |" : "");
+  std::snprintf(line, sizeof line,
+                "| **total** (%d iterations) | %.3f | %.3f | 100 %% | %.1f |%s\n", iterations_,
+                total, total * per, static_cast<double>(calls) / std::max(1, iterations_),
+                memory ? " |" : "");
   out += line;
   if (memory) {
     std::snprintf(line, sizeof line,

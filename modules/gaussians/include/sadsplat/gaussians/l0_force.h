@@ -22,8 +22,7 @@ namespace gaussians {
 /// \param[in] weights [N] per-Gaussian factors of the force, or undefined (all 1)
 /// \param[in] strength the force's mean relative to the mean |loss gradient|
 void addBalancedL0Force(at::Tensor& grad, const at::Tensor& direction,
-                        const at::Tensor& opacity_grad, const at::Tensor& weights,
-                        double strength);
+                        const at::Tensor& opacity_grad, const at::Tensor& weights, double strength);
 
 /// \brief The same as ATen operations on any device (the reference the kernels are tested
 /// against).

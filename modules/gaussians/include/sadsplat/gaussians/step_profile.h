@@ -92,7 +92,7 @@ class StepProfile {
   };
   const Phase* find(const std::string& name) const;  // null when never timed
   bool waitsForDevice() const;
-  int indexOf(const std::string& name);              // find(), or a new phase
+  int indexOf(const std::string& name);  // find(), or a new phase
   void closeSlice();  // (waits for the device,) credits the innermost phase with its time
   void openSlice();   // starts the clock (and the device's peak memory counters) afresh
 
