@@ -21,6 +21,11 @@ mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 bin="${BIN:-build/bin/sadsplat}"
 
+# The machine, with the vector units that decide how fast LibTorch's operators run (OpenSplat's
+# CPU path) against sadsplat's SSE2 loops: ratios from machines with other units differ.
+simd=$(grep -o -w 'avx2\|fma\|avx512f\|amx_tile' /proc/cpuinfo 2>/dev/null | sort -u | tr '\n' ' ')
+echo "machine: $(nproc) cores, $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p'), SIMD beyond SSE2: ${simd:-none}"
+
 # OpenSplat, built once per OUT_DIR.
 opensplat=""
 if [ -n "${OPENSPLAT_SRC:-}" ]; then
