@@ -80,12 +80,10 @@ void ParameterStore::adamStep() {
   for (Parameter& q : params_) {
     const at::Tensor grad = q.value.grad();
     if (!grad.defined() && !q.steps_without_gradient) continue;
-    step.push_back({q.value, grad, q.m, q.v, q.lr});
+    step.push_back({q.value, grad, q.m, q.v, q.lr});  // holds the gradient for adamSteps
+    if (grad.defined()) q.value.mutable_grad().reset();
   }
   gaussians::adamSteps(step, adam_step_);  // one launch on CUDA
-  for (Parameter& q : params_) {
-    if (q.value.grad().defined()) q.value.mutable_grad().reset();
-  }
 }
 
 void ParameterStore::allReduceGradients(Collective& collective,

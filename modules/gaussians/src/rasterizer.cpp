@@ -72,8 +72,11 @@ CameraParams unpackCamera(const std::vector<double>& v) {
               "CUDA tensors");
 }
 
-at::Tensor orZeros(const at::Tensor& grad, const at::Tensor& like) {
-  return grad.defined() ? grad.contiguous() : at::zeros_like(like);
+// An output's gradient, or zeros of its shape when autograd passed none (made only then: the
+// backward runs every step).
+at::Tensor orZeros(const at::Tensor& grad, at::IntArrayRef sizes,
+                   const at::TensorOptions& options) {
+  return grad.defined() ? grad.contiguous() : at::zeros(sizes, options);
 }
 
 struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
@@ -105,8 +108,8 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     const at::Tensor &m = saved[0], &q = saved[1], &s = saved[2], &radii = saved[3];
     const ScopedPhase phase("project backward");
     const CameraParams cam = unpackCamera(ctx->saved_data["camera"].toDoubleVector());
-    const at::Tensor g_m2 = orZeros(grads[0], at::empty({m.size(0), 2}, m.options()));
-    const at::Tensor g_co = orZeros(grads[1], at::empty({m.size(0), 3}, m.options()));
+    const at::Tensor g_m2 = orZeros(grads[0], {m.size(0), 2}, m.options());
+    const at::Tensor g_co = orZeros(grads[1], {m.size(0), 3}, m.options());
     raster::ProjectionGrads g;
     if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
@@ -118,7 +121,7 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
       noCuda();
 #endif
     } else {
-      const at::Tensor g_d = orZeros(grads[2], at::empty({m.size(0)}, m.options()));
+      const at::Tensor g_d = orZeros(grads[2], {m.size(0)}, m.options());
       g = raster::projectBackwardCpu(m, q, s, radii, cam, g_m2, g_co, g_d);
     }
     return {g.means, g.quats, g.log_scales, at::Tensor()};
@@ -203,7 +206,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       noCuda();
 #endif
     } else {
-      const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha);
+      const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha.sizes(), fwd.alpha.options());
       g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
     }
     return {g.means2d,    g.conics,     g.opacities,  g.values,    at::Tensor(),
@@ -241,7 +244,7 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
     const ScopedPhase phase("SH backward");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
-    const at::Tensor g = orZeros(grads[0], at::empty({saved[1].size(0), 3}, saved[1].options()));
+    const at::Tensor g = orZeros(grads[0], {saved[1].size(0), 3}, saved[1].options());
     std::pair<at::Tensor, at::Tensor> out;
     if (saved[1].is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
