@@ -699,6 +699,34 @@ TEST_F(TrainerTest, StepsThatDoNotReadTheLossesTrainTheSame) {
   EXPECT_TRUE(at::equal(a.features, b.features));
 }
 
+// CUDA: tile lists sized from earlier renders train as exact lists do. With margin 1 (count +
+// 1024 entries) densification's growth makes lists short: those steps render again, exactly.
+// CUDA's backward sums with atomics, so two trainings agree to rounding, not bit for bit.
+TEST_F(TrainerTest, CudaTileListsSizedFromEarlierRendersTrainAsExactLists) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  TrainConfig c = small(60, "cuda");
+  c.densify_from = 10;
+  c.densify_interval = 10;
+  c.densify_grad_threshold = 1e-7;  // every Gaussian grows: the counts jump
+  c.drop = "full";                  // gated renders: the second pass samples the same gates
+  c.tile_list_margin = 1.0;
+  TrainConfig exact_config = c;
+  exact_config.tile_list_margin = 0;
+  Trainer sized(scene_, c), exact(scene_, exact_config);
+  int again = 0;
+  for (int i = 0; i < 60; ++i) {
+    const gaussians::StepStats s = sized.step(true), e = exact.step(true);
+    EXPECT_FALSE(e.rendered_again);
+    again += s.rendered_again ? 1 : 0;
+    EXPECT_NEAR(s.loss, e.loss, 1e-3 * e.loss) << "step " << i;
+  }
+  EXPECT_GE(again, 1);
+  EXPECT_LT(again, 30);
+  const auto a = sized.parameters(), b = exact.parameters();
+  ASSERT_EQ(a.means.size(0), b.means.size(0));
+  EXPECT_LT((a.means - b.means).abs().max().item<double>(), 1e-3 * sceneExtent());
+}
+
 TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   test::TempDir dir;
   test::writeFile(dir.file("bad.bin"), "not a checkpoint");
@@ -722,6 +750,13 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   EXPECT_EQ(TrainConfig::fromJson("{\"seed\": 18446744073709551615}", "c").seed,
             18446744073709551615ull);
   EXPECT_EQ(TrainConfig::fromJson("{\"iterations\": 3.0}", "c").iterations, 3);
+  // A tile-list margin between 0 (exact lists) and 1 would size lists below the last count.
+  try {
+    TrainConfig::fromJson("{\"tile_list_margin\": 0.5}", "cfg.json").check("cfg.json");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "tile_list_margin");
+  }
   TrainConfig c;
   c.iterations = 123;
   c.background = {0.5f, 0.25f, 1.f};

@@ -12,6 +12,7 @@
 
 namespace sadsplat {
 namespace gaussians {
+class TileListCapacity;
 namespace raster {
 
 /// A camera as the backends take it (double so that it can be stored in autograd contexts).
@@ -95,10 +96,11 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
                                     const CameraParams& cam, const at::Tensor& g_means2d,
                                     const at::Tensor& g_conics, const at::Tensor& g_depths,
                                     void* stream);
+/// capacity: null, or how to size the tile list without waiting for the GPU (tile_list_capacity.h).
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const at::Tensor& radii, const at::Tensor& depths, int width,
-                                  int height, void* stream);
+                                  int height, TileListCapacity* capacity, void* stream);
 // g_alpha may be undefined (no alpha gradient: zeros).
 RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,

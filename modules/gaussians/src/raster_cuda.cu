@@ -13,6 +13,7 @@
 #include "sadsplat/common/cuda_support.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/tile_list_capacity.h"
 #include "tf32_mma.cuh"
 
 namespace sadsplat {
@@ -172,7 +173,7 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
                                 const float* __restrict__ opacities,
                                 const float* __restrict__ depths,
                                 const int64_t* __restrict__ offsets, int tiles_x, int tiles_y,
-                                int64_t* keys, int* values) {
+                                int64_t capacity, int64_t* keys, int* values) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   int rx, ry;
@@ -184,6 +185,7 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
   const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
   for (int ty = y0; ty < y1; ++ty) {
     for (int tx = x0; tx < x1; ++tx) {
+      if (out >= capacity) return;  // a list sized before the count: the rest does not fit
       keys[out] = (static_cast<int64_t>(ty * tiles_x + tx) << 32) | depth_bits;
       values[out] = static_cast<int>(i);
       ++out;
@@ -191,10 +193,13 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
   }
 }
 
-__global__ void tileRangesKernel(int64_t m, const int64_t* __restrict__ keys, int* ranges) {
+// Entries of a tile id >= num_tiles are the unused end of a list sized before the count.
+__global__ void tileRangesKernel(int64_t m, const int64_t* __restrict__ keys, int num_tiles,
+                                 int* ranges) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= m) return;
   const int tile = static_cast<int>(keys[i] >> 32);
+  if (tile >= num_tiles) return;
   if (i == 0 || static_cast<int>(keys[i - 1] >> 32) != tile) ranges[2 * tile] = static_cast<int>(i);
   if (i == m - 1 || static_cast<int>(keys[i + 1] >> 32) != tile) {
     ranges[2 * tile + 1] = static_cast<int>(i + 1);
@@ -204,8 +209,9 @@ __global__ void tileRangesKernel(int64_t m, const int64_t* __restrict__ keys, in
 // Sorts the (key, Gaussian id) pairs by key with a radix sort over the key's used bits only: the
 // 32 depth bits and as many tile bits as the tile count needs (11 at 800x450), not all 64. A
 // radix sort is stable: equal keys (same tile and depth) keep Gaussian id order, as on the CPU.
+// `tile_ids`: how many tile ids the keys hold (the tiles, and one more for a list's unused end).
 std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
-                                                     const at::Tensor& values, int num_tiles,
+                                                     const at::Tensor& values, int tile_ids,
                                                      cudaStream_t stream) {
   const int64_t m = keys.size(0);
   if (m > std::numeric_limits<int>::max()) {
@@ -213,7 +219,7 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
                 std::to_string(m) + " (fewer Gaussians or a smaller image)");
   }
   int tile_bits = 1;
-  while ((int64_t{1} << tile_bits) < num_tiles) ++tile_bits;
+  while ((int64_t{1} << tile_bits) < tile_ids) ++tile_bits;
   const int end_bit = 32 + tile_bits;
   using Key = unsigned long long;  // keys are non-negative: the unsigned order is the same
   const auto* keys_in = reinterpret_cast<const Key*>(keys.data_ptr<int64_t>());
@@ -233,15 +239,22 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
   return {sorted_keys, sorted_values};
 }
 
+// The (Gaussian, tile) list of one render: count each Gaussian's tiles, write the keys at the
+// counts' running sum, sort, and mark each tile's range. The list's length is the total count,
+// read from the GPU (the host waits for the queue); with a capacity that knows earlier counts,
+// the list has capacity->capacity() entries instead and nobody waits: entries past the count
+// keep the key of tile num_tiles (sorted last, in no tile's range), pairs past the capacity are
+// not written, and the count goes to the host for capacity->renderedAll() to check.
 Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const at::Tensor& radii,
                      const at::Tensor& opacities, const at::Tensor& depths, int width, int height,
-                     cudaStream_t stream) {
+                     TileListCapacity* capacity, cudaStream_t stream) {
   const int64_t n = means2d.size(0);
   const ScopedPhase phase("binning");
   const auto [tiles_x, tiles_y] = tileGrid(width, height);
+  const int num_tiles = tiles_x * tiles_y;
   const auto opts = means2d.options();
   Binning b;
-  b.tile_ranges = at::zeros({tiles_x * tiles_y, 2}, opts.dtype(at::kInt));
+  b.tile_ranges = at::zeros({num_tiles, 2}, opts.dtype(at::kInt));
   if (n == 0) {
     b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
     return b;
@@ -252,19 +265,36 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
       opacities.data_ptr<float>(), tiles_x, tiles_y, counts.data_ptr<int64_t>());
   checkLaunch("countTilesKernel");
   const at::Tensor offsets = counts.cumsum(0);
-  const int64_t m = offsets[n - 1].item<int64_t>();
-  at::Tensor keys = at::empty({m}, opts.dtype(at::kLong));
-  at::Tensor values = at::empty({m}, opts.dtype(at::kInt));
+  const bool sized_before = capacity != nullptr && capacity->capacity() > 0;
+  int64_t m = 0;
+  at::Tensor keys, values;
+  if (sized_before) {
+    m = capacity->capacity();
+    const TileListCapacity::Slot slot = capacity->reserve();
+    cudaError_t err = cudaMemcpyAsync(slot.count, offsets.data_ptr<int64_t>() + (n - 1),
+                                      sizeof(int64_t), cudaMemcpyDeviceToHost, stream);
+    if (err == cudaSuccess) err = cudaEventRecord(static_cast<cudaEvent_t>(slot.event), stream);
+    if (err != cudaSuccess) {
+      throw Error("<render>", "tile count", "queued for the host", cudaGetErrorString(err));
+    }
+    keys = at::full({m}, static_cast<int64_t>(num_tiles) << 32, opts.dtype(at::kLong));
+  } else {
+    m = offsets[n - 1].item<int64_t>();
+    if (capacity != nullptr) capacity->counted(m);
+    keys = at::empty({m}, opts.dtype(at::kLong));
+  }
+  values = at::empty({m}, opts.dtype(at::kInt));
   if (m > 0) {
     writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
         n, means2d.data_ptr<float>(), conics.data_ptr<float>(), radii.data_ptr<int>(),
         opacities.data_ptr<float>(), depths.data_ptr<float>(), offsets.data_ptr<int64_t>(),
-        tiles_x, tiles_y,
-        keys.data_ptr<int64_t>(), values.data_ptr<int>());
+        tiles_x, tiles_y, m, keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     const ScopedPhase sort_phase("sort");
-    std::tie(keys, values) = sortByTileAndDepth(keys, values, tiles_x * tiles_y, stream);
+    std::tie(keys, values) =
+        sortByTileAndDepth(keys, values, sized_before ? num_tiles + 1 : num_tiles, stream);
     tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(m, keys.data_ptr<int64_t>(),
+                                                              num_tiles,
                                                               b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");
   }
@@ -786,7 +816,7 @@ std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh_all, const
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const at::Tensor& radii, const at::Tensor& depths, int width,
-                                  int height, void* stream_ptr) {
+                                  int height, TileListCapacity* capacity, void* stream_ptr) {
   check(means2d, "means2d");
   check(conics, "conics");
   check(opacities, "opacities");
@@ -800,7 +830,7 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
   out.alpha = at::empty({height, width}, values.options());
   out.last = at::empty({height, width}, values.options().dtype(at::kInt));
   out.binning =
-      binGaussians(means2d, conics, radii, opacities, depths, width, height, stream);
+      binGaussians(means2d, conics, radii, opacities, depths, width, height, capacity, stream);
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(out.binning.tile_ranges.size(0));
 #define SADSPLAT_LAUNCH_FORWARD(CH)                                                         \

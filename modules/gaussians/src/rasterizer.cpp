@@ -17,6 +17,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/tile_list_capacity.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -137,7 +138,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                const at::Tensor& conics, const at::Tensor& opacities,
                                const at::Tensor& values, const at::Tensor& radii,
                                const at::Tensor& depths, int64_t width, int64_t height,
-                               int64_t split) {
+                               int64_t split, TileListCapacity* capacity) {
     const ScopedPhase phase("rasterize");
     const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
                      op = opacities.contiguous(), val = values.contiguous();
@@ -147,7 +148,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       const c10::cuda::CUDAGuard guard(m2.device());
       r = raster::rasterizeForwardCuda(m2, co, op, val, radii.contiguous(), depths.contiguous(),
                                        static_cast<int>(width), static_cast<int>(height),
-                                       currentStream(m2));
+                                       capacity, currentStream(m2));
 #else
       noCuda();
 #endif
@@ -209,8 +210,9 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha.sizes(), fwd.alpha.options());
       g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
     }
+    // No gradient for radii, depths, width, height, split and the tile-list capacity.
     return {g.means2d,    g.conics,     g.opacities,  g.values,    at::Tensor(),
-            at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
+            at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };
 
@@ -381,14 +383,15 @@ namespace {
 std::array<at::Tensor, 3> splitRasterize(const at::Tensor& means2d, const at::Tensor& conics,
                                          const at::Tensor& opacities, const at::Tensor& values,
                                          const at::Tensor& radii, const at::Tensor& depths,
-                                         int width, int height, int64_t split) {
+                                         int width, int height, int64_t split,
+                                         TileListCapacity* capacity = nullptr) {
   const int64_t n = means2d.size(0);
   expectTensor(conics, "conics", n, {3}, means2d);
   expectTensor(opacities, "opacities", n, {}, means2d);
   expectTensor(values, "values", n, {-1}, means2d);
   expectTensor(depths, "depths", n, {}, means2d);
   const auto out = RasterizeFunction::apply(means2d, conics, opacities, values, radii,
-                                            depths.detach(), width, height, split);
+                                            depths.detach(), width, height, split, capacity);
   return {out[0], out[1], out[2]};
 }
 
@@ -461,7 +464,8 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   // RGB apart from the features (and depth): the losses' gradients reach the rasterizer without
   // a slice backward of the whole image.
   auto [rgb, rest, alpha] = splitRasterize(means2d, conics, opacities, values, radii, depths,
-                                           camera.width, camera.height, 3);
+                                           camera.width, camera.height, 3,
+                                           settings.tile_capacity);
   const int64_t C = features.size(1);
   RenderResult result;
   result.rgb = composeBackground(rgb, alpha, settings.background);

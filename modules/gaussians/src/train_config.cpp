@@ -114,6 +114,10 @@ const std::vector<TrainOption> kOptions = {
      "the SSIM loss in fused passes, CPU and CUDA (false: the reference composition)"},
     {"fused_semantic_loss", &C::fused_semantic_loss,
      "CUDA: the semantic loss in fused kernels (false: reference)"},
+    {"tile_list_margin", &C::tile_list_margin,
+     "CUDA: tile lists sized from earlier renders' counts x this, checked after the backward "
+     "(0: exact, waiting)",
+     nullptr, 0, kInf},
     {"lambda_rgb", &C::lambda_rgb, "weight of the RGB loss", nullptr, 0, kInf},
     {"lambda_semantic", &C::lambda_semantic, "weight of the semantic loss on labelled views",
      nullptr, 0, kInf},
@@ -386,6 +390,10 @@ void TrainConfig::check(const std::string& origin) const {
       for (const std::string& c : choices) expected += (expected.empty() ? "" : ",") + c;
       throw Error(origin, o.key, expected, v.get<std::string>());
     }
+  }
+  if (tile_list_margin > 0 && tile_list_margin < 1) {
+    throw Error(origin, "tile_list_margin", "0 (exact lists) or >= 1",
+                numberText(tile_list_margin));
   }
   if (recovery_iterations >= iterations) {
     throw Error(origin, "recovery_iterations", "0 .. iterations - 1",

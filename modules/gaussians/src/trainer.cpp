@@ -21,6 +21,7 @@
 #include "sadsplat/gaussians/parameter_store.h"
 #include "sadsplat/gaussians/semantic_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
+#include "sadsplat/gaussians/tile_list_capacity.h"
 #include "sadsplat/gaussians/view_coverage.h"
 #include "sadsplat/io/gaussian_checks.h"
 #include "training_views.h"
@@ -75,6 +76,8 @@ struct Trainer::State {
   DensificationStrategy::Ptr densification;
   StepProfile::Ptr profile;
   Collective::Ptr collective;
+  // CUDA: the training renders' tile lists are sized from earlier renders (no wait per render).
+  std::unique_ptr<TileListCapacity> tile_capacity;
 
   // The one way the Gaussians' rows change: every per-row state follows the parameters.
   void resize(const at::Tensor& keep, const std::map<std::string, at::Tensor>& extra) {
@@ -147,6 +150,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
       throw Error("<config>", "device", "cpu (no CUDA device or no CUDA build here)", "cuda");
     }
     s.device = at::Device(at::kCUDA, 0);
+    if (config.tile_list_margin > 0) {
+      s.tile_capacity = std::make_unique<TileListCapacity>(config.tile_list_margin);
+    }
   }
   s.num_classes = static_cast<int>(scene.classes.size());
   // A scene without classes trains plain 3DGS: no features, no decoder rows, no semantic loss.
@@ -239,7 +245,6 @@ StepStats Trainer::step(bool read_losses) {
     enterPhase(profile, "L0 weights");
     s.drop.refreshL0Weights(s.params, s.views, s.iteration);
   }
-  g.opacity_gate = s.drop.trainingGate(s.params, it);  // undefined when not gated
   at::Tensor total;
   // Loss values stay on the device until the end of the step: one host synchronisation per step.
   at::Tensor rgb_sum, sem_sum;
@@ -249,54 +254,74 @@ StepStats Trainer::step(bool read_losses) {
   };
   std::vector<RenderResult> renders;
   std::vector<RasterCamera> cameras;
-  for (int v : views) {
-    enterPhase(profile, "render forward");
-    const ViewRole role = s.views.role(v, c);
-    // Training uses no depth, and features only where a semantic loss reads them.
-    settings.features = role.semantic;
-    settings.depth = false;
-    RenderResult r = render(g, s.views.cameras[v], settings);
-    r.means2d.retain_grad();
-    enterPhase(profile, "losses forward");
-    // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
-    // operations for the host to issue and for the autograd engine to run backwards.
-    const at::Tensor& gt = s.views.images[v];
-    const bool masked = !s.views.mask_is_full[v];
-    const at::Tensor mask = masked ? s.views.masks[v].unsqueeze(2) : at::Tensor();
-    const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
-    const at::Tensor l1 = masking((r.rgb - gt).abs()).mean();
-    const at::Tensor rgb_loss =
-        (1 - c.lambda_ssim) * l1 +
-        c.lambda_ssim * (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
-                                           : ssimReference(masking(r.rgb), masking(gt))));
-    at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
-    accumulate(rgb_sum, rgb_loss);
-    if (role.semantic) {
-      // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
-      // class-score space of the built-in backend), averaged over supervised pixels only.
-      const at::Tensor& w = s.params["decoder_w"].value;
-      const at::Tensor& b = s.params["decoder_b"].value;
-      const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
-      const at::Tensor& labels = s.views.labels[v];
-      const at::Tensor sem = role.decoder_learns
-                                 ? loss_of(r.features, labels, w, b)
-                                 : loss_of(r.features, labels, w.detach(), b.detach());
-      const double weight = s.views.semantic_weight[v];
-      loss = loss + (weight == 1 ? sem : weight * sem);
-      accumulate(sem_sum, sem);
+  // The step's renders, losses and backward pass; again when a render's tile list was short.
+  const auto render_losses_backward = [&](TileListCapacity* tile_capacity) {
+    total = rgb_sum = sem_sum = at::Tensor();
+    renders.clear();
+    cameras.clear();
+    settings.tile_capacity = tile_capacity;
+    // Counter-based noise: a second pass samples the same gates (the first one's graph is gone).
+    g.opacity_gate = s.drop.trainingGate(s.params, it);  // undefined when not gated
+    for (int v : views) {
+      enterPhase(profile, "render forward");
+      const ViewRole role = s.views.role(v, c);
+      // Training uses no depth, and features only where a semantic loss reads them.
+      settings.features = role.semantic;
+      settings.depth = false;
+      RenderResult r = render(g, s.views.cameras[v], settings);
+      r.means2d.retain_grad();
+      enterPhase(profile, "losses forward");
+      // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
+      // operations for the host to issue and for the autograd engine to run backwards.
+      const at::Tensor& gt = s.views.images[v];
+      const bool masked = !s.views.mask_is_full[v];
+      const at::Tensor mask = masked ? s.views.masks[v].unsqueeze(2) : at::Tensor();
+      const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
+      const at::Tensor l1 = masking((r.rgb - gt).abs()).mean();
+      const at::Tensor rgb_loss =
+          (1 - c.lambda_ssim) * l1 +
+          c.lambda_ssim * (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
+                                             : ssimReference(masking(r.rgb), masking(gt))));
+      at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
+      accumulate(rgb_sum, rgb_loss);
+      if (role.semantic) {
+        // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
+        // class-score space of the built-in backend), averaged over supervised pixels only.
+        const at::Tensor& w = s.params["decoder_w"].value;
+        const at::Tensor& b = s.params["decoder_b"].value;
+        const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
+        const at::Tensor& labels = s.views.labels[v];
+        const at::Tensor sem = role.decoder_learns
+                                   ? loss_of(r.features, labels, w, b)
+                                   : loss_of(r.features, labels, w.detach(), b.detach());
+        const double weight = s.views.semantic_weight[v];
+        loss = loss + (weight == 1 ? sem : weight * sem);
+        accumulate(sem_sum, sem);
+      }
+      total = total.defined() ? total + loss : loss;
+      renders.push_back(r);
+      cameras.push_back(s.views.cameras[v]);
     }
-    total = total.defined() ? total + loss : loss;
-    renders.push_back(r);
-    cameras.push_back(s.views.cameras[v]);
+    // The mean over the global batch (one draw: the sum of the training and labelled views' losses).
+    if (batch > 1) total = total / batch;
+    const at::Tensor reg = s.drop.regularisation(s.params, it);
+    if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);  // once over all ranks
+    enterPhase(profile, "backward");
+    total.backward();
+  };
+  render_losses_backward(s.tile_capacity.get());
+  bool rendered_again = false;
+  if (s.tile_capacity && !s.tile_capacity->renderedAll()) {
+    // A render's (Gaussian, tile) list, sized from earlier renders, was too short: its image
+    // and gradients miss pairs. Again with lists sized by the exact counts (rare: a jump in the
+    // count past the capacity's margin).
+    for (Parameter& p : s.params.all()) p.value.mutable_grad() = at::Tensor();
+    render_losses_backward(nullptr);
+    rendered_again = true;
   }
-  // The mean over the global batch (one draw: the sum of its training and labelled views' losses).
-  if (batch > 1) total = total / batch;
-  const at::Tensor reg = s.drop.regularisation(s.params, it);
-  if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);  // once over all ranks
-  enterPhase(profile, "backward");
-  total.backward();
 
   StepStats stats;
+  stats.rendered_again = rendered_again;
   {
     c10::AutoGradMode no_grad(false);
     enterPhase(profile, "densification statistics");

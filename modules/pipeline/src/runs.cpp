@@ -275,6 +275,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     o.collective->max(flag);
     return flag.item<float>() > 0;
   };
+  int rendered_again = 0;  // CUDA steps whose tile lists, sized from earlier counts, were short
   while (trainer.iteration() < config.iterations) {
     if (stopRequested()) {
       checkpointNow();
@@ -296,6 +297,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                   "CUDA out of memory");
     }
     const int it = stats.iteration;
+    rendered_again += stats.rendered_again ? 1 : 0;
     if (stats.losses_read && !std::isfinite(stats.loss)) {
       const std::string kept = last_checkpoint > 0 ? "; checkpoint.bin keeps iteration " +
                                                          std::to_string(last_checkpoint)
@@ -369,6 +371,12 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   }
   checkpoint_writes.wait();
   if (o.progress) *o.progress << "\n";
+  if (rendered_again > 0 && o.progress) {
+    *o.progress << "[tile lists] " << rendered_again
+                << " steps rendered again: a tile list sized from earlier renders was short "
+                   "(tile_list_margin "
+                << config.tile_list_margin << ")\n";
+  }
   if (profile) {
     const std::string table = "Training time per phase (" + config.device +
                               (*o.profile == gaussians::StepProfile::Clock::kHost

@@ -17,6 +17,8 @@
 namespace sadsplat {
 namespace gaussians {
 
+class TileListCapacity;
+
 /// \brief A pinhole or orthographic camera for rendering (COLMAP conventions, see
 /// io::PinholeCamera). Orthographic: pixel = (fx x_cam + cx, fy y_cam + cy), fx and fy in pixels
 /// per world unit, depth = z_cam; every ray runs along the camera's z axis (a top-down map render).
@@ -49,6 +51,10 @@ struct RenderSettings {
   bool features = true;
   /// Render the expected depth (false: RenderResult::depth is undefined; one channel fewer).
   bool depth = true;
+  /// CUDA: size the (Gaussian, tile) list from earlier renders instead of waiting for the GPU
+  /// to count it; the caller checks with tile_capacity->renderedAll() before using the render's
+  /// gradients (tile_list_capacity.h). Null: exact lists. Kept alive by the caller. CPU: unused.
+  TileListCapacity* tile_capacity = nullptr;
 };
 
 /// \brief The Gaussians to render: N rows, float32 (or float64 on CPU), one device.

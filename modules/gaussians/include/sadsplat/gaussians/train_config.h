@@ -26,6 +26,11 @@ struct TrainConfig {
   /// On CUDA, the semantic loss in fused kernels (gaussians::semanticLoss); false: the reference
   /// composition of ATen operations (gaussians::semanticLossReference), for comparisons.
   bool fused_semantic_loss = true;
+  /// On CUDA, each training render's (Gaussian, tile) list is sized from earlier renders' counts
+  /// (this margin times the largest) and checked after the backward pass, the step rendered
+  /// again when one was short (gaussians/tile_list_capacity.h): the host does not wait for the
+  /// GPU once per render. The same values; 0: lists sized by each render's count (waiting).
+  double tile_list_margin = 1.25;
   double lambda_rgb = 1.0;
   double lambda_semantic = 1.0;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss

@@ -50,6 +50,9 @@ struct StepStats {
   std::int64_t recovery_closed_gates = 0;
   std::int64_t recovery_pruned = 0;
   int pseudo_labelled_views = 0;  ///< training views supervised by pseudo-labels
+  /// CUDA: a render's tile list, sized from earlier counts, was short, so the step rendered its
+  /// views again with exact lists (TrainConfig::tile_list_margin).
+  bool rendered_again = false;
 };
 
 /// \brief Trains Gaussians on a scene.
