@@ -302,7 +302,8 @@ StepStats Trainer::step(bool read_losses) {
       renders.push_back(r);
       cameras.push_back(s.views.cameras[v]);
     }
-    // The mean over the global batch (one draw: the sum of the training and labelled views' losses).
+    // The mean over the global batch (one draw: the sum of its training and labelled views'
+    // losses).
     if (batch > 1) total = total / batch;
     const at::Tensor reg = s.drop.regularisation(s.params, it);
     if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);  // once over all ranks
