@@ -312,6 +312,7 @@ StepStats Trainer::step(bool read_losses) {
   };
   render_losses_backward(s.tile_capacity.get());
   bool rendered_again = false;
+  if (s.tile_capacity) enterPhase(profile, "tile list check");  // where the host may wait
   if (s.tile_capacity && !s.tile_capacity->renderedAll()) {
     // A render's (Gaussian, tile) list, sized from earlier renders, was too short: its image
     // and gradients miss pairs. Again with lists sized by the exact counts (rare: a jump in the
