@@ -78,6 +78,22 @@ std::vector<at::Tensor> gradients(const GaussianParams& g, const gaussians::Rend
   return torch::autograd::grad({loss}, leaves(g));
 }
 
+// The CPU backend sizes its lists itself: a capacity in the settings changes nothing there and
+// learns nothing (no count reaches it).
+TEST(TileListCapacity, CpuRendersIgnoreIt) {
+  const GaussianParams g = onDevice(500, 4, at::kCPU);
+  gaussians::RenderSettings settings;
+  settings.depth = false;
+  const gaussians::RenderResult plain = gaussians::render(g, camera(), settings);
+  TileListCapacity capacity;
+  settings.tile_capacity = &capacity;
+  const gaussians::RenderResult with = gaussians::render(g, camera(), settings);
+  EXPECT_TRUE(at::equal(with.rgb, plain.rgb));
+  EXPECT_TRUE(at::equal(with.features, plain.features));
+  EXPECT_EQ(capacity.capacity(), 0);
+  EXPECT_TRUE(capacity.renderedAll());
+}
+
 // Lists longer than the count (unused entries sort last, in no tile): the same images bit for
 // bit, the same gradients to the rounding of the backward's atomic sums.
 TEST(TileListCapacityCuda, ListsSizedBeforeTheCountRenderAsExactLists) {
