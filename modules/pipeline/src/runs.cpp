@@ -373,7 +373,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   if (o.progress) *o.progress << "\n";
   if (rendered_again > 0 && o.progress) {
     *o.progress << "[tile lists] " << rendered_again
-                << " steps rendered again: a tile list sized from earlier renders was short "
+                << (rendered_again == 1 ? " step" : " steps")
+                << " rendered again: a tile list sized from earlier renders was short "
                    "(tile_list_margin "
                 << config.tile_list_margin << ")\n";
   }
