@@ -9,8 +9,8 @@
 /// no tile: the image and gradients are bit-identical to an exactly sized list's) and leaves the
 /// count on its way to the host. renderedAll() reads the counts later — in training after the
 /// backward pass, when the GPU has long passed them — and says whether every render had room.
-/// A render that had not missed pairs: the caller renders it again (the trainer does so without
-/// a capacity). The capacity follows the counts: `margin` times the largest count of the last
+/// A render whose list was too short missed pairs: the caller renders it again (the trainer does
+/// so without a capacity). The capacity follows the counts: `margin` times the largest count of the last
 /// check, shrinking by at most 2 % per check.
 
 #include <cstdint>
