@@ -311,19 +311,18 @@ StepStats Trainer::step(bool read_losses) {
     total.backward();
   };
   render_losses_backward(s.tile_capacity.get());
-  bool rendered_again = false;
-  if (s.tile_capacity) enterPhase(profile, "tile list check");  // where the host may wait
-  if (s.tile_capacity && !s.tile_capacity->renderedAll()) {
-    // A render's (Gaussian, tile) list, sized from earlier renders, was too short: its image
-    // and gradients miss pairs. Again with lists sized by the exact counts (rare: a jump in the
-    // count past the capacity's margin).
-    for (Parameter& p : s.params.all()) p.value.mutable_grad() = at::Tensor();
-    render_losses_backward(nullptr);
-    rendered_again = true;
-  }
-
   StepStats stats;
-  stats.rendered_again = rendered_again;
+  if (s.tile_capacity) {
+    enterPhase(profile, "tile list check");  // where the host may wait for the GPU
+    if (!s.tile_capacity->renderedAll()) {
+      // A render's (Gaussian, tile) list, sized from earlier renders, was too short: its image
+      // and gradients miss pairs. Again with lists sized by the exact counts (rare: a jump in
+      // the count past the capacity's margin).
+      for (Parameter& p : s.params.all()) p.value.mutable_grad() = at::Tensor();
+      render_losses_backward(nullptr);
+      stats.rendered_again = true;
+    }
+  }
   {
     c10::AutoGradMode no_grad(false);
     enterPhase(profile, "densification statistics");
