@@ -322,6 +322,14 @@ __device__ __forceinline__ void stageGaussian(int g, const float* __restrict__ m
 
 // ---- forward
 
+// Whether the forward stages the batch's values (CH floats per Gaussian, zero padded) in shared
+// memory beside its 2D data: up to 36 channels (36 KiB per block). Every pixel that a Gaussian
+// reaches reads all its channels; from shared memory that is CH / 4 16-byte loads which all
+// threads share, instead of CH loads through the L1 cache (the forward's main stall at 36
+// channels, Nsight Compute, H100). Wider values stay in global memory (the shared memory would
+// cost more occupancy than the loads).
+constexpr bool forwardStagesValues(int CH) { return CH <= 36; }
+
 // One block per tile, one thread per pixel; Gaussians are staged through shared memory in
 // batches of kBlock. CH is the channel capacity (>= D), fixed at compile time so the per-pixel
 // accumulators can live in registers.
@@ -344,6 +352,9 @@ __global__ void __launch_bounds__(kBlock)
   __shared__ float s_mean[kBlock][2];
   __shared__ float s_conic[kBlock][3];
   __shared__ float s_opacity[kBlock];
+  constexpr bool kStaged = forwardStagesValues(CH);
+  static_assert(!kStaged || CH % 4 == 0, "staged values are read as whole float4s");
+  __shared__ __align__(16) float s_values[kStaged ? kBlock : 1][kStaged ? CH : 4];
 
   float acc[CH];
 #pragma unroll
@@ -354,8 +365,21 @@ __global__ void __launch_bounds__(kBlock)
   for (int batch = start; batch < stop; batch += kBlock) {
     if (__syncthreads_count(done) == kBlock) break;
     const int k = batch + threadIdx.x;
-    if (k < stop)
-      stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
+    if (k < stop) {
+      const int g = ids[k];
+      stageGaussian(g, means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
+      if constexpr (kStaged) {
+        const float* src = values + static_cast<int64_t>(g) * D;
+#pragma unroll
+        for (int q = 0; q < CH / 4; ++q) {
+          const int c = 4 * q;
+          *reinterpret_cast<float4*>(&s_values[threadIdx.x][c]) =
+              make_float4(c < D ? __ldg(src + c) : 0.f, c + 1 < D ? __ldg(src + c + 1) : 0.f,
+                          c + 2 < D ? __ldg(src + c + 2) : 0.f,
+                          c + 3 < D ? __ldg(src + c + 3) : 0.f);
+        }
+      }
+    }
     __syncthreads();
     const int count = min(kBlock, stop - batch);
     for (int j = 0; j < count && !done; ++j) {
@@ -369,10 +393,21 @@ __global__ void __launch_bounds__(kBlock)
         break;
       }
       const float w = alpha * trans;
-      const float* v = values + static_cast<int64_t>(s_id[j]) * D;
+      if constexpr (kStaged) {
 #pragma unroll
-      for (int c = 0; c < CH; ++c) {
-        if (c < D) acc[c] += w * v[c];
+        for (int q = 0; q < CH / 4; ++q) {
+          const float4 v = *reinterpret_cast<const float4*>(&s_values[j][4 * q]);
+          if (4 * q < D) acc[4 * q] += w * v.x;
+          if (4 * q + 1 < D) acc[4 * q + 1] += w * v.y;
+          if (4 * q + 2 < D) acc[4 * q + 2] += w * v.z;
+          if (4 * q + 3 < D) acc[4 * q + 3] += w * v.w;
+        }
+      } else {
+        const float* v = values + static_cast<int64_t>(s_id[j]) * D;
+#pragma unroll
+        for (int c = 0; c < CH; ++c) {
+          if (c < D) acc[c] += w * v[c];
+        }
       }
       trans = next;
       last = batch + j - start + 1;
@@ -397,12 +432,13 @@ __global__ void __launch_bounds__(kBlock)
 //  1. lane l tests whether Gaussian l of the group can reach the warp's 16 x 2 pixels at all
 //     (alphaMayReach) and lies before the last contributor of one of its pixels; the ballot is
 //     the group's mask, and a Gaussian outside it costs the warp nothing more;
-//  2. the dot products of the group's values with the pixel gradients, values [32 x D] x pixel
+//  then steps 2-4 for each half of 16 Gaussians with a bit in the mask:
+//  2. the dot products of the half's values with the pixel gradients, values [16 x D] x pixel
 //     gradients^T [D x 32 pixels], which the alpha gradients need, on tensor cores
 //     (tf32_mma.cuh, 3xTF32: FP32 accuracy);
 //  3. the per-pixel scalar work (transmittance, alpha and geometry gradients) Gaussian by
 //     Gaussian, leaving each pixel's weight in shared memory;
-//  4. the value gradients, weights^T [32 x 32 pixels] x pixel gradients [32 pixels x D], on
+//  4. the value gradients, weights^T [16 x 32 pixels] x pixel gradients [32 pixels x D], on
 //     tensor cores again.
 // The same grouping of the forward's channel sums (image += weights x values) measured slower
 // than the forward's per-pixel sums (H100, 100k Gaussians with 32 features: 1.26-1.29 ms
@@ -481,88 +517,81 @@ __device__ __forceinline__ void addGeometryGradients(const float (&v)[6], int g,
   }
 }
 
-// rows[Gaussian][pixel] = values[ids[Gaussian]] . gradient of the pixel for the group's Gaussians
-// in mask: [32 x D] x [D x 32 pixels], 16 Gaussians (a row tile) at a time; a row tile without a
-// Gaussian in mask is skipped.
+// rows[Gaussian][pixel] = values[ids[Gaussian]] . gradient of the pixel for the 16 Gaussians of
+// a half group (a row tile of the product) in `mask` (bit r: Gaussian r of the half):
+// [16 x D] x [D x 32 pixels].
 template <int CH>
-__device__ __forceinline__ void groupDots(unsigned mask, const int* ids,
-                                          const float* __restrict__ values, int D,
-                                          const float* warp_gpix,
-                                          float (*rows)[kBackwardRowStride], int group, int quad) {
+__device__ __forceinline__ void halfDots(unsigned mask, const int* ids,
+                                         const float* __restrict__ values, int D,
+                                         const float* warp_gpix,
+                                         float (*rows)[kBackwardRowStride], int group, int quad) {
   constexpr int S = gradientRowStride(CH);
+  const int g0 = group, g1 = g0 + 8;
+  const float* v0 = (mask >> g0) & 1u ? values + static_cast<int64_t>(ids[g0]) * D : nullptr;
+  const float* v1 = (mask >> g1) & 1u ? values + static_cast<int64_t>(ids[g1]) * D : nullptr;
+  float acc[4][4] = {};  // pixel tiles 8 n .. 8 n + 7
 #pragma unroll
-  for (int m = 0; m < 2; ++m) {
-    if (((mask >> (16 * m)) & 0xffffu) == 0) continue;
-    const int g0 = 16 * m + group, g1 = g0 + 8;
-    const float* v0 = (mask >> g0) & 1u ? values + static_cast<int64_t>(ids[g0]) * D : nullptr;
-    const float* v1 = (mask >> g1) & 1u ? values + static_cast<int64_t>(ids[g1]) * D : nullptr;
-    float acc[4][4] = {};  // pixel tiles 8 n .. 8 n + 7
-#pragma unroll
-    for (int k = 0; k < channelTiles(CH); ++k) {  // channels: the K extent
-      if (8 * k >= D) break;
-      const int c0 = 8 * k + quad, c1 = c0 + 4;
-      const Tf32Split a[4] = {splitTf32(v0 && c0 < D ? __ldg(v0 + c0) : 0.f),
-                              splitTf32(v1 && c0 < D ? __ldg(v1 + c0) : 0.f),
-                              splitTf32(v0 && c1 < D ? __ldg(v0 + c1) : 0.f),
-                              splitTf32(v1 && c1 < D ? __ldg(v1 + c1) : 0.f)};
-#pragma unroll
-      for (int n = 0; n < 4; ++n) {
-        const float* gp = warp_gpix + (8 * n + group) * S;  // B: channel rows, pixel columns
-        const Tf32Split b[2] = {splitTf32(gp[c0]), splitTf32(gp[c1])};
-        mma3xTf32(acc[n], a, b);
-      }
-    }
+  for (int k = 0; k < channelTiles(CH); ++k) {  // channels: the K extent
+    if (8 * k >= D) break;
+    const int c0 = 8 * k + quad, c1 = c0 + 4;
+    const Tf32Split a[4] = {splitTf32(v0 && c0 < D ? __ldg(v0 + c0) : 0.f),
+                            splitTf32(v1 && c0 < D ? __ldg(v1 + c0) : 0.f),
+                            splitTf32(v0 && c1 < D ? __ldg(v0 + c1) : 0.f),
+                            splitTf32(v1 && c1 < D ? __ldg(v1 + c1) : 0.f)};
 #pragma unroll
     for (int n = 0; n < 4; ++n) {
-      const int p = 8 * n + 2 * quad;
-      *reinterpret_cast<float2*>(&rows[g0][p]) = make_float2(acc[n][0], acc[n][1]);
-      *reinterpret_cast<float2*>(&rows[g1][p]) = make_float2(acc[n][2], acc[n][3]);
+      const float* gp = warp_gpix + (8 * n + group) * S;  // B: channel rows, pixel columns
+      const Tf32Split b[2] = {splitTf32(gp[c0]), splitTf32(gp[c1])};
+      mma3xTf32(acc[n], a, b);
     }
+  }
+#pragma unroll
+  for (int n = 0; n < 4; ++n) {
+    const int p = 8 * n + 2 * quad;
+    *reinterpret_cast<float2*>(&rows[g0][p]) = make_float2(acc[n][0], acc[n][1]);
+    *reinterpret_cast<float2*>(&rows[g1][p]) = make_float2(acc[n][2], acc[n][3]);
   }
 }
 
 // g_values[ids[Gaussian]] += sum over the warp's pixels p of rows[Gaussian][p] (the weights) x the
-// gradient of p: [32 x 32 pixels] x [32 x D]. One atomic per Gaussian, channel and warp, none for
-// a zero sum (a Gaussian that reached no pixel of the warp).
+// gradient of p for the first `in_half` Gaussians of a half group: [16 x 32 pixels] x [32 x D].
+// One atomic per Gaussian, channel and warp, none for a zero sum (a Gaussian that reached no
+// pixel of the warp).
 template <int CH>
-__device__ __forceinline__ void addGroupValueGradients(int in_group, const int* ids,
-                                                       float* g_values, int D,
-                                                       const float* warp_gpix,
-                                                       const float (*rows)[kBackwardRowStride],
-                                                       int group, int quad) {
+__device__ __forceinline__ void addHalfValueGradients(int in_half, const int* ids,
+                                                      float* g_values, int D,
+                                                      const float* warp_gpix,
+                                                      const float (*rows)[kBackwardRowStride],
+                                                      int group, int quad) {
   constexpr int S = gradientRowStride(CH);
+  const int g0 = group, g1 = g0 + 8;
+  const bool in0 = g0 < in_half, in1 = g1 < in_half;
+  Tf32Split a[4][4];  // A: Gaussian rows, pixel columns 8 k + quad (+ 4), for every k
 #pragma unroll
-  for (int m = 0; m < 2; ++m) {
-    if (16 * m >= in_group) break;
-    const int g0 = 16 * m + group, g1 = g0 + 8;
-    const bool in0 = g0 < in_group, in1 = g1 < in_group;
-    Tf32Split a[4][4];  // A: Gaussian rows, pixel columns 8 k + quad (+ 4), for every k
+  for (int k = 0; k < 4; ++k) {
+    const int p0 = 8 * k + quad, p1 = p0 + 4;
+    a[k][0] = splitTf32(in0 ? rows[g0][p0] : 0.f);
+    a[k][1] = splitTf32(in1 ? rows[g1][p0] : 0.f);
+    a[k][2] = splitTf32(in0 ? rows[g0][p1] : 0.f);
+    a[k][3] = splitTf32(in1 ? rows[g1][p1] : 0.f);
+  }
+  float* out0 = in0 ? g_values + static_cast<int64_t>(ids[g0]) * D : nullptr;
+  float* out1 = in1 ? g_values + static_cast<int64_t>(ids[g1]) * D : nullptr;
+#pragma unroll
+  for (int n = 0; n < channelTiles(CH); ++n) {
+    if (8 * n >= D) break;
+    float acc[4] = {0.f, 0.f, 0.f, 0.f};
 #pragma unroll
     for (int k = 0; k < 4; ++k) {
-      const int p0 = 8 * k + quad, p1 = p0 + 4;
-      a[k][0] = splitTf32(in0 ? rows[g0][p0] : 0.f);
-      a[k][1] = splitTf32(in1 ? rows[g1][p0] : 0.f);
-      a[k][2] = splitTf32(in0 ? rows[g0][p1] : 0.f);
-      a[k][3] = splitTf32(in1 ? rows[g1][p1] : 0.f);
+      const float* gp = warp_gpix + (8 * k + quad) * S + 8 * n + group;  // B: pixel rows
+      const Tf32Split b[2] = {splitTf32(gp[0]), splitTf32(gp[4 * S])};
+      mma3xTf32(acc, a[k], b);
     }
-    float* out0 = in0 ? g_values + static_cast<int64_t>(ids[g0]) * D : nullptr;
-    float* out1 = in1 ? g_values + static_cast<int64_t>(ids[g1]) * D : nullptr;
-#pragma unroll
-    for (int n = 0; n < channelTiles(CH); ++n) {
-      if (8 * n >= D) break;
-      float acc[4] = {0.f, 0.f, 0.f, 0.f};
-#pragma unroll
-      for (int k = 0; k < 4; ++k) {
-        const float* gp = warp_gpix + (8 * k + quad) * S + 8 * n + group;  // B: pixel rows
-        const Tf32Split b[2] = {splitTf32(gp[0]), splitTf32(gp[4 * S])};
-        mma3xTf32(acc, a[k], b);
-      }
-      const int c = 8 * n + 2 * quad;
-      if (out0 && c < D && acc[0] != 0.f) atomicAdd(out0 + c, acc[0]);
-      if (out0 && c + 1 < D && acc[1] != 0.f) atomicAdd(out0 + c + 1, acc[1]);
-      if (out1 && c < D && acc[2] != 0.f) atomicAdd(out1 + c, acc[2]);
-      if (out1 && c + 1 < D && acc[3] != 0.f) atomicAdd(out1 + c + 1, acc[3]);
-    }
+    const int c = 8 * n + 2 * quad;
+    if (out0 && c < D && acc[0] != 0.f) atomicAdd(out0 + c, acc[0]);
+    if (out0 && c + 1 < D && acc[1] != 0.f) atomicAdd(out0 + c + 1, acc[1]);
+    if (out1 && c < D && acc[2] != 0.f) atomicAdd(out1 + c, acc[2]);
+    if (out1 && c + 1 < D && acc[3] != 0.f) atomicAdd(out1 + c + 1, acc[3]);
   }
 }
 
@@ -598,8 +627,8 @@ __global__ void __launch_bounds__(kBlock)
   __shared__ float s_mean[kBlock][2];
   __shared__ float s_conic[kBlock][3];
   __shared__ float s_opacity[kBlock];
-  // [warp][Gaussian in group][pixel]: the group's dot products, overwritten by its weights
-  __shared__ __align__(16) float s_rows[kWarps][32][kBackwardRowStride];
+  // [warp][Gaussian in half group][pixel]: the half's dot products, overwritten by its weights
+  __shared__ __align__(16) float s_rows[kWarps][16][kBackwardRowStride];
   extern __shared__ float s_gpix[];  // [warp][pixel][S], channels >= D zero
   float(*rows)[kBackwardRowStride] = s_rows[warp];
   const float* warp_gpix = s_gpix + static_cast<int64_t>(warp) * 32 * S;
@@ -642,46 +671,54 @@ __global__ void __launch_bounds__(kBlock)
       const int in_group = min(32, count - j0);
       const unsigned mask = groupMask(j0, in_group, lane, first_position - j0 - lane < warp_last,
                                       s_mean, s_conic, s_opacity, rect);
-      if (mask == 0) continue;
-      groupDots<CH>(mask, s_id + j0, values, D, warp_gpix, rows, group, quad);
-      __syncwarp();
-      bool any_weight = false;
-      for (int slot = 0; slot < in_group; ++slot) {
-        float w = 0.f;
-        if ((mask >> slot) & 1u) {
-          const int j = j0 + slot;
-          float G = 0.f, alpha = 0.f;
-          bool clamped = false;
-          if (first_position - j < last) {
-            alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
-          }
-          const bool contributes = alpha > 0.f;
-          if (__any_sync(kFullMask, contributes)) {
-            float grads[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};  // mean2d, conic, opacity
-            if (contributes) {
-              const float inv_keep = 1.f / (1.f - alpha);  // one division, used twice
-              trans *= inv_keep;
-              w = alpha * trans;
-              const float dot = rows[slot][lane];
-              behind = last_alpha * last_dot + (1.f - last_alpha) * behind;
-              const float g_a = (dot - behind) * trans + ga_out * final_trans * inv_keep;
-              last_dot = dot;
-              last_alpha = alpha;
-              pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a,
-                                 grads, grads + 2, grads + 5);
+      // Half by half (16 Gaussians, one row tile of the products): the products' rows then take
+      // half the shared memory, which lets three blocks share an SM at 36 channels instead of two.
+#pragma unroll
+      for (int h = 0; h < 2; ++h) {
+        const int h0 = 16 * h, in_half = min(16, in_group - h0);
+        const unsigned half_mask = (mask >> h0) & 0xffffu;
+        if (in_half <= 0) break;
+        if (half_mask == 0) continue;
+        halfDots<CH>(half_mask, s_id + j0 + h0, values, D, warp_gpix, rows, group, quad);
+        __syncwarp();
+        bool any_weight = false;
+        for (int r = 0; r < in_half; ++r) {
+          float w = 0.f;
+          if ((half_mask >> r) & 1u) {
+            const int j = j0 + h0 + r;
+            float G = 0.f, alpha = 0.f;
+            bool clamped = false;
+            if (first_position - j < last) {
+              alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
             }
-            addGeometryGradients(grads, s_id[j], lane, g_means2d, g_conics, g_opacities);
+            const bool contributes = alpha > 0.f;
+            if (__any_sync(kFullMask, contributes)) {
+              float grads[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};  // mean2d, conic, opacity
+              if (contributes) {
+                const float inv_keep = 1.f / (1.f - alpha);  // one division, used twice
+                trans *= inv_keep;
+                w = alpha * trans;
+                const float dot = rows[r][lane];
+                behind = last_alpha * last_dot + (1.f - last_alpha) * behind;
+                const float g_a = (dot - behind) * trans + ga_out * final_trans * inv_keep;
+                last_dot = dot;
+                last_alpha = alpha;
+                pixelAlphaBackward(s_mean[j], s_conic[j], s_opacity[j], fx, fy, G, clamped, g_a,
+                                   grads, grads + 2, grads + 5);
+              }
+              addGeometryGradients(grads, s_id[j], lane, g_means2d, g_conics, g_opacities);
+            }
           }
+          rows[r][lane] = w;
+          any_weight = any_weight || w != 0.f;
         }
-        rows[slot][lane] = w;
-        any_weight = any_weight || w != 0.f;
+        __syncwarp();
+        if (__any_sync(kFullMask, any_weight)) {
+          addHalfValueGradients<CH>(in_half, s_id + j0 + h0, g_values, D, warp_gpix, rows, group,
+                                    quad);
+        }
+        __syncwarp();
       }
-      __syncwarp();
-      if (__any_sync(kFullMask, any_weight)) {
-        addGroupValueGradients<CH>(in_group, s_id + j0, g_values, D, warp_gpix, rows, group,
-                                   quad);
-      }
-      __syncwarp();
     }
   }
 }
