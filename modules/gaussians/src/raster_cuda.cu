@@ -413,11 +413,37 @@ __global__ void __launch_bounds__(kBlock)
       last = batch + j - start + 1;
     }
   }
+  // From 16 channels on, the channels leave through shared memory: a warp's two rows of 16
+  // pixels are 2 x 16 x D contiguous floats of the image, written by consecutive lanes
+  // (per-pixel stores, D floats apart, cost up to 8 times the L2 sectors). Not for RGB: there
+  // the per-pixel stores waste less and the copy's registers would cost occupancy.
+  constexpr bool kRowStores = kStaged && CH >= 16;
+  if constexpr (kRowStores) {
+    __syncthreads();  // every warp is past its last read of the batch's values
+    const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+    float* s_out = &s_values[0][0] + warp * 32 * D;  // [pixel of the warp][D]
+#pragma unroll
+    for (int c = 0; c < CH; ++c) {
+      if (c < D) s_out[lane * D + c] = acc[c];
+    }
+    __syncwarp();
+    const int x0 = tx * kTileSize;
+    const int row_floats = min(kTileSize, width - x0) * D;
+    for (int r = 0; r < 2; ++r) {
+      const int y = ty * kTileSize + 2 * warp + r;
+      if (y >= height) break;
+      float* dst = image + (static_cast<int64_t>(y) * width + x0) * D;
+      const float* src = s_out + r * kTileSize * D;
+      for (int e = lane; e < row_floats; e += 32) dst[e] = src[e];
+    }
+  }
   if (!inside) return;
   const int64_t pix = static_cast<int64_t>(py) * width + px;
+  if constexpr (!kRowStores) {
 #pragma unroll
-  for (int c = 0; c < CH; ++c) {
-    if (c < D) image[pix * D + c] = acc[c];
+    for (int c = 0; c < CH; ++c) {
+      if (c < D) image[pix * D + c] = acc[c];
+    }
   }
   alpha_out[pix] = 1.f - trans;
   last_out[pix] = last;
@@ -638,7 +664,28 @@ __global__ void __launch_bounds__(kBlock)
   const int last = inside ? last_fwd[pix] : 0;
   const float ga_out = inside && g_alpha != nullptr ? g_alpha[pix] : 0.f;
   float* my_gpix = s_gpix + (static_cast<int64_t>(warp) * 32 + lane) * S;
-  for (int c = 0; c < S; ++c) my_gpix[c] = c < D && inside ? g_image[pix * D + c] : 0.f;
+  if constexpr (CH >= 16) {
+    // The warp's two rows of 16 pixels are 2 x 16 x D contiguous floats of the gradient image:
+    // consecutive lanes load consecutive floats (a pixel's own D floats, D apart from the next
+    // lane's, cost up to 8 times the L1 sectors). Channels D .. S and pixels outside stay zero.
+    for (int c = inside ? D : 0; c < S; ++c) my_gpix[c] = 0.f;
+    const int x0 = tx * kTileSize;
+    const int row_floats = min(kTileSize, width - x0) * D;
+    float* warp_rows = s_gpix + static_cast<int64_t>(warp) * 32 * S;
+    for (int r = 0; r < 2; ++r) {
+      const int y = ty * kTileSize + 2 * warp + r;
+      if (y >= height) break;
+      const float* src = g_image + (static_cast<int64_t>(y) * width + x0) * D;
+      int col = lane / D, c = lane % D;  // of float e = lane + 32 k of the row
+      for (int e = lane; e < row_floats; e += 32) {
+        warp_rows[(r * kTileSize + col) * S + c] = src[e];
+        for (c += 32; c >= D; c -= D) ++col;
+      }
+    }
+    __syncwarp();
+  } else {
+    for (int c = 0; c < S; ++c) my_gpix[c] = c < D && inside ? g_image[pix * D + c] : 0.f;
+  }
   float trans = final_trans;
   float last_alpha = 0.f;
   float behind = 0.f;    // sum_c (colour accumulated behind the current Gaussian)[c] * gpix[c]
