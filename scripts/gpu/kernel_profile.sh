@@ -2,8 +2,10 @@
 # ON THE GPU MACHINE from the repository root: where one training's GPU time goes, per CUDA kernel
 # (Nsight Compute's gpu__time_duration, clocks left alone), and how busy the GPU is without it.
 #
-#   bash scripts/gpu/kernel_profile.sh TAG SCENE [AT=5000] [WINDOW=5] [train args...]
+#   [CONFIG=file.json] bash scripts/gpu/kernel_profile.sh TAG SCENE [AT=5000] [WINDOW=5] [train args...]
 #
+# CONFIG: TrainConfig keys for every training of the profile (train args must not carry a
+# --config of their own: the short runs below pass one).
 # 1. The training alone (ITERATIONS, default 7000), nvidia-smi sampling the GPU's utilisation every
 #    200 ms: the wall time per iteration.
 # 2. Two short trainings under ncu (10 and 20 iterations) count the kernels of the setup and of one
@@ -23,6 +25,7 @@ at="${3:-5000}"
 window="${4:-5}"
 shift $(( $# < 4 ? $# : 4 ))
 iterations="${ITERATIONS:-7000}"
+user_config=(); [ -n "${CONFIG:-}" ] && user_config=(--config "$CONFIG")
 [ -x "$SADSPLAT_BIN" ] || gpu_build || exit 1
 export PATH=/usr/local/cuda/bin:$PATH
 ncu_bin=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1)
@@ -36,8 +39,8 @@ if [ "${PLAIN:-1}" = 1 ]; then
   nvidia-smi --query-gpu=utilization.gpu --format=csv,noheader,nounits -lms 200 > "$work/util.txt" &
   smi=$!
   start=$(date +%s%N)
-  "$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$iterations" --out "$work/plain" "$@" \
-    > "$work/plain.log" 2>&1
+  "$SADSPLAT_BIN" train "$scene" --device cuda --iterations "$iterations" --out "$work/plain" \
+    "${user_config[@]}" "$@" > "$work/plain.log" 2>&1
   wall_ms=$(( ($(date +%s%N) - start) / 1000000 ))
   kill "$smi" 2>/dev/null
   {
@@ -63,15 +66,17 @@ count_rows() { python3 -c 'import csv,sys; r=[x for x in csv.reader(open(sys.arg
 # launches are left untimed at the start: it must stay below the launches of a 10-iteration run
 # (the setup of the city at 800x450 with pseudo-labels has fewer than 2000).
 count_skip="${COUNT_SKIP:-0}"
-"$SADSPLAT_BIN" train "$scene" --device cuda --iterations 10 --out "$work/schedule" "$@" \
-  > "$work/schedule.log" 2>&1
-python3 - "$work/schedule.log" "$work/schedule.json" <<'PY'
+"$SADSPLAT_BIN" train "$scene" --device cuda --iterations 10 --out "$work/schedule" \
+  "${user_config[@]}" "$@" > "$work/schedule.log" 2>&1
+python3 - "$work/schedule.log" "$work/schedule.json" "${CONFIG:-}" <<'PY'
 import json, re, sys
 keys = {}
 for line in open(sys.argv[1]):
     if line.startswith("schedule of a run of"):
         for key, default in re.findall(r" (\w+) (\S+) -> \S+;", line):
             keys[key] = json.loads(default)
+if sys.argv[3]:
+    keys.update(json.load(open(sys.argv[3])))  # the user's keys as the full runs have them
 json.dump(keys, open(sys.argv[2], "w"))
 print("short runs keep", keys)
 PY
@@ -101,7 +106,7 @@ echo "kernels timed after the first $count_skip: 10 iterations $k10, 20 iteratio
 skip=$(( setup + at * per_it ))
 count=$(( window * per_it ))
 ncu_times "$OUT/kernels_$tag.csv" "$skip" "$count" "${WINDOW_TIMEOUT_S:-300}" \
-  --iterations "$iterations" --out "$work/window" "$@" > "$work/window.log" 2>&1
+  --iterations "$iterations" --out "$work/window" "${user_config[@]}" "$@" > "$work/window.log" 2>&1
 echo "window: launches $skip .. $(( skip + count )) (~iterations $at .. $(( at + window )))" | tee -a "$summary"
 python3 - "$OUT/kernels_$tag.csv" "$wall_ms" "$iterations" <<'PY' | tee -a "$summary"
 import csv, re, sys
