@@ -215,21 +215,20 @@ void forwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int widt
   }
 }
 
-// One tile of the backward pass (see forwardOneTile). accum, last_value: kTileSize * D values;
-// row_buffer: 6 + D.
+// One tile of the backward pass (see forwardOneTile). row_buffer: 6 + D values.
 template <typename T>
 void backwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int width, int height,
                      CpuTileLoops loops, const T* gimg, const T* galpha, const T* alpha_fwd,
-                     const int* last_fwd, T* accum, T* last_value, T* row_buffer, T* grads) {
+                     const int* last_fwd, T* row_buffer, T* grads) {
 #if SADSPLAT_CPU_RASTER_SIMD
   if constexpr (std::is_same_v<T, float>) {
     if (loops == CpuTileLoops::kFastest) {
       if (D == 3) {
         cpu_tiles::backwardTileRows<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
-                                       last_fwd, accum, last_value, row_buffer, grads);
+                                       last_fwd, row_buffer, grads);
       } else {
         cpu_tiles::backwardTileRows<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
-                                       last_fwd, accum, last_value, row_buffer, grads);
+                                       last_fwd, row_buffer, grads);
       }
       return;
     }
@@ -237,10 +236,10 @@ void backwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int wid
 #endif
   if (D == 3) {
     cpu_tiles::backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
-                               accum, last_value, grads);
+                               grads);
   } else {
     cpu_tiles::backwardTile<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
-                               accum, last_value, grads);
+                               grads);
   }
 }
 
@@ -348,8 +347,6 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     }
     run_start[0] = 0;
     at::parallel_for(0, threads, 1, [&](int64_t first_run, int64_t end_run) {
-      std::vector<T> accum(static_cast<std::size_t>(kTileSize * D));
-      std::vector<T> last_value(accum.size());
       std::vector<T> row_buffer(static_cast<std::size_t>(row));
       std::vector<T> grads;
       TileList<T> list;
@@ -363,7 +360,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
                       D);
           grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
           backwardOneTile(list, D, tx, ty, width, height, loops, gimg, galpha, alpha_fwd, last_fwd,
-                          accum.data(), last_value.data(), row_buffer.data(), grads.data());
+                          row_buffer.data(), grads.data());
           for (int j = 0; j < list.size(); ++j) {
             T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
             const T* gt = grads.data() + j * row;

@@ -94,28 +94,33 @@ inline bool blendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, int
 }
 
 // The backward of blendGaussian for the pixel at (fx, fy), walked back to front: adds Gaussian
-// j's gradients (mean2d, conic, opacity, values) to its row `gb`. The pixel's state: `trans`,
-// `last_alpha`, `accum`, `last_value` (updated); gpix its image gradient, g_alpha_out its alpha
-// gradient, final_trans its transmittance after the forward. Shared by both loops, as above.
+// j's gradients (mean2d, conic, opacity, values) to its row `gb`. The opacity gradient needs the
+// dot product of the pixel gradient with the colour accumulated behind the Gaussian; the pixel
+// gradient is the same for every Gaussian of the pixel, so that product follows the colour's own
+// recurrence (behind <- a * value + (1 - a) * behind) and is carried as one number, `behind`,
+// with `last_dot` (value . gradient of the Gaussian visited before) — D multiply-adds per pair
+// fewer than carrying the D-channel colour (the CUDA backward does the same). The pixel's state:
+// `trans`, `last_alpha`, `behind`, `last_dot` (updated); gpix its image gradient, g_alpha_out its
+// alpha gradient, final_trans its transmittance after the forward. Shared by both loops, as above.
 template <typename T>
 inline void unblendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, T fx, T fy,
                             const T* gpix, T g_alpha_out, T final_trans, T* trans, T* last_alpha,
-                            T* accum, T* last_value, T* gb) {
+                            T* behind, T* last_dot, T* gb) {
   T G;
   bool clamped;
   const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
   if (alpha == T(0)) return;
   *trans = *trans / (T(1) - alpha);
   const T w = alpha * *trans;
-  T g_a = T(0);
+  T dot = T(0);
   for (int64_t ch = 0; ch < D; ++ch) {
-    accum[ch] = *last_alpha * last_value[ch] + (T(1) - *last_alpha) * accum[ch];
-    last_value[ch] = v[ch];
-    g_a += (v[ch] - accum[ch]) * gpix[ch];
+    dot += v[ch] * gpix[ch];
     gb[6 + ch] += w * gpix[ch];
   }
-  g_a *= *trans;
+  *behind = *last_alpha * *last_dot + (T(1) - *last_alpha) * *behind;
+  T g_a = (dot - *behind) * *trans;
   g_a += g_alpha_out * final_trans / (T(1) - alpha);
+  *last_dot = dot;
   *last_alpha = alpha;
   pixelAlphaBackward(p.mean2d, p.conic, p.opacity, fx, fy, G, clamped, g_a, gb, gb + 2, gb + 5);
 }
@@ -150,8 +155,8 @@ void forwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int
 // ([L, 6 + D]: mean2d, conic, opacity, values), which the caller has zeroed.
 template <int kD, typename T>
 void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, int width, int height,
-                  const T* gimg, const T* galpha, const T* alpha_fwd, const int* last_fwd, T* accum,
-                  T* last_value, T* grads) {
+                  const T* gimg, const T* galpha, const T* alpha_fwd, const int* last_fwd,
+                  T* grads) {
   const int64_t D = kD > 0 ? kD : dynamic_d;
   const int64_t row = 6 + D;
   const PackedGaussian<T>* pg = list.gaussians.data();
@@ -162,14 +167,12 @@ void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, in
     const T final_trans = T(1) - alpha_fwd[pix];
     const T* gpix = gimg + pix * D;
     T trans = final_trans;
-    std::fill(accum, accum + D, T(0));
-    std::fill(last_value, last_value + D, T(0));
-    T last_alpha = T(0);
+    T last_alpha = T(0), behind = T(0), last_dot = T(0);
     for (int j = last_fwd[pix] - 1; j >= 0; --j) {
       const PackedGaussian<T>& p = pg[j];
       if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
       unblendGaussian(p, val + j * D, D, fx, fy, gpix, galpha[pix], final_trans, &trans,
-                      &last_alpha, accum, last_value, grads + j * row);
+                      &last_alpha, &behind, &last_dot, grads + j * row);
     }
   });
 }
@@ -254,13 +257,11 @@ void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int
 
 // backwardTile for float, a tile row at a time (see forwardTileRows). For each Gaussian the
 // row's pixels add their gradients in pixel order, rows in order: the same sequence of additions
-// to every gradient as backwardTile's pixel-by-pixel walk. `accum`, `last_value`: kTileSize * D;
-// `row_buffer`: 6 + D.
+// to every gradient as backwardTile's pixel-by-pixel walk. `row_buffer`: 6 + D.
 template <int kD>
 void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int ty, int width,
                       int height, const float* gimg, const float* galpha, const float* alpha_fwd,
-                      const int* last_fwd, float* accum, float* last_value, float* row_buffer,
-                      float* grads) {
+                      const int* last_fwd, float* row_buffer, float* grads) {
   const int64_t D = kD > 0 ? kD : dynamic_d;
   const int64_t grad_row = 6 + D;
   const PackedGaussian<float>* pg = list.gaussians.data();
@@ -270,6 +271,7 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
   const int lanes = std::min(width - x0, kTileSize);
   const int y_end = std::min(height, (ty + 1) * kTileSize);
   float trans[kTileSize], final_trans[kTileSize], last_alpha[kTileSize], g_out[kTileSize];
+  float behind[kTileSize], last_dot[kTileSize];
   int last[kTileSize];
   // One Gaussian's gradient row: a fixed array for RGB, the caller's buffer otherwise.
   float rgb_row[6 + 3];
@@ -277,8 +279,6 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
   for (int py = ty * kTileSize; py < y_end; ++py) {
     const float fy = float(py) + 0.5f;
     const int64_t pix0 = static_cast<int64_t>(py) * width + x0;
-    std::fill(accum, accum + kTileSize * D, 0.f);
-    std::fill(last_value, last_value + kTileSize * D, 0.f);
     int end = 0;
     for (int l = 0; l < kTileSize; ++l) {
       const bool inside = l < lanes;
@@ -287,6 +287,8 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
       last[l] = inside ? last_fwd[pix0 + l] : 0;
       g_out[l] = inside ? galpha[pix0 + l] : 0.f;
       last_alpha[l] = 0.f;
+      behind[l] = 0.f;
+      last_dot[l] = 0.f;
       end = std::max(end, last[l]);
     }
     for (int j = end - 1; j >= 0; --j) {
@@ -303,8 +305,8 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
       for (; bits != 0; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
         unblendGaussian(p, val + j * D, D, float(x0 + l) + 0.5f, fy, gimg + (pix0 + l) * D,
-                        g_out[l], final_trans[l], &trans[l], &last_alpha[l], accum + l * D,
-                        last_value + l * D, gb);
+                        g_out[l], final_trans[l], &trans[l], &last_alpha[l], &behind[l],
+                        &last_dot[l], gb);
       }
       std::copy(gb, gb + grad_row, gj);
     }
