@@ -135,7 +135,9 @@ TEST_P(RasterizerCuda, OrthographicForwardAndBackwardMatchTheCpuReference) {
   expectCudaMatchesCpu(cam, GetParam(), true);
 }
 
-INSTANTIATE_TEST_SUITE_P(FeatureChannels, RasterizerCuda, ::testing::Values(0, 3, 32, 64));
+// 0, 3, 12, 32, 64 features: every channel capacity up to 68 (4, 8, 16, 36, 68), each with its
+// own forward and backward paths (values staged or not, row-wise image copies or not).
+INSTANTIATE_TEST_SUITE_P(FeatureChannels, RasterizerCuda, ::testing::Values(0, 3, 12, 32, 64));
 
 // The SH colours and their backward on CUDA against the CPU, for every degree, with exactly
 // (degree+1)^2 coefficients, with more than the degree uses, and with more than 16. 1000
