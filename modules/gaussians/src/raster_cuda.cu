@@ -287,15 +287,14 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
   if (m > 0) {
     writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
         n, means2d.data_ptr<float>(), conics.data_ptr<float>(), radii.data_ptr<int>(),
-        opacities.data_ptr<float>(), depths.data_ptr<float>(), offsets.data_ptr<int64_t>(),
-        tiles_x, tiles_y, m, keys.data_ptr<int64_t>(), values.data_ptr<int>());
+        opacities.data_ptr<float>(), depths.data_ptr<float>(), offsets.data_ptr<int64_t>(), tiles_x,
+        tiles_y, m, keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     const ScopedPhase sort_phase("sort");
     std::tie(keys, values) =
         sortByTileAndDepth(keys, values, sized_before ? num_tiles + 1 : num_tiles, stream);
-    tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(m, keys.data_ptr<int64_t>(),
-                                                              num_tiles,
-                                                              b.tile_ranges.data_ptr<int>());
+    tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(
+        m, keys.data_ptr<int64_t>(), num_tiles, b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");
   }
   b.gaussian_ids = values;
@@ -373,10 +372,9 @@ __global__ void __launch_bounds__(kBlock)
 #pragma unroll
         for (int q = 0; q < CH / 4; ++q) {
           const int c = 4 * q;
-          *reinterpret_cast<float4*>(&s_values[threadIdx.x][c]) =
-              make_float4(c < D ? __ldg(src + c) : 0.f, c + 1 < D ? __ldg(src + c + 1) : 0.f,
-                          c + 2 < D ? __ldg(src + c + 2) : 0.f,
-                          c + 3 < D ? __ldg(src + c + 3) : 0.f);
+          *reinterpret_cast<float4*>(&s_values[threadIdx.x][c]) = make_float4(
+              c < D ? __ldg(src + c) : 0.f, c + 1 < D ? __ldg(src + c + 1) : 0.f,
+              c + 2 < D ? __ldg(src + c + 2) : 0.f, c + 3 < D ? __ldg(src + c + 3) : 0.f);
         }
       }
     }
@@ -468,8 +466,8 @@ __global__ void __launch_bounds__(kBlock)
 //     tensor cores again.
 // The same grouping of the forward's channel sums (image += weights x values) measured slower
 // than the forward's per-pixel sums (H100, 100k Gaussians with 32 features: 1.26-1.29 ms
-// against 1.11-1.15 ms): the forward stops each pixel at its transmittance floor, the product cannot.
-// CH is the channel capacity (>= D), fixed at compile time: the accumulator tiles live in
+// against 1.11-1.15 ms): the forward stops each pixel at its transmittance floor, the product
+// cannot. CH is the channel capacity (>= D), fixed at compile time: the accumulator tiles live in
 // registers.
 static_assert(kTileSize == 16, "a warp is two rows of a 16-pixel-wide tile");
 constexpr int kWarps = kBlock / 32;
@@ -549,8 +547,8 @@ __device__ __forceinline__ void addGeometryGradients(const float (&v)[6], int g,
 template <int CH>
 __device__ __forceinline__ void halfDots(unsigned mask, const int* ids,
                                          const float* __restrict__ values, int D,
-                                         const float* warp_gpix,
-                                         float (*rows)[kBackwardRowStride], int group, int quad) {
+                                         const float* warp_gpix, float (*rows)[kBackwardRowStride],
+                                         int group, int quad) {
   constexpr int S = gradientRowStride(CH);
   const int g0 = group, g1 = g0 + 8;
   const float* v0 = (mask >> g0) & 1u ? values + static_cast<int64_t>(ids[g0]) * D : nullptr;
@@ -584,9 +582,8 @@ __device__ __forceinline__ void halfDots(unsigned mask, const int* ids,
 // One atomic per Gaussian, channel and warp, none for a zero sum (a Gaussian that reached no
 // pixel of the warp).
 template <int CH>
-__device__ __forceinline__ void addHalfValueGradients(int in_half, const int* ids,
-                                                      float* g_values, int D,
-                                                      const float* warp_gpix,
+__device__ __forceinline__ void addHalfValueGradients(int in_half, const int* ids, float* g_values,
+                                                      int D, const float* warp_gpix,
                                                       const float (*rows)[kBackwardRowStride],
                                                       int group, int quad) {
   constexpr int S = gradientRowStride(CH);
@@ -856,8 +853,7 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
       n, means.data_ptr<float>(), quats.data_ptr<float>(), log_scales.data_ptr<float>(),
       radii.data_ptr<int>(), toCamera<float>(cam), g_means2d.data_ptr<float>(),
       g_conics.data_ptr<float>(), g_depths.defined() ? g_depths.data_ptr<float>() : nullptr,
-      g.means.data_ptr<float>(),
-      g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
+      g.means.data_ptr<float>(), g.quats.data_ptr<float>(), g.log_scales.data_ptr<float>());
   checkLaunch("projectBackwardKernel");
   return g;
 }
@@ -952,14 +948,13 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));
 #define SADSPLAT_LAUNCH_BACKWARD(CH)                                                               \
   launchBackward(rasterizeBackwardKernel<CH>, num_tiles,                                           \
-                 sizeof(float) * kBlock * gradientRowStride(CH), stream, width, height,            \
-                 tiles_x, static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),            \
+                 sizeof(float) * kBlock * gradientRowStride(CH), stream, width, height, tiles_x,   \
+                 static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),                     \
                  fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),              \
                  conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),  \
                  fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(), \
-                 g_alpha_ptr, g.means2d.data_ptr<float>(),                                         \
-                 g.conics.data_ptr<float>(), g.opacities.data_ptr<float>(),                        \
-                 g.values.data_ptr<float>())
+                 g_alpha_ptr, g.means2d.data_ptr<float>(), g.conics.data_ptr<float>(),             \
+                 g.opacities.data_ptr<float>(), g.values.data_ptr<float>())
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_BACKWARD)
 #undef SADSPLAT_LAUNCH_BACKWARD
   checkLaunch("rasterizeBackwardKernel");
