@@ -3,9 +3,11 @@
 // whose edge tiles have partial rows and with lists long enough for pixels to saturate.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 
 #include "raster_backend.h"
+#include "raster_cpu_tiles.h"
 
 namespace sadsplat {
 namespace {
@@ -28,14 +30,18 @@ struct Scene {
   at::Tensor means2d, conics, opacities, values, radii, depths;
 };
 
-// n float Gaussians in front of the camera, projected with the CPU backend; D channels.
-Scene projectedScene(int n, int D, const CameraParams& cam, std::uint64_t seed, double opacity) {
+// n float Gaussians in front of the camera, projected with the CPU backend; D channels. needles:
+// scales from 0.001 to 0.3 per axis (cubed uniform), so many are thin and long, at every angle.
+Scene projectedScene(int n, int D, const CameraParams& cam, std::uint64_t seed, double opacity,
+                     bool needles = false) {
   at::manual_seed(static_cast<int64_t>(seed));
   const auto opts = at::TensorOptions().dtype(at::kFloat);
   const at::Tensor means =
       at::cat({(at::rand({n, 2}, opts) - 0.5) * 1.2, 2.0 + at::rand({n, 1}, opts)}, 1);
   const at::Tensor quats = at::randn({n, 4}, opts);
-  const at::Tensor log_scales = at::log(0.01 + 0.08 * at::rand({n, 3}, opts));
+  const at::Tensor log_scales =
+      needles ? at::log(0.001 + 0.3 * at::rand({n, 3}, opts).pow(3))
+              : at::log(0.01 + 0.08 * at::rand({n, 3}, opts));
   const auto p = gaussians::raster::projectForwardCpu(means, quats, log_scales, cam);
   Scene s;
   s.means2d = p.means2d;
@@ -57,11 +63,11 @@ void expectBitIdentical(const at::Tensor& a, const at::Tensor& b, const char* wh
 // coverage: the largest alpha the scene must reach (0.999: pixels near saturation, which stop at
 // a transmittance of 1e-4).
 void expectPathsAgree(int width, int height, int n, int D, double opacity, double coverage,
-                      std::uint64_t seed) {
+                      std::uint64_t seed, bool needles = false) {
   SCOPED_TRACE(testing::Message() << width << "x" << height << ", " << n << " Gaussians, D " << D
                                   << ", opacity up to " << opacity);
   const CameraParams cam = frontCamera(width, height, 0.9 * width);
-  const Scene s = projectedScene(n, D, cam, seed, opacity);
+  const Scene s = projectedScene(n, D, cam, seed, opacity, needles);
   using gaussians::raster::rasterizeBackwardCpu;
   using gaussians::raster::rasterizeForwardCpu;
   const auto fast = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
@@ -102,6 +108,50 @@ TEST(RasterCpuPaths, FeatureChannelsAreBitIdentical) {
 
 TEST(RasterCpuPaths, FaintGaussiansThatNeverSaturateAreBitIdentical) {
   expectPathsAgree(40, 40, 800, 3, 0.05, 0.2, 4);
+}
+
+// Thin, long Gaussians at every angle: the vectorised loops leave out the rows outside each
+// Gaussian's row range (rowRange), which must never hold a pixel that the skip test passes.
+TEST(RasterCpuPaths, ThinRotatedGaussiansAreBitIdentical) {
+  expectPathsAgree(64, 48, 2500, 3, 0.95, 0.999, 5, true);
+  expectPathsAgree(45, 33, 1200, 35, 0.9, 0.999, 6, true);
+}
+
+// rowRange directly: on the first pixel-centre rows outside the range of random Gaussians (thin
+// ones and high opacities included), no pixel of a wide span of x passes the skip test as the
+// vectorised loops compute it (gaussianPower in float).
+TEST(RasterCpuPaths, NoPixelOutsideTheRowRangePassesTheSkipTest) {
+  at::manual_seed(7);
+  const int n = 20000;
+  const at::Tensor u = at::rand({n, 6}, at::kDouble);
+  int rows_checked = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto r = [&](int k) { return u[i][k].item<double>(); };
+    // Covariance from two axis variances (0.3 .. ~1e4 px^2) and an angle.
+    const double s1 = 0.3 + 1e4 * std::pow(r(0), 4), s2 = 0.3 + 1e4 * std::pow(r(1), 4);
+    const double t = 3.14159265 * r(2), c = std::cos(t), sn = std::sin(t);
+    const double sxx = c * c * s1 + sn * sn * s2, syy = sn * sn * s1 + c * c * s2,
+                 sxy = c * sn * (s1 - s2), det = sxx * syy - sxy * sxy;
+    const float conic[3] = {float(syy / det), float(-sxy / det), float(sxx / det)};
+    const float opacity = float(0.005 + 0.995 * r(3));
+    const float skip = std::log(float(gaussians::raster::kMinAlpha) / opacity) - 1e-3f;
+    const float mean_y = float(100.0 * r(4)), mean_x = float(100.0 * r(5));
+    float lo = 0, hi = 0;
+    gaussians::raster::cpu_tiles::rowRange(mean_y, conic, skip, &lo, &hi);
+    ASSERT_TRUE(std::isfinite(lo) && std::isfinite(hi) && lo <= mean_y && mean_y <= hi) << i;
+    // The nearest pixel-centre rows outside [lo, hi].
+    const float above = std::floor(lo - 0.5f) + 0.5f, below = std::ceil(hi - 0.5f) + 0.5f;
+    for (const float fy : {above < lo ? above : above - 1.f, below > hi ? below : below + 1.f}) {
+      const float half_width = float(std::sqrt(-2.0 * skip * sxx)) + 2.f;
+      for (float fx = std::floor(mean_x - half_width) + 0.5f; fx <= mean_x + half_width; fx += 1.f) {
+        const float power =
+            gaussians::raster::gaussianPower(conic, mean_x - fx, mean_y - fy);
+        ASSERT_LT(power, skip) << "Gaussian " << i << " row " << fy << " x " << fx;
+      }
+      ++rows_checked;
+    }
+  }
+  EXPECT_EQ(rows_checked, 2 * n);
 }
 
 }  // namespace

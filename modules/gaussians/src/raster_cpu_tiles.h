@@ -3,11 +3,13 @@
 // reference, for any scalar type, and for float a vectorised form that tests a Gaussian's skip
 // threshold at one tile row's 16 pixels at once with SSE2 (x86-64's baseline). Most
 // (pixel, Gaussian) pairs of a tile's list are skipped (~92 % on the demo city at 160x90); the
-// vectorised form does the pairs that are not with the scalar code, pixel by pixel in the same
+// vectorised form leaves out the rows outside a Gaussian's row range (rowRange) without a test,
+// and does the pairs that are not skipped with the scalar code, pixel by pixel in the same
 // order, so its images and gradients are bit-identical to the scalar form's
 // (test_raster_cpu_paths.cpp).
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -42,7 +44,25 @@ struct PackedGaussian {
   T conic[3];
   T opacity;
   T skip;  // skipThresholds
+  // The pixel-centre rows y with y_lo <= y <= y_hi are the only ones where some pixel may pass the
+  // skip test (rowRange); NaN bounds (no bound) exclude no row.
+  T y_lo, y_hi;
 };
+
+// Rows that Gaussian (mean_y, conic, skip) may reach: at a given dy the largest power over all x
+// is -0.5 dy^2 / S_yy, with S_yy = a / (a c - b^2) the covariance's y variance (conic (a, b, c)),
+// so no pixel with |dy| > sqrt(-2 skip S_yy) passes `power >= skip`. Widened by 0.1 % + 0.05 px
+// for the float rounding of the skip test (its power's error is ~1e-4 at most, dy's a thousandth of
+// a pixel); in double. A degenerate conic, an opacity <= 0 (skip = +inf) or a NaN give an
+// unbounded or NaN range, which excludes no row: the skip test decides, as without the range.
+template <typename T>
+inline void rowRange(T mean_y, const T conic[3], T skip, T* y_lo, T* y_hi) {
+  const double a = conic[0], b = conic[1], c = conic[2];
+  const double half = std::sqrt(-2.0 * double(skip) * a / (a * c - b * b));
+  const double h = half * (1 + 1e-3) + 0.05;
+  *y_lo = T(double(mean_y) - h);
+  *y_hi = T(double(mean_y) + h);
+}
 
 // A tile's Gaussians copied front to back into contiguous arrays (values as [L, D]): every pixel
 // of the tile walks the same list, so gathering it once per tile turns 256 indirect, scattered
@@ -68,6 +88,7 @@ struct TileList {
       for (int k = 0; k < 3; ++k) p.conic[k] = conics[3 * g + k];
       p.opacity = opacities[g];
       p.skip = skip[g];
+      rowRange(p.mean2d[1], p.conic, p.skip, &p.y_lo, &p.y_hi);
       std::copy(all_values + g * D, all_values + (g + 1) * D, values.begin() + j * D);
     }
   }
@@ -238,6 +259,7 @@ void forwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, int
     unsigned active = row.valid;
     for (int j = 0; j < count && active != 0; ++j) {
       const PackedGaussian<float>& p = pg[j];
+      if (fy < p.y_lo || fy > p.y_hi) continue;  // every pixel of the row skips it
       for (unsigned bits = notSkipped(p, row, fy) & active; bits != 0; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
         if (!blendGaussian(p, val + j * D, D, j, float(x0 + l) + 0.5f, fy, accum + l * D, &trans[l],
@@ -292,10 +314,11 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
       end = std::max(end, last[l]);
     }
     for (int j = end - 1; j >= 0; --j) {
+      const PackedGaussian<float>& p = pg[j];
+      if (fy < p.y_lo || fy > p.y_hi) continue;  // every pixel of the row skips it
       // The pixels whose last contributor lies at or behind list position j.
       unsigned live = 0;
       for (int l = 0; l < lanes; ++l) live |= static_cast<unsigned>(last[l] > j) << l;
-      const PackedGaussian<float>& p = pg[j];
       unsigned bits = notSkipped(p, row, fy) & live;
       if (bits == 0) continue;
       // The row's additions to Gaussian j's gradients, in lane order, on a local copy of its
