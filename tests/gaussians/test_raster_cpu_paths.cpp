@@ -39,9 +39,8 @@ Scene projectedScene(int n, int D, const CameraParams& cam, std::uint64_t seed, 
   const at::Tensor means =
       at::cat({(at::rand({n, 2}, opts) - 0.5) * 1.2, 2.0 + at::rand({n, 1}, opts)}, 1);
   const at::Tensor quats = at::randn({n, 4}, opts);
-  const at::Tensor log_scales =
-      needles ? at::log(0.001 + 0.3 * at::rand({n, 3}, opts).pow(3))
-              : at::log(0.01 + 0.08 * at::rand({n, 3}, opts));
+  const at::Tensor log_scales = needles ? at::log(0.001 + 0.3 * at::rand({n, 3}, opts).pow(3))
+                                        : at::log(0.01 + 0.08 * at::rand({n, 3}, opts));
   const auto p = gaussians::raster::projectForwardCpu(means, quats, log_scales, cam);
   Scene s;
   s.means2d = p.means2d;
@@ -143,9 +142,9 @@ TEST(RasterCpuPaths, NoPixelOutsideTheRowRangePassesTheSkipTest) {
     const float above = std::floor(lo - 0.5f) + 0.5f, below = std::ceil(hi - 0.5f) + 0.5f;
     for (const float fy : {above < lo ? above : above - 1.f, below > hi ? below : below + 1.f}) {
       const float half_width = float(std::sqrt(-2.0 * skip * sxx)) + 2.f;
-      for (float fx = std::floor(mean_x - half_width) + 0.5f; fx <= mean_x + half_width; fx += 1.f) {
-        const float power =
-            gaussians::raster::gaussianPower(conic, mean_x - fx, mean_y - fy);
+      for (float fx = std::floor(mean_x - half_width) + 0.5f; fx <= mean_x + half_width;
+           fx += 1.f) {
+        const float power = gaussians::raster::gaussianPower(conic, mean_x - fx, mean_y - fy);
         ASSERT_LT(power, skip) << "Gaussian " << i << " row " << fy << " x " << fx;
       }
       ++rows_checked;

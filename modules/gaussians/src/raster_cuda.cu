@@ -329,6 +329,12 @@ __device__ __forceinline__ void stageGaussian(int g, const float* __restrict__ m
 // cost more occupancy than the loads).
 constexpr bool forwardStagesValues(int CH) { return CH <= 36; }
 
+// Whether the kernels move a warp's two image rows (2 x 16 x D contiguous floats) between global
+// and shared memory with consecutive lanes on consecutive floats, instead of each pixel its own D
+// floats (D apart from the next lane's: up to 8 times the sectors). From 16 channels on; not for
+// RGB, where per-pixel accesses waste less and the copy's registers would cost occupancy.
+constexpr bool copiesWarpRows(int CH) { return CH >= 16; }
+
 // One block per tile, one thread per pixel; Gaussians are staged through shared memory in
 // batches of kBlock. CH is the channel capacity (>= D), fixed at compile time so the per-pixel
 // accumulators can live in registers.
@@ -411,11 +417,8 @@ __global__ void __launch_bounds__(kBlock)
       last = batch + j - start + 1;
     }
   }
-  // From 16 channels on, the channels leave through shared memory: a warp's two rows of 16
-  // pixels are 2 x 16 x D contiguous floats of the image, written by consecutive lanes
-  // (per-pixel stores, D floats apart, cost up to 8 times the L2 sectors). Not for RGB: there
-  // the per-pixel stores waste less and the copy's registers would cost occupancy.
-  constexpr bool kRowStores = kStaged && CH >= 16;
+  // The channels leave through shared memory (copiesWarpRows), reusing the staged values' space.
+  constexpr bool kRowStores = kStaged && copiesWarpRows(CH);
   if constexpr (kRowStores) {
     __syncthreads();  // every warp is past its last read of the batch's values
     const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
@@ -661,10 +664,9 @@ __global__ void __launch_bounds__(kBlock)
   const int last = inside ? last_fwd[pix] : 0;
   const float ga_out = inside && g_alpha != nullptr ? g_alpha[pix] : 0.f;
   float* my_gpix = s_gpix + (static_cast<int64_t>(warp) * 32 + lane) * S;
-  if constexpr (CH >= 16) {
-    // The warp's two rows of 16 pixels are 2 x 16 x D contiguous floats of the gradient image:
-    // consecutive lanes load consecutive floats (a pixel's own D floats, D apart from the next
-    // lane's, cost up to 8 times the L1 sectors). Channels D .. S and pixels outside stay zero.
+  if constexpr (copiesWarpRows(CH)) {
+    // The gradient image's rows come in through shared memory. Channels D .. S and pixels
+    // outside stay zero.
     for (int c = inside ? D : 0; c < S; ++c) my_gpix[c] = 0.f;
     const int x0 = tx * kTileSize;
     const int row_floats = min(kTileSize, width - x0) * D;

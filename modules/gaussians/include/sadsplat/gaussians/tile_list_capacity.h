@@ -10,8 +10,8 @@
 /// count on its way to the host. renderedAll() reads the counts later — in training after the
 /// backward pass, when the GPU has long passed them — and says whether every render had room.
 /// A render whose list was too short missed pairs: the caller renders it again (the trainer does
-/// so without a capacity). The capacity follows the counts: `margin` times the largest count of the last
-/// check, shrinking by at most 2 % per check.
+/// so without a capacity). The capacity follows the counts: `margin` times the largest count of the
+/// last check, shrinking by at most 2 % per check.
 
 #include <cstdint>
 #include <memory>
