@@ -1,10 +1,13 @@
-// The CPU rasterizer's vectorised tile loops (raster_cpu_tiles.h) against its scalar reference
+// The CPU rasterizer's vectorised tile loops (the SSE2 rows of raster_cpu_tiles.h, the AVX2 and
+// AVX-512 lanes of raster_cpu_lanes.h, each where this CPU runs it) against its scalar reference
 // loops: images, alphas, last contributors and every gradient must be bit-identical, in images
 // whose edge tiles have partial rows and with lists long enough for pixels to saturate.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <vector>
 
 #include "raster_backend.h"
 #include "raster_cpu_tiles.h"
@@ -59,6 +62,17 @@ void expectBitIdentical(const at::Tensor& a, const at::Tensor& b, const char* wh
       << (a.to(at::kDouble) - b.to(at::kDouble)).abs().max().item<double>();
 }
 
+// The vectorised loops this CPU runs (a test with none of them checks nothing and says so).
+std::vector<std::pair<CpuTileLoops, const char*>> vectorisedLoops() {
+  std::vector<std::pair<CpuTileLoops, const char*>> loops;
+  for (const auto& [l, name] : {std::pair{CpuTileLoops::kRows, "SSE2 rows"},
+                                {CpuTileLoops::kLanesAvx2, "AVX2 lanes"},
+                                {CpuTileLoops::kLanesAvx512, "AVX-512 lanes"}}) {
+    if (gaussians::raster::cpuTileLoopsAvailable(l)) loops.emplace_back(l, name);
+  }
+  return loops;
+}
+
 // coverage: the largest alpha the scene must reach (0.999: pixels near saturation, which stop at
 // a transmittance of 1e-4).
 void expectPathsAgree(int width, int height, int n, int D, double opacity, double coverage,
@@ -69,27 +83,68 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
   const Scene s = projectedScene(n, D, cam, seed, opacity, needles);
   using gaussians::raster::rasterizeBackwardCpu;
   using gaussians::raster::rasterizeForwardCpu;
-  const auto fast = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
-                                        s.depths, width, height, CpuTileLoops::kFastest);
   const auto scalar = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
                                           s.depths, width, height, CpuTileLoops::kScalar);
   ASSERT_GT(scalar.alpha.max().item<float>(), coverage) << "the scene must cover pixels";
-  expectBitIdentical(fast.image, scalar.image, "image");
-  expectBitIdentical(fast.alpha, scalar.alpha, "alpha");
-  expectBitIdentical(fast.last, scalar.last, "last");
-
   at::manual_seed(static_cast<int64_t>(seed) + 1);
   const at::Tensor g_image = at::randn({height, width, D});
   const at::Tensor g_alpha = at::randn({height, width});
-  const auto gf = rasterizeBackwardCpu(s.means2d, s.conics, s.opacities, s.values, scalar, g_image,
-                                       g_alpha, CpuTileLoops::kFastest);
   const auto gs = rasterizeBackwardCpu(s.means2d, s.conics, s.opacities, s.values, scalar, g_image,
                                        g_alpha, CpuTileLoops::kScalar);
   ASSERT_GT(gs.opacities.abs().sum().item<float>(), 0.f) << "the gradients must not all be 0";
-  expectBitIdentical(gf.means2d, gs.means2d, "means2d gradient");
-  expectBitIdentical(gf.conics, gs.conics, "conics gradient");
-  expectBitIdentical(gf.opacities, gs.opacities, "opacities gradient");
-  expectBitIdentical(gf.values, gs.values, "values gradient");
+  const auto loops = vectorisedLoops();
+  if (loops.empty()) GTEST_SKIP() << "this build or CPU has no vectorised tile loops";
+  for (const auto& [l, name] : loops) {
+    SCOPED_TRACE(name);
+    const auto fast = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
+                                          s.depths, width, height, l);
+    expectBitIdentical(fast.image, scalar.image, "image");
+    expectBitIdentical(fast.alpha, scalar.alpha, "alpha");
+    expectBitIdentical(fast.last, scalar.last, "last");
+    const auto gf = rasterizeBackwardCpu(s.means2d, s.conics, s.opacities, s.values, scalar,
+                                         g_image, g_alpha, l);
+    expectBitIdentical(gf.means2d, gs.means2d, "means2d gradient");
+    expectBitIdentical(gf.conics, gs.conics, "conics gradient");
+    expectBitIdentical(gf.opacities, gs.opacities, "opacities gradient");
+    expectBitIdentical(gf.values, gs.values, "values gradient");
+  }
+}
+
+// kFastest is one of the loops above (the widest this CPU runs), so it renders as they do.
+TEST(RasterCpuPaths, FastestIsBitIdenticalToTheScalarLoops) {
+  const CameraParams cam = frontCamera(48, 40, 0.9 * 48);
+  const Scene s = projectedScene(1500, 3, cam, 11, 0.95);
+  using gaussians::raster::rasterizeForwardCpu;
+  const auto fast = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
+                                        s.depths, 48, 40, CpuTileLoops::kFastest);
+  const auto scalar = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
+                                          s.depths, 48, 40, CpuTileLoops::kScalar);
+  expectBitIdentical(fast.image, scalar.image, "image");
+  expectBitIdentical(fast.last, scalar.last, "last");
+}
+
+// expPoly, the exp of every CPU pixel alpha: within 2 ulp of exp (in double, rounded to float)
+// over the whole clamped range and at the powers alphas come from; NaN stays NaN.
+TEST(RasterCpuPaths, ExpPolyIsWithinTwoUlpOfExp) {
+  const auto ulps = [](float a, float b) {
+    int32_t ia, ib;
+    std::memcpy(&ia, &a, sizeof ia);
+    std::memcpy(&ib, &b, sizeof ib);
+    return std::abs(static_cast<int64_t>(ia) - ib);
+  };
+  int64_t worst = 0;
+  for (int i = 0; i <= 400000; ++i) {
+    const float x = -87.f + 175.f * float(i) / 400000.f;
+    worst = std::max(worst, ulps(gaussians::raster::expPoly(x), float(std::exp(double(x)))));
+  }
+  for (int i = 0; i <= 100000; ++i) {
+    const float x = -6.f * float(i) / 100000.f;
+    worst = std::max(worst, ulps(gaussians::raster::expPoly(x), float(std::exp(double(x)))));
+  }
+  EXPECT_LE(worst, 2);
+  EXPECT_EQ(gaussians::raster::expPoly(0.f), 1.f);
+  EXPECT_TRUE(std::isnan(gaussians::raster::expPoly(std::nanf(""))));
+  EXPECT_GT(gaussians::raster::expPoly(-200.f), 0.f);  // clamped to exp(-87), not 0 or garbage
 }
 
 TEST(RasterCpuPaths, RgbRendersAndGradientsAreBitIdenticalToTheScalarLoops) {

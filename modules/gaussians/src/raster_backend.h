@@ -60,9 +60,14 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
                                    const at::Tensor& log_scales, const at::Tensor& radii,
                                    const CameraParams& cam, const at::Tensor& g_means2d,
                                    const at::Tensor& g_conics, const at::Tensor& g_depths);
-/// The CPU rasterizer's tile loops: kFastest takes the vectorised form for float where the build
-/// has one (raster_cpu_tiles.h; bit-identical results), kScalar always the scalar reference.
-enum class CpuTileLoops { kFastest, kScalar };
+/// The CPU rasterizer's tile loops, all with bit-identical results for float: kScalar the scalar
+/// reference (raster_cpu_tiles.h), kRows its SSE2 skip test over a tile row, kLanesAvx2 /
+/// kLanesAvx512 a tile row's pixels in vector lanes (raster_cpu_lanes.h). kFastest: the widest
+/// that this build and CPU run, for float (double always takes the scalar loops).
+enum class CpuTileLoops { kFastest, kScalar, kRows, kLanesAvx2, kLanesAvx512 };
+
+/// Whether `loops` runs here (kScalar and kFastest always do).
+bool cpuTileLoopsAvailable(CpuTileLoops loops);
 
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,

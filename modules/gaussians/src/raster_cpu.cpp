@@ -6,13 +6,18 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <vector>
 
 #include "raster_backend.h"
+#include "raster_cpu_lanes.h"
 #include "raster_cpu_tiles.h"
+#include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/step_profile.h"
 
@@ -190,13 +195,69 @@ std::vector<T> skipThresholds(const T* opacities, int64_t n) {
 
 using cpu_tiles::TileList;
 
-// One tile of the forward pass with the loops `loops` asks for. accum: kTileSize * D values.
+// The loops kFastest stands for: the widest that run here, or those that the environment
+// variable SADSPLAT_CPU_TILE_LOOPS names (scalar, rows, avx2, avx512: for timing one against
+// another; all give the same bits). An unknown or unavailable name is an error.
+CpuTileLoops fastestLoops() {
+  static const CpuTileLoops chosen = [] {
+    const char* env = std::getenv("SADSPLAT_CPU_TILE_LOOPS");
+    if (env != nullptr && *env != '\0') {
+      const std::string name = env;
+      const CpuTileLoops named = name == "scalar"   ? CpuTileLoops::kScalar
+                                 : name == "rows"   ? CpuTileLoops::kRows
+                                 : name == "avx2"   ? CpuTileLoops::kLanesAvx2
+                                 : name == "avx512" ? CpuTileLoops::kLanesAvx512
+                                                    : CpuTileLoops::kFastest;
+      if (named == CpuTileLoops::kFastest || !cpuTileLoopsAvailable(named)) {
+        throw Error("SADSPLAT_CPU_TILE_LOOPS", "value",
+                    "scalar, rows, avx2 or avx512, one that this CPU runs", name);
+      }
+      return named;
+    }
+    for (CpuTileLoops best :
+         {CpuTileLoops::kLanesAvx512, CpuTileLoops::kLanesAvx2, CpuTileLoops::kRows}) {
+      if (cpuTileLoopsAvailable(best)) return best;
+    }
+    return CpuTileLoops::kScalar;
+  }();
+  return chosen;
+}
+
+// `loops` resolved to the loops that run; double always takes the scalar ones.
+template <typename T>
+CpuTileLoops resolveLoops(CpuTileLoops loops) {
+  if (!std::is_same_v<T, float>) return CpuTileLoops::kScalar;
+  if (loops == CpuTileLoops::kFastest) return fastestLoops();
+  if (!cpuTileLoopsAvailable(loops)) throw std::invalid_argument("CPU tile loops not available");
+  return loops;
+}
+
+cpu_lanes::Isa laneIsa(CpuTileLoops loops) {
+  return loops == CpuTileLoops::kLanesAvx512 ? cpu_lanes::Isa::kAvx512 : cpu_lanes::Isa::kAvx2;
+}
+
+template <typename T>
+cpu_lanes::TileView tileView(const TileList<T>& list, int64_t D, int tx, int ty, int width,
+                             int height) {
+  if constexpr (std::is_same_v<T, float>) {
+    return {list.gaussians.data(), list.values.data(), list.size(), D, tx, ty, width, height};
+  } else {
+    throw std::logic_error("the lane loops are for float");
+  }
+}
+
+// One tile of the forward pass with `loops` (resolved). accum: kTileSize * D values.
 template <typename T>
 void forwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int width, int height,
                     CpuTileLoops loops, T* accum, T* img, T* alpha_out, int* last_out) {
-#if SADSPLAT_CPU_RASTER_SIMD
   if constexpr (std::is_same_v<T, float>) {
-    if (loops == CpuTileLoops::kFastest) {
+    if (loops == CpuTileLoops::kLanesAvx2 || loops == CpuTileLoops::kLanesAvx512) {
+      cpu_lanes::forwardTileLanes(laneIsa(loops), tileView(list, D, tx, ty, width, height), accum,
+                                  img, alpha_out, last_out);
+      return;
+    }
+#if SADSPLAT_CPU_RASTER_SIMD
+    if (loops == CpuTileLoops::kRows) {
       if (D == 3) {
         cpu_tiles::forwardTileRows<3>(list, D, tx, ty, width, height, accum, img, alpha_out,
                                       last_out);
@@ -206,8 +267,8 @@ void forwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int widt
       }
       return;
     }
-  }
 #endif
+  }
   if (D == 3) {
     cpu_tiles::forwardTile<3>(list, D, tx, ty, width, height, accum, img, alpha_out, last_out);
   } else {
@@ -215,25 +276,30 @@ void forwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int widt
   }
 }
 
-// One tile of the backward pass (see forwardOneTile). row_buffer: 6 + D values.
+// One tile of the backward pass (see forwardOneTile). scratch: backwardScratchFloats(D) values.
 template <typename T>
 void backwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int width, int height,
                      CpuTileLoops loops, const T* gimg, const T* galpha, const T* alpha_fwd,
-                     const int* last_fwd, T* row_buffer, T* grads) {
-#if SADSPLAT_CPU_RASTER_SIMD
+                     const int* last_fwd, T* scratch, T* grads) {
   if constexpr (std::is_same_v<T, float>) {
-    if (loops == CpuTileLoops::kFastest) {
+    if (loops == CpuTileLoops::kLanesAvx2 || loops == CpuTileLoops::kLanesAvx512) {
+      cpu_lanes::backwardTileLanes(laneIsa(loops), tileView(list, D, tx, ty, width, height), gimg,
+                                   galpha, alpha_fwd, last_fwd, scratch, grads);
+      return;
+    }
+#if SADSPLAT_CPU_RASTER_SIMD
+    if (loops == CpuTileLoops::kRows) {
       if (D == 3) {
         cpu_tiles::backwardTileRows<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
-                                       last_fwd, row_buffer, grads);
+                                       last_fwd, scratch, grads);
       } else {
         cpu_tiles::backwardTileRows<0>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd,
-                                       last_fwd, row_buffer, grads);
+                                       last_fwd, scratch, grads);
       }
       return;
     }
-  }
 #endif
+  }
   if (D == 3) {
     cpu_tiles::backwardTile<3>(list, D, tx, ty, width, height, gimg, galpha, alpha_fwd, last_fwd,
                                grads);
@@ -244,6 +310,21 @@ void backwardOneTile(const TileList<T>& list, int64_t D, int tx, int ty, int wid
 }
 
 }  // namespace
+
+bool cpuTileLoopsAvailable(CpuTileLoops loops) {
+  switch (loops) {
+    case CpuTileLoops::kFastest:
+    case CpuTileLoops::kScalar:
+      return true;
+    case CpuTileLoops::kRows:
+      return SADSPLAT_CPU_RASTER_SIMD != 0;
+    case CpuTileLoops::kLanesAvx2:
+      return cpu_lanes::lanesAvailable(cpu_lanes::Isa::kAvx2);
+    case CpuTileLoops::kLanesAvx512:
+      return cpu_lanes::lanesAvailable(cpu_lanes::Isa::kAvx512);
+  }
+  return false;
+}
 
 RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& conics,
                                  const at::Tensor& opacities, const at::Tensor& values,
@@ -257,6 +338,7 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
   out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
   AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeForwardCpu", [&] {
     using T = scalar_t;
+    const CpuTileLoops tile_loops = resolveLoops<T>(loops);
     const T* m2 = means2d.data_ptr<T>();
     const T* co = conics.data_ptr<T>();
     const T* op = opacities.data_ptr<T>();
@@ -282,7 +364,7 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
         const int tx = static_cast<int>(tile % tiles_x), ty = static_cast<int>(tile / tiles_x);
         const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
         list.gather(ids + start, stop - start, m2, co, op, skip.data(), val, D);
-        forwardOneTile(list, D, tx, ty, width, height, loops, accum.data(), img, alpha_out,
+        forwardOneTile(list, D, tx, ty, width, height, tile_loops, accum.data(), img, alpha_out,
                        last_out);
       }
     });
@@ -306,6 +388,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
   at::Tensor buffers = at::zeros({threads, n, row}, values.options());
   AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeBackwardCpu", [&] {
     using T = scalar_t;
+    const CpuTileLoops tile_loops = resolveLoops<T>(loops);
     const T* m2 = means2d.data_ptr<T>();
     const T* co = conics.data_ptr<T>();
     const T* op = opacities.data_ptr<T>();
@@ -347,7 +430,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
     }
     run_start[0] = 0;
     at::parallel_for(0, threads, 1, [&](int64_t first_run, int64_t end_run) {
-      std::vector<T> row_buffer(static_cast<std::size_t>(row));
+      std::vector<T> scratch(static_cast<std::size_t>(cpu_lanes::backwardScratchFloats(D)));
       std::vector<T> grads;
       TileList<T> list;
       for (int64_t k = first_run; k < end_run; ++k) {
@@ -359,8 +442,8 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
           list.gather(ids + start, std::min(used[tile], stop - start), m2, co, op, skip.data(), val,
                       D);
           grads.assign(static_cast<std::size_t>(list.size() * row), T(0));
-          backwardOneTile(list, D, tx, ty, width, height, loops, gimg, galpha, alpha_fwd, last_fwd,
-                          row_buffer.data(), grads.data());
+          backwardOneTile(list, D, tx, ty, width, height, tile_loops, gimg, galpha, alpha_fwd,
+                          last_fwd, scratch.data(), grads.data());
           for (int j = 0; j < list.size(); ++j) {
             T* gb = buf + static_cast<int64_t>(list.ids[j]) * row;
             const T* gt = grads.data() + j * row;
