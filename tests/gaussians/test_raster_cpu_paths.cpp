@@ -110,7 +110,7 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
   }
 }
 
-// kFastest is one of the loops above (the widest this CPU runs), so it renders as they do.
+// kFastest is one of the loops above, so it renders as they do.
 TEST(RasterCpuPaths, FastestIsBitIdenticalToTheScalarLoops) {
   const CameraParams cam = frontCamera(48, 40, 0.9 * 48);
   const Scene s = projectedScene(1500, 3, cam, 11, 0.95);

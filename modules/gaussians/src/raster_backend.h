@@ -62,8 +62,9 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
                                    const at::Tensor& g_conics, const at::Tensor& g_depths);
 /// The CPU rasterizer's tile loops, all with bit-identical results for float: kScalar the scalar
 /// reference (raster_cpu_tiles.h), kRows its SSE2 skip test over a tile row, kLanesAvx2 /
-/// kLanesAvx512 a tile row's pixels in vector lanes (raster_cpu_lanes.h). kFastest: the widest
-/// that this build and CPU run, for float (double always takes the scalar loops).
+/// kLanesAvx512 a tile row's pixels in vector lanes (raster_cpu_lanes.h). kFastest, for float: the
+/// AVX2 lanes where they run, else the rows (or what SADSPLAT_CPU_TILE_LOOPS names; double always
+/// takes the scalar loops).
 enum class CpuTileLoops { kFastest, kScalar, kRows, kLanesAvx2, kLanesAvx512 };
 
 /// Whether `loops` runs here (kScalar and kFastest always do).

@@ -195,9 +195,12 @@ std::vector<T> skipThresholds(const T* opacities, int64_t n) {
 
 using cpu_tiles::TileList;
 
-// The loops kFastest stands for: the widest that run here, or those that the environment
-// variable SADSPLAT_CPU_TILE_LOOPS names (scalar, rows, avx2, avx512: for timing one against
-// another; all give the same bits). An unknown or unavailable name is an error.
+// The loops kFastest stands for: the AVX2 lanes where the CPU has AVX2, else the SSE2 rows, or
+// those that the environment variable SADSPLAT_CPU_TILE_LOOPS names (scalar, rows, avx2, avx512:
+// for timing one against another; all give the same bits). An unknown or unavailable name is an
+// error. The AVX-512 lanes are not the default: on 2 cores of an AVX-512 machine they trained the
+// demo (320x180, feature channels) 10 % faster than the AVX2 lanes but the 160x90 RGB benchmark
+// 13 % slower (docs/measurements/cpu_speed).
 CpuTileLoops fastestLoops() {
   static const CpuTileLoops chosen = [] {
     const char* env = std::getenv("SADSPLAT_CPU_TILE_LOOPS");
@@ -214,8 +217,7 @@ CpuTileLoops fastestLoops() {
       }
       return named;
     }
-    for (CpuTileLoops best :
-         {CpuTileLoops::kLanesAvx512, CpuTileLoops::kLanesAvx2, CpuTileLoops::kRows}) {
+    for (CpuTileLoops best : {CpuTileLoops::kLanesAvx2, CpuTileLoops::kRows}) {
       if (cpuTileLoopsAvailable(best)) return best;
     }
     return CpuTileLoops::kScalar;
