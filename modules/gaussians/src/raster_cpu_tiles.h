@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <type_traits>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -88,7 +90,11 @@ struct TileList {
       for (int k = 0; k < 3; ++k) p.conic[k] = conics[3 * g + k];
       p.opacity = opacities[g];
       p.skip = skip[g];
-      rowRange(p.mean2d[1], p.conic, p.skip, &p.y_lo, &p.y_hi);
+      if constexpr (std::is_same_v<T, float>) {
+        rowRange(p.mean2d[1], p.conic, p.skip, &p.y_lo, &p.y_hi);
+      } else {  // only the float loops read the range
+        p.y_lo = p.y_hi = std::numeric_limits<T>::quiet_NaN();
+      }
       std::copy(all_values + g * D, all_values + (g + 1) * D, values.begin() + j * D);
     }
   }

@@ -335,6 +335,30 @@ constexpr bool forwardStagesValues(int CH) { return CH <= 36; }
 // RGB, where per-pixel accesses waste less and the copy's registers would cost occupancy.
 constexpr bool copiesWarpRows(int CH) { return CH >= 16; }
 
+// The walk of those copies: calls visit(i, k, pixel, c) for each float that lane `lane` moves of
+// warp `warp`'s two image rows of tile (tx, ty) — i its index in the [H, W, D] image, k its index
+// in the warp's 2 x 16 x D floats, and with kPixels its pixel (0 .. 31) and channel (k = pixel *
+// D + c; float e = lane + 32 j of a row is pixel e / D, channel e % D, tracked without a division;
+// without kPixels both are 0 and nothing is tracked). Consecutive lanes take consecutive floats.
+template <bool kPixels, typename Visit>
+__device__ __forceinline__ void forEachWarpRowFloat(int tx, int ty, int warp, int lane, int width,
+                                                    int height, int D, Visit&& visit) {
+  const int x0 = tx * kTileSize;
+  const int row_floats = min(kTileSize, width - x0) * D;
+  for (int r = 0; r < 2; ++r) {
+    const int y = ty * kTileSize + 2 * warp + r;
+    if (y >= height) break;
+    const int64_t row_start = (static_cast<int64_t>(y) * width + x0) * D;
+    int col = kPixels ? lane / D : 0, c = kPixels ? lane % D : 0;
+    for (int e = lane; e < row_floats; e += 32) {
+      visit(row_start + e, r * kTileSize * D + e, r * kTileSize + col, c);
+      if constexpr (kPixels) {
+        for (c += 32; c >= D; c -= D) ++col;
+      }
+    }
+  }
+}
+
 // One block per tile, one thread per pixel; Gaussians are staged through shared memory in
 // batches of kBlock. CH is the channel capacity (>= D), fixed at compile time so the per-pixel
 // accumulators can live in registers.
@@ -428,15 +452,8 @@ __global__ void __launch_bounds__(kBlock)
       if (c < D) s_out[lane * D + c] = acc[c];
     }
     __syncwarp();
-    const int x0 = tx * kTileSize;
-    const int row_floats = min(kTileSize, width - x0) * D;
-    for (int r = 0; r < 2; ++r) {
-      const int y = ty * kTileSize + 2 * warp + r;
-      if (y >= height) break;
-      float* dst = image + (static_cast<int64_t>(y) * width + x0) * D;
-      const float* src = s_out + r * kTileSize * D;
-      for (int e = lane; e < row_floats; e += 32) dst[e] = src[e];
-    }
+    forEachWarpRowFloat<false>(tx, ty, warp, lane, width, height, D,
+                               [&](int64_t i, int k, int, int) { image[i] = s_out[k]; });
   }
   if (!inside) return;
   const int64_t pix = static_cast<int64_t>(py) * width + px;
@@ -668,19 +685,10 @@ __global__ void __launch_bounds__(kBlock)
     // The gradient image's rows come in through shared memory. Channels D .. S and pixels
     // outside stay zero.
     for (int c = inside ? D : 0; c < S; ++c) my_gpix[c] = 0.f;
-    const int x0 = tx * kTileSize;
-    const int row_floats = min(kTileSize, width - x0) * D;
     float* warp_rows = s_gpix + static_cast<int64_t>(warp) * 32 * S;
-    for (int r = 0; r < 2; ++r) {
-      const int y = ty * kTileSize + 2 * warp + r;
-      if (y >= height) break;
-      const float* src = g_image + (static_cast<int64_t>(y) * width + x0) * D;
-      int col = lane / D, c = lane % D;  // of float e = lane + 32 k of the row
-      for (int e = lane; e < row_floats; e += 32) {
-        warp_rows[(r * kTileSize + col) * S + c] = src[e];
-        for (c += 32; c >= D; c -= D) ++col;
-      }
-    }
+    forEachWarpRowFloat<true>(
+        tx, ty, warp, lane, width, height, D,
+        [&](int64_t i, int, int pixel, int c) { warp_rows[pixel * S + c] = g_image[i]; });
     __syncwarp();
   } else {
     for (int c = 0; c < S; ++c) my_gpix[c] = c < D && inside ? g_image[pix * D + c] : 0.f;
