@@ -160,6 +160,12 @@ TEST(RasterCpuPaths, FeatureChannelsAreBitIdentical) {
   expectPathsAgree(45, 33, 1200, 35, 0.9, 0.999, 3);
 }
 
+// Channel counts around the lanes' vector widths (8 and 16 floats): whole vectors, whole vectors
+// and a tail, a tail only.
+TEST(RasterCpuPaths, ChannelCountsAroundTheVectorWidthsAreBitIdentical) {
+  for (const int D : {1, 2, 8, 16, 17, 32}) expectPathsAgree(33, 21, 700, D, 0.9, 0.99, 20 + D);
+}
+
 TEST(RasterCpuPaths, FaintGaussiansThatNeverSaturateAreBitIdentical) {
   expectPathsAgree(40, 40, 800, 3, 0.05, 0.2, 4);
 }
