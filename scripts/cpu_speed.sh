@@ -4,6 +4,9 @@
 # Net-1 (--drop none). Build first (cmake --build build).
 #   bash scripts/cpu_speed.sh [OUT_DIR=/tmp/sadsplat-cpu-speed] [THREADS=all cores]
 # BIN (env): the sadsplat binary to time (build/bin/sadsplat).
+# PASSES (env, 1): how many times to time each size; with more than one, each pass prints its own
+# rates and a last line per size gives the median of the passes' ratios (a single pass of either
+# program moves by ~10 % on a 2-core cloud machine).
 # OPENSPLAT_SRC (env): a checkout of OpenSplat's public source (github.com/pierotofy/OpenSplat).
 # The script then builds it for the CPU (-DGPU_RUNTIME=CPU against Debian's LibTorch; its
 # FetchContent dependencies replaced by Debian's libnanoflann-dev, libcxxopts-dev and
@@ -22,7 +25,8 @@ out="$(cd "$out" && pwd)"
 bin="${BIN:-build/bin/sadsplat}"
 
 # The machine, with the vector units that decide how fast LibTorch's operators run (OpenSplat's
-# CPU path) against sadsplat's SSE2 loops: ratios from machines with other units differ.
+# CPU path) and which of sadsplat's tile loops run (AVX2 lanes, else SSE2 rows): ratios from
+# machines with other units differ.
 simd=$(grep -o -w 'avx2\|fma\|avx512f\|amx_tile' /proc/cpuinfo 2>/dev/null | sort -u | tr '\n' ' ')
 echo "machine: $(nproc) cores, $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p'), SIMD beyond SSE2: ${simd:-none}"
 
@@ -75,21 +79,31 @@ for size in 160x90 320x180; do
       --colmap-binary >/dev/null
   fi
   declare -A t o
-  for n in 300 600; do
-    rm -rf "$out/run_${size}_$n"
-    t[$n]=$("$bin" train "$cache" --out "$out/run_${size}_$n" --iterations "$n" --drop none 2>&1 |
-            tr '\r' '\n' | grep -o 'trained in [0-9.]*' | grep -o '[0-9.]*$')
+  ratios=()
+  for pass in $(seq "${PASSES:-1}"); do
+    for n in 300 600; do
+      rm -rf "$out/run_${size}_$n"
+      t[$n]=$("$bin" train "$cache" --out "$out/run_${size}_$n" --iterations "$n" --drop none 2>&1 |
+              tr '\r' '\n' | grep -o 'trained in [0-9.]*' | grep -o '[0-9.]*$')
+      if [ -n "$opensplat" ]; then
+        start=$(now)
+        "$opensplat" "$out/city_${size}" --cpu -n "$n" --num-downscales 0 \
+          -o "$out/opensplat_${size}_$n.ply" > "$out/opensplat_${size}_$n.log" 2>&1
+        o[$n]=$(seconds "$start" "$(now)")
+      fi
+    done
+    awk -v a="${t[300]}" -v b="${t[600]}" -v s="$size" -v th="${OMP_NUM_THREADS:-all}" \
+      'BEGIN { printf "%s, threads %s: sadsplat 300 it %.1f s, 600 it %.1f s -> %.2f it/s steady\n", s, th, a, b, 300 / (b - a) }'
     if [ -n "$opensplat" ]; then
-      start=$(now)
-      "$opensplat" "$out/city_${size}" --cpu -n "$n" --num-downscales 0 \
-        -o "$out/opensplat_${size}_$n.ply" > "$out/opensplat_${size}_$n.log" 2>&1
-      o[$n]=$(seconds "$start" "$(now)")
+      awk -v a="${o[300]}" -v b="${o[600]}" -v s="$size" -v sa="${t[300]}" -v sb="${t[600]}" \
+        'BEGIN { printf "%s: OpenSplat 300 it %.1f s, 600 it %.1f s -> %.2f it/s steady; sadsplat / OpenSplat %.2fx\n", s, a, b, 300 / (b - a), (b - a) / (sb - sa) }'
+      ratios+=("$(awk -v a="${o[300]}" -v b="${o[600]}" -v sa="${t[300]}" -v sb="${t[600]}" \
+                  'BEGIN { printf "%.4f", (b - a) / (sb - sa) }')")
     fi
   done
-  awk -v a="${t[300]}" -v b="${t[600]}" -v s="$size" -v th="${OMP_NUM_THREADS:-all}" \
-    'BEGIN { printf "%s, threads %s: sadsplat 300 it %.1f s, 600 it %.1f s -> %.2f it/s steady\n", s, th, a, b, 300 / (b - a) }'
-  if [ -n "$opensplat" ]; then
-    awk -v a="${o[300]}" -v b="${o[600]}" -v s="$size" -v sa="${t[300]}" -v sb="${t[600]}" \
-      'BEGIN { printf "%s: OpenSplat 300 it %.1f s, 600 it %.1f s -> %.2f it/s steady; sadsplat / OpenSplat %.2fx\n", s, a, b, 300 / (b - a), (b - a) / (sb - sa) }'
+  if [ ${#ratios[@]} -gt 1 ]; then
+    printf '%s\n' "${ratios[@]}" | sort -g | awk -v s="$size" \
+      '{ r[NR] = $1 } END { m = NR % 2 ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2;
+         printf "%s: median sadsplat / OpenSplat over %d passes %.2fx (%.2f .. %.2f)\n", s, NR, m, r[1], r[NR] }'
   fi
 done
