@@ -273,10 +273,7 @@ void backwardRows(const TileView& t, const float* gimg, const float* galpha, con
       st.last_dot[l] = 0.f;
       end = st.last[l] > end ? st.last[l] : end;
     }
-    for (int64_t ch = 0; ch < D; ++ch) {
-      for (int l = 0; l < kRow; ++l)
-        g_by_channel[ch * kRow + l] = l < lanes ? gimg[(pix0 + l) * D + ch] : 0.f;
-    }
+    bool by_channel = false;  // g_by_channel holds this row (filled for its first dense chunk)
     for (int j = end - 1; j >= 0; --j) {
       const PackedGaussian<float>& p = pg[j];
       if (fy < p.y_lo || fy > p.y_hi) continue;  // every pixel of the row skips it
@@ -349,6 +346,13 @@ void backwardRows(const TileView& t, const float* gimg, const float* galpha, con
         storeVf(st.trans + base, m ? trans_j : tr);
         const Vf w = a.alpha * trans_j;
         Vf dot = Vf{};
+        if (!by_channel) {
+          for (int64_t ch = 0; ch < D; ++ch) {
+            for (int l = 0; l < kRow; ++l)
+              g_by_channel[ch * kRow + l] = l < lanes ? gimg[(pix0 + l) * D + ch] : 0.f;
+          }
+          by_channel = true;
+        }
         for (int64_t ch = 0; ch < D; ++ch) dot += v[ch] * loadVf(g_by_channel + ch * kRow + base);
         const Vf la = loadVf(st.last_alpha + base), ld = loadVf(st.last_dot + base);
         const Vf bh = loadVf(st.behind + base);
