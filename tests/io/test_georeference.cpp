@@ -63,7 +63,9 @@ TEST(Georeference, SimilarityFitRecoversScaleRotationAndTranslationDespiteOutlie
     to.push_back(y);
   }
   std::vector<bool> inliers;
-  const io::Similarity fit = io::fitSimilarity(from, to, 3.0, &inliers);
+  bool consensus = false;
+  const io::Similarity fit = io::fitSimilarity(from, to, 3.0, &inliers, &consensus);
+  EXPECT_TRUE(consensus);
   EXPECT_NEAR(fit.scale, truth.scale, 0.02 * truth.scale);
   for (int k = 0; k < 9; ++k) EXPECT_NEAR(fit.rotation[k], truth.rotation[k], 0.02) << k;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(fit.translation[k], truth.translation[k], 1.0) << k;
@@ -76,6 +78,34 @@ TEST(Georeference, SimilarityFitRecoversScaleRotationAndTranslationDespiteOutlie
   EXPECT_THROW(io::fitSimilarity({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}},
                                  {{0, 0, 0}, {2, 0, 0}, {4, 0, 0}, {6, 0, 0}}, 3.0),
                Error);
+}
+
+// A reconstruction that does not match the flight (seen on a real 6-photo survey: two strips
+// joined wrongly, camera centres 20-110 m from their GPS): no 3 pairs agree within the distance.
+// The fit of all pairs comes back flagged, and only pairs really within the distance under it
+// count as inliers (they were all reported as inliers before).
+TEST(Georeference, WithoutConsensusTheFitOfAllIsFlaggedAndInliersAreHonest) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, 40);  // metres: a reconstruction that is wrong
+  std::vector<std::array<double, 3>> from, to;
+  for (int i = 0; i < 6; ++i) {
+    const std::array<double, 3> x{10.0 * (i % 3), 20.0 * (i / 3), 0.0};
+    from.push_back(x);
+    to.push_back({x[0] + noise(rng), x[1] + noise(rng), x[2] + noise(rng)});
+  }
+  std::vector<bool> inliers;
+  bool consensus = true;
+  const io::Similarity fit = io::fitSimilarity(from, to, 1.0, &inliers, &consensus);
+  EXPECT_FALSE(consensus);
+  int within = 0;
+  for (int i = 0; i < 6; ++i) {
+    const auto y = fit.apply(from[i]);
+    const double d = std::hypot(y[0] - to[i][0], y[1] - to[i][1], y[2] - to[i][2]);
+    EXPECT_EQ(static_cast<bool>(inliers[i]), d <= 1.0) << i << ": " << d << " m";
+    within += d <= 1.0;
+  }
+  EXPECT_LT(within, 3);
+  for (double v : fit.rotation) EXPECT_TRUE(std::isfinite(v));
 }
 
 TEST(Georeference, ExifGpsWrittenBySadsplatIsReadBackByLibexif) {
@@ -108,12 +138,14 @@ TEST(Georeference, JsonAndSceneCacheRoundTrips) {
   g.sfm_to_local.translation = {1, 2, 3};
   g.photos_with_gps = 18;
   g.inliers = 17;
+  g.consensus = false;
   g.rms_metres = 0.8;
   const io::Georeference back = io::georeferenceFromJson(io::georeferenceToJson(g), "<test>");
   EXPECT_DOUBLE_EQ(back.origin.latitude, g.origin.latitude);
   EXPECT_EQ(back.epsg_utm, 32615);
   EXPECT_DOUBLE_EQ(back.sfm_to_local.scale, 12.5);
   EXPECT_EQ(back.inliers, 17);
+  EXPECT_FALSE(back.consensus);
   // Bad files name the field.
   try {
     io::georeferenceFromJson("{\"origin\": {\"latitude\": 95, \"longitude\": 0, \"altitude\": 0}}",

@@ -3,6 +3,7 @@
 // the recovered cameras and points are compared with the synthetic ones in metres. No data from
 // outside; skipped where `colmap` is not installed (scripts/setup_debian.sh installs it).
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <Eigen/Dense>
 #include <opencv2/imgcodecs.hpp>
@@ -89,6 +90,15 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
       io::readWholeFile(o.out + "/georeference.json"), o.out + "/georeference.json");
   EXPECT_EQ(g.epsg_utm, 32632);  // Zurich: UTM zone 32 N
   EXPECT_EQ(g.inliers, n);
+  EXPECT_TRUE(g.consensus);
+  // The report lists every photo's distance to its GPS under the fit.
+  const auto report = nlohmann::json::parse(io::readWholeFile(o.out + "/sfm_report.json"));
+  ASSERT_EQ(static_cast<int>(report.at("gps_residuals").size()), n);
+  for (const auto& r : report.at("gps_residuals")) {
+    EXPECT_TRUE(r.at("inlier").get<bool>()) << r.dump();
+    EXPECT_LT(r.at("metres").get<double>(), o.gps_inlier_metres) << r.dump();
+    EXPECT_TRUE(true_centres.count(r.at("photo").get<std::string>())) << r.dump();
+  }
   const io::ColmapModel model = io::readColmapModel(o.out + "/sparse/0");
   ASSERT_EQ(static_cast<int>(model.images.size()), n);
   // The orbit's size sets the scale of the bounds.

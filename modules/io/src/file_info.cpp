@@ -29,8 +29,9 @@ void describeGeoreference(std::ostream& out, const Georeference& g) {
   geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude << ", "
       << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
       << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; "
-      << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit, RMS "
-      << g.rms_metres << " m\n";
+      << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit"
+      << (g.consensus ? "" : " (no consensus: the fit of all; positions can be off by the RMS)")
+      << ", RMS " << g.rms_metres << " m\n";
   out << geo.str();
 }
 

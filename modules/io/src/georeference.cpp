@@ -267,7 +267,7 @@ std::array<double, 3> Similarity::apply(const std::array<double, 3>& x) const {
 
 Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
                          const std::vector<std::array<double, 3>>& to, double inlier_metres,
-                         std::vector<bool>* inliers) {
+                         std::vector<bool>* inliers, bool* consensus) {
   const int n = static_cast<int>(from.size());
   if (n < 3 || to.size() != from.size()) {
     throw Error("<georeference>", "position pairs", "at least 3 (camera centre, GPS) pairs",
@@ -292,37 +292,37 @@ Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
     if (static_cast<int>(best.size()) == n) break;
   }
   Similarity s;
-  if (best.size() < 3 || !umeyama(from, to, best, &s)) {
-    // No consensus within the distance (GPS noisier than assumed): the least-squares fit of all.
-    if (!umeyama(from, to, all, &s)) {
-      throw Error("<georeference>", "camera centres",
-                  "positions not all on one line (a flight with some extent across)",
-                  "degenerate positions");
-    }
-    best = all;
+  const bool agreed = best.size() >= 3 && umeyama(from, to, best, &s);
+  if (!agreed && !umeyama(from, to, all, &s)) {
+    // No consensus within the distance (GPS noisier than assumed, or a reconstruction that does
+    // not match the flight): the least-squares fit of all, reported as such.
+    throw Error("<georeference>", "camera centres",
+                "positions not all on one line (a flight with some extent across)",
+                "degenerate positions");
   }
   if (inliers != nullptr) {
     inliers->assign(n, false);
-    for (int i : best) (*inliers)[i] = true;
+    for (int i = 0; i < n; ++i) (*inliers)[i] = distance(s, from[i], to[i]) <= inlier_metres;
   }
+  if (consensus != nullptr) *consensus = agreed;
   return s;
 }
 
 std::string georeferenceToJson(const Georeference& g) {
-  const nlohmann::json j = {
-      {"frame", "east-north-up metres around origin (WGS84)"},
-      {"origin",
-       {{"latitude", g.origin.latitude},
-        {"longitude", g.origin.longitude},
-        {"altitude", g.origin.altitude}}},
-      {"epsg_utm", g.epsg_utm},
-      {"sfm_to_local",
-       {{"scale", g.sfm_to_local.scale},
-        {"rotation", g.sfm_to_local.rotation},
-        {"translation", g.sfm_to_local.translation}}},
-      {"photos_with_gps", g.photos_with_gps},
-      {"inliers", g.inliers},
-      {"rms_metres", g.rms_metres}};
+  const nlohmann::json j = {{"frame", "east-north-up metres around origin (WGS84)"},
+                            {"origin",
+                             {{"latitude", g.origin.latitude},
+                              {"longitude", g.origin.longitude},
+                              {"altitude", g.origin.altitude}}},
+                            {"epsg_utm", g.epsg_utm},
+                            {"sfm_to_local",
+                             {{"scale", g.sfm_to_local.scale},
+                              {"rotation", g.sfm_to_local.rotation},
+                              {"translation", g.sfm_to_local.translation}}},
+                            {"photos_with_gps", g.photos_with_gps},
+                            {"inliers", g.inliers},
+                            {"consensus", g.consensus},
+                            {"rms_metres", g.rms_metres}};
   return j.dump(2) + "\n";
 }
 
@@ -358,6 +358,7 @@ Georeference georeferenceFromJson(const std::string& text, const std::string& or
     g.photos_with_gps = static_cast<int>(j.value("photos_with_gps", 0));
     g.inliers = static_cast<int>(j.value("inliers", 0));
     g.rms_metres = j.value("rms_metres", 0.0);
+    g.consensus = j.value("consensus", true);  // older files carry no such field
   } catch (const nlohmann::json::exception& e) {
     throw Error(origin, "JSON", "a georeference.json as sadsplat writes it", e.what());
   }

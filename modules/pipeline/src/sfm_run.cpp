@@ -310,9 +310,11 @@ SfmSummary sfmRun(const SfmOptions& o) {
   // The georeference: camera centres against the photos' GPS in east-north-up metres.
   std::vector<std::array<double, 3>> centres, targets;
   std::vector<const io::GeoPosition*> used;
+  std::vector<std::string> gps_names;
   for (const auto& im : model.images) {
     const auto it = gps.find(im.name);
     if (it == gps.end()) continue;
+    gps_names.push_back(im.name);
     const Eigen::Vector3d c =
         -rotationOf(im.qvec).transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
     centres.push_back({c.x(), c.y(), c.z()});
@@ -330,18 +332,53 @@ SfmSummary sfmRun(const SfmOptions& o) {
     std::vector<bool> inliers;
     try {
       io::Georeference geo;
-      geo.sfm_to_local = io::fitSimilarity(centres, targets, o.gps_inlier_metres, &inliers);
+      geo.sfm_to_local =
+          io::fitSimilarity(centres, targets, o.gps_inlier_metres, &inliers, &geo.consensus);
       geo.origin = origin;
       geo.epsg_utm = io::utmEpsg(origin);
       geo.photos_with_gps = static_cast<int>(used.size());
+      // Residuals per photo; the RMS is over the photos the fit used (the agreeing ones, or all).
       double sq = 0;
+      int fitted = 0;
+      nlohmann::json residuals = nlohmann::json::array();
+      std::vector<std::pair<double, std::string>> off;  // photos outside the inlier distance
       for (std::size_t i = 0; i < centres.size(); ++i) {
-        if (!inliers[i]) continue;
-        ++geo.inliers;
         const auto x = geo.sfm_to_local.apply(centres[i]);
-        for (int k = 0; k < 3; ++k) sq += (x[k] - targets[i][k]) * (x[k] - targets[i][k]);
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) d2 += (x[k] - targets[i][k]) * (x[k] - targets[i][k]);
+        residuals.push_back({{"photo", gps_names[i]},
+                             {"metres", std::sqrt(d2)},
+                             {"inlier", static_cast<bool>(inliers[i])}});
+        if (inliers[i]) {
+          ++geo.inliers;
+        } else {
+          off.emplace_back(std::sqrt(d2), gps_names[i]);
+        }
+        if (inliers[i] || !geo.consensus) sq += d2, ++fitted;
       }
-      geo.rms_metres = std::sqrt(sq / std::max(1, geo.inliers));
+      geo.rms_metres = std::sqrt(sq / std::max(1, fitted));
+      report["gps_residuals"] = residuals;
+      std::sort(off.rbegin(), off.rend());
+      std::ostringstream warn;
+      warn.precision(3);
+      if (!geo.consensus) {
+        warn << "warning: no 3 photos' GPS agree with the reconstruction within "
+             << o.gps_inlier_metres << " m; georeferenced by the least-squares fit of all "
+             << used.size() << " (RMS " << geo.rms_metres << " m), so positions in the outputs "
+             << "can be off by that much. The reconstruction or the GPS is wrong: check the "
+                "photos' overlap (sfm_report.json lists each photo's distance to its GPS), or "
+                "raise --gps-inlier if the GPS is this noisy.\n";
+      }
+      if (!off.empty()) {
+        warn << "warning: " << off.size() << " of " << used.size()
+             << " photos' camera centres lie more than " << o.gps_inlier_metres
+             << " m from their GPS:";
+        for (std::size_t k = 0; k < std::min<std::size_t>(off.size(), 5); ++k) {
+          warn << " " << off[k].second << " (" << off[k].first << " m)";
+        }
+        warn << (off.size() > 5 ? " ...\n" : "\n");
+      }
+      say(warn.str());
       transformModel(model, geo.sfm_to_local);
       io::writeFileAtomically(o.out + "/georeference.json",
                               [&](std::ostream& out) { out << io::georeferenceToJson(geo); });
@@ -378,7 +415,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
     const auto g = io::georeferenceFromJson(io::readWholeFile(o.out + "/georeference.json"),
                                             o.out + "/georeference.json");
     done << "; georeferenced (" << g.inliers << " of " << g.photos_with_gps
-         << " GPS positions within " << o.gps_inlier_metres << " m, RMS " << g.rms_metres
+         << " GPS positions within " << o.gps_inlier_metres << " m"
+         << (g.consensus ? "" : ", no consensus: fit of all") << ", RMS " << g.rms_metres
          << " m, UTM EPSG:" << g.epsg_utm << ")";
   }
   done << "; " << summary.seconds << " s\n";
