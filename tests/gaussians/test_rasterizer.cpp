@@ -587,6 +587,65 @@ TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
   EXPECT_TRUE(alphaMayReach(m, round, 1.f, 0.5f, 9.5f, 15.5f, 10.5f));        // on the mean
 }
 
+TEST(Rasterizer, AlphaEllipseMeetsEveryTileAGaussianReachesAndSkipsMostOfANeedlesBox) {
+  // The binning's exact tile test: in float, as the kernels run it, every 16 x 16 tile inside the
+  // alphaBox with a pixel centre where pixelAlpha is non-zero must pass alphaEllipseMeetsTile; and
+  // the test must drop tiles of the box that nothing reaches (a needle across the screen's axes
+  // leaves most of its box empty).
+  using gaussians::raster::alphaEllipseMeetsTile;
+  std::mt19937 rng(29);
+  int reached = 0, skipped = 0, boxed = 0;
+  for (int k = 0; k < 120; ++k) {
+    gaussians::raster::Projected<double> p;
+    if (!randomBinningGaussian(rng, k, &p)) continue;
+    const float m[2] = {float(p.mean2d[0]) * 3.f, float(p.mean2d[1]) * 3.f};  // across more tiles
+    const float conic[3] = {float(p.conic[0]) / 9.f, float(p.conic[1]) / 9.f,
+                            float(p.conic[2]) / 9.f};  // the same Gaussian 3x larger on screen
+    for (float opacity : {1.f / 300, 1.f / 255, 0.0045f, 0.05f, 0.5f, 1.f}) {
+      int rx = 0, ry = 0;
+      gaussians::raster::alphaBox(3 * p.radius, opacity, conic, &rx, &ry);
+      gaussians::raster::AlphaEllipse<float> e;
+      const bool any_reach = gaussians::raster::alphaEllipse(m, conic, opacity, &e);
+      if (rx <= 0) continue;
+      ASSERT_TRUE(any_reach);
+      int x0, y0, x1, y1;
+      gaussians::raster::tileRect(m, rx, ry, 1000, 1000, &x0, &y0, &x1, &y1);
+      for (int ty = y0; ty < y1; ++ty) {
+        for (int tx = x0; tx < x1; ++tx) {
+          ++boxed;
+          bool any = false;
+          for (int y = 16 * ty; y < 16 * ty + 16 && !any; ++y) {
+            for (int x = 16 * tx; x < 16 * tx + 16 && !any; ++x) {
+              float G = 0.f;
+              bool clamped = false;
+              any = gaussians::raster::pixelAlpha(m, conic, opacity, x + 0.5f, y + 0.5f, &G,
+                                                  &clamped) != 0.f;
+            }
+          }
+          const bool meets = alphaEllipseMeetsTile(e, tx, ty);
+          if (any) {
+            ++reached;
+            EXPECT_TRUE(meets) << "Gaussian " << k << " opacity " << opacity << " tile " << tx
+                               << ", " << ty;
+          }
+          skipped += !meets;
+        }
+      }
+    }
+  }
+  EXPECT_GT(reached, 1000);
+  EXPECT_GT(skipped, boxed / 10) << skipped << " of " << boxed;
+  // A degenerate conic has no bound; a Gaussian too faint for any pixel has no ellipse.
+  gaussians::raster::AlphaEllipse<float> e;
+  const float m[2] = {8.f, 8.f}, flat[3] = {1.f, 1.f, 1.f}, round[3] = {0.1f, 0.f, 0.1f};
+  ASSERT_TRUE(gaussians::raster::alphaEllipse(m, flat, 1.f, &e));
+  EXPECT_TRUE(alphaEllipseMeetsTile(e, 40, 40));
+  EXPECT_FALSE(gaussians::raster::alphaEllipse(m, round, 1.f / 300, &e));
+  ASSERT_TRUE(gaussians::raster::alphaEllipse(m, round, 1.f, &e));
+  EXPECT_TRUE(alphaEllipseMeetsTile(e, 0, 0));   // holds the mean
+  EXPECT_FALSE(alphaEllipseMeetsTile(e, 3, 3));  // ~60 px away, radius ~10 px
+}
+
 // Without features and depth (what training renders for a view with no semantic loss) the colour,
 // alpha and every colour gradient are those of the full render; features get no gradient.
 TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {

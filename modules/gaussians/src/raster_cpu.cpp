@@ -148,10 +148,16 @@ Binning binGaussians(const T* means2d, const T* conics, const int* radii, const 
     int rx, ry;
     alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
     if (rx <= 0) continue;
+    AlphaEllipse<T> ellipse;
+    if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) continue;
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {
-      for (int tx = x0; tx < x1; ++tx) lists[ty * tiles_x + tx].push_back(static_cast<int>(i));
+      for (int tx = x0; tx < x1; ++tx) {
+        if (alphaEllipseMeetsTile(ellipse, tx, ty)) {
+          lists[ty * tiles_x + tx].push_back(static_cast<int>(i));
+        }
+      }
     }
   }
   Binning b;

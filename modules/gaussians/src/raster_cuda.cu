@@ -159,10 +159,13 @@ __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
   int64_t count = 0;
   int rx, ry;
   alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
-  if (rx > 0) {
+  AlphaEllipse<float> ellipse;
+  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) {
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
-    count = static_cast<int64_t>(max(0, x1 - x0)) * max(0, y1 - y0);
+    for (int ty = y0; ty < y1; ++ty) {
+      for (int tx = x0; tx < x1; ++tx) count += alphaEllipseMeetsTile(ellipse, tx, ty);
+    }
   }
   counts[i] = count;
 }
@@ -176,20 +179,30 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
                                 int64_t capacity, int64_t* keys, int* values) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
+  int64_t out = i == 0 ? 0 : offsets[i - 1];
+  const int64_t end = min(offsets[i], capacity);  // a list sized before the count may end early
   int rx, ry;
   alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
-  if (rx <= 0) return;
-  int64_t out = i == 0 ? 0 : offsets[i - 1];
-  int x0, y0, x1, y1;
-  tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
-  const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
-  for (int ty = y0; ty < y1; ++ty) {
-    for (int tx = x0; tx < x1; ++tx) {
-      if (out >= capacity) return;  // a list sized before the count: the rest does not fit
-      keys[out] = (static_cast<int64_t>(ty * tiles_x + tx) << 32) | depth_bits;
-      values[out] = static_cast<int>(i);
-      ++out;
+  AlphaEllipse<float> ellipse;
+  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) {
+    int x0, y0, x1, y1;
+    tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
+    for (int ty = y0; ty < y1 && out < end; ++ty) {
+      for (int tx = x0; tx < x1 && out < end; ++tx) {
+        if (!alphaEllipseMeetsTile(ellipse, tx, ty)) continue;
+        keys[out] = (static_cast<int64_t>(ty * tiles_x + tx) << 32) | depth_bits;
+        values[out] = static_cast<int>(i);
+        ++out;
+      }
     }
+  }
+  // The count kernel made the same tests, so nothing is left; should a test ever come out
+  // otherwise here (the compiler may contract its float operations differently in the two
+  // kernels), the rest gets tile num_tiles' key: sorted last, in no tile's range.
+  for (; out < end; ++out) {
+    keys[out] = static_cast<int64_t>(tiles_x * tiles_y) << 32;
+    values[out] = 0;
   }
 }
 
@@ -291,8 +304,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
         tiles_y, m, keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     const ScopedPhase sort_phase("sort");
-    std::tie(keys, values) =
-        sortByTileAndDepth(keys, values, sized_before ? num_tiles + 1 : num_tiles, stream);
+    std::tie(keys, values) = sortByTileAndDepth(keys, values, num_tiles + 1, stream);
     tileRangesKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(
         m, keys.data_ptr<int64_t>(), num_tiles, b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");

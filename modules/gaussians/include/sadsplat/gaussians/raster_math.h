@@ -485,6 +485,69 @@ SADSPLAT_HD void alphaBox(int radius, T opacity, const T conic[3], int* rx, int*
   if (sy < T(extent)) *ry = static_cast<int>(mceil(sy));
 }
 
+/// The ellipse where a Gaussian can reach kMinAlpha, d^T C d <= k2 (d = pixel centre - mean, C
+/// its conic, k2 = 2 ln(255 opacity) with alphaEllipseHalfWidths' 1 % margin on the opacity), for
+/// testing tiles against it exactly (alphaEllipseMeetsTile) instead of against its box.
+template <typename T>
+struct AlphaEllipse {
+  T mean[2];
+  T a, b, c;     ///< the conic: d^T C d = a dx^2 + 2 b dx dy + c dy^2
+  T det;         ///< a c - b^2
+  T k2;          ///< the bound on d^T C d
+  bool bounded;  ///< false when the conic is not positive definite: every tile may be reached
+};
+
+/// Fills *e; false when no pixel can reach kMinAlpha (the opacity is too low).
+template <typename T>
+SADSPLAT_HD bool alphaEllipse(const T mean2d[2], const T conic[3], T opacity, AlphaEllipse<T>* e) {
+  const T q = opacity * T(1.01 / kMinAlpha);
+  if (!(q > T(1))) return false;
+  e->mean[0] = mean2d[0];
+  e->mean[1] = mean2d[1];
+  e->a = conic[0];
+  e->b = conic[1];
+  e->c = conic[2];
+  e->det = conic[0] * conic[2] - conic[1] * conic[1];
+  e->k2 = T(2) * mlog(q);
+  e->bounded = e->det > T(0) && conic[0] > T(0) && conic[2] > T(0);
+  return true;
+}
+
+/// Whether the alpha ellipse meets the rectangle of pixel centres [x0, x1] x [y0, y1]: the least
+/// d^T C d over the rectangle is <= k2. With the mean outside the rectangle the least value lies
+/// on an edge; on the edge x = x_e it is c (dy - dy*)^2 + det / c dx^2 with dy* = -b dx / c
+/// clamped to the edge (likewise for y edges) — two non-negative terms, so no cancellation.
+/// Conservative like alphaBox: false only where pixelAlpha returns 0 at every centre of the
+/// rectangle (the 1 % opacity margin is 0.02 in d^T C d, far above the float rounding of either).
+template <typename T>
+SADSPLAT_HD bool alphaEllipseMeetsRect(const AlphaEllipse<T>& e, T x0, T y0, T x1, T y1) {
+  if (!e.bounded) return true;
+  const T dx0 = x0 - e.mean[0], dx1 = x1 - e.mean[0];
+  const T dy0 = y0 - e.mean[1], dy1 = y1 - e.mean[1];
+  if (dx0 <= T(0) && dx1 >= T(0) && dy0 <= T(0) && dy1 >= T(0)) return true;
+  T least = std::numeric_limits<T>::infinity();
+  const T dxs[2] = {dx0, dx1}, dys[2] = {dy0, dy1};
+  for (int k = 0; k < 2; ++k) {
+    const T dx = dxs[k];  // edge x = x_k
+    const T centre = -e.b * dx / e.c;
+    const T off = mmin(mmax(centre, dy0), dy1) - centre;
+    least = mmin(least, e.c * off * off + e.det / e.c * dx * dx);
+    const T dy = dys[k];  // edge y = y_k
+    const T centre_x = -e.b * dy / e.a;
+    const T off_x = mmin(mmax(centre_x, dx0), dx1) - centre_x;
+    least = mmin(least, e.a * off_x * off_x + e.det / e.a * dy * dy);
+  }
+  return least <= e.k2;
+}
+
+/// Whether the alpha ellipse meets tile (tx, ty) (its pixel centres; columns and rows past the
+/// image's edge included, which only makes the test looser).
+template <typename T>
+SADSPLAT_HD bool alphaEllipseMeetsTile(const AlphaEllipse<T>& e, int tx, int ty) {
+  const T x0 = T(tx * kTileSize) + T(0.5), y0 = T(ty * kTileSize) + T(0.5);
+  return alphaEllipseMeetsRect(e, x0, y0, x0 + T(kTileSize - 1), y0 + T(kTileSize - 1));
+}
+
 /// Whether a Gaussian can reach kMinAlpha at any pixel centre of the rectangle [x0, x1] x [y0, y1]
 /// (centre coordinates): its alphaEllipseHalfWidths box meets the rectangle. Conservative: false
 /// only where pixelAlpha would return 0 at every centre of the rectangle.
