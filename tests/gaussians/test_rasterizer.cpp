@@ -541,19 +541,24 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
   EXPECT_GT(narrower, boxes / 5) << narrower << " of " << boxes;
 }
 
-TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
-  // The CUDA backward skips a Gaussian for a warp's 16 x 2 pixels when alphaMayReach says no: in
-  // float, as the kernel runs it, no pixel centre of a skipped rectangle may have a non-zero
-  // pixelAlpha; and the test must skip rectangles (it is not "always yes").
-  using gaussians::raster::alphaMayReach;
+TEST(Rasterizer, AlphaEllipseMeetsEveryWarpRectangleAGaussianReaches) {
+  // The CUDA kernels skip a Gaussian for a warp's 16 x 2 pixels when alphaEllipseMeetsRect says
+  // no (the binning's warp masks): in float, as the kernels run it, no pixel centre of a skipped
+  // rectangle may have a non-zero pixelAlpha; and the test must skip rectangles (it is not
+  // "always yes"), more of them than the ellipse's box would.
+  using gaussians::raster::alphaEllipseMeetsRect;
   std::mt19937 rng(23);
-  int reached = 0, skipped = 0;
+  int reached = 0, skipped = 0, boxed_in = 0;
   for (int k = 0; k < 80; ++k) {
     gaussians::raster::Projected<double> p;
     if (!randomBinningGaussian(rng, k, &p)) continue;
     const float m[2] = {float(p.mean2d[0]), float(p.mean2d[1])};
     const float conic[3] = {float(p.conic[0]), float(p.conic[1]), float(p.conic[2])};
     for (float opacity : {1.f / 300, 1.f / 255, 0.0045f, 0.05f, 0.5f, 1.f}) {
+      gaussians::raster::AlphaEllipse<float> e;
+      const bool can_reach = gaussians::raster::alphaEllipse(m, conic, opacity, &e);
+      float sx = 0.f, sy = 0.f;
+      gaussians::raster::alphaEllipseHalfWidths(opacity, conic, &sx, &sy);
       // Rectangles of 16 x 2 pixel centres on a grid around the mean, out to 1.5 radii.
       const int reach = p.radius * 3 / 2 + 16;
       for (int y0 = int(m[1]) - reach; y0 <= int(m[1]) + reach; y0 += 2) {
@@ -567,24 +572,25 @@ TEST(Rasterizer, AlphaMayReachHoldsEveryWarpRectangleAGaussianReaches) {
                                                   &clamped) != 0.f;
             }
           }
-          const bool may =
-              alphaMayReach(m, conic, opacity, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f, y0 + 1.5f);
+          const bool meets =
+              can_reach && alphaEllipseMeetsRect(e, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f, y0 + 1.5f);
           if (any) {
             ++reached;
-            EXPECT_TRUE(may) << "Gaussian " << k << " opacity " << opacity << " at " << x0 << ", "
-                             << y0;
+            EXPECT_TRUE(meets) << "Gaussian " << k << " opacity " << opacity << " at " << x0 << ", "
+                               << y0;
           }
-          skipped += !may;
+          skipped += !meets;
+          // In the ellipse's box (what the kernels tested before) but not met.
+          const float dx = std::max({x0 + 0.5f - m[0], m[0] - (x0 + 15.5f), 0.f});
+          const float dy = std::max({y0 + 0.5f - m[1], m[1] - (y0 + 1.5f), 0.f});
+          boxed_in += can_reach && !meets && dx <= sx && dy <= sy;
         }
       }
     }
   }
   EXPECT_GT(reached, 2000);
   EXPECT_GT(skipped, 2000);
-  const float m[2] = {10.f, 10.f}, round[3] = {0.1f, 0.f, 0.1f};
-  EXPECT_FALSE(alphaMayReach(m, round, 1.f / 300, 0.5f, 0.5f, 15.5f, 1.5f));  // too faint
-  EXPECT_FALSE(alphaMayReach(m, round, 1.f, 100.5f, 0.5f, 115.5f, 1.5f));     // too far
-  EXPECT_TRUE(alphaMayReach(m, round, 1.f, 0.5f, 9.5f, 15.5f, 10.5f));        // on the mean
+  EXPECT_GT(boxed_in, 500) << "the exact test skips no more than the box";
 }
 
 TEST(Rasterizer, AlphaEllipseMeetsEveryTileAGaussianReachesAndSkipsMostOfANeedlesBox) {

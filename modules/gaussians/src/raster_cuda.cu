@@ -252,6 +252,45 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
   return {sorted_keys, sorted_values};
 }
 
+// The warps of tile (tx, ty) whose pixel centres a Gaussian's alpha ellipse meets: bit w when it
+// meets warp w's two rows (alphaEllipseMeetsRect: exact, and conservative like the binning's tile
+// test). A warp skips a Gaussian without its bit before any pixel work: each of its pixels would
+// get alpha 0.
+__device__ __forceinline__ unsigned warpsReached(const float mean[2], const float conic[3],
+                                                 float opacity, int tx, int ty) {
+  unsigned warps = 0;
+  AlphaEllipse<float> e;
+  if (alphaEllipse(mean, conic, opacity, &e)) {
+    const float x0 = tx * kTileSize + 0.5f, x1 = x0 + float(kTileSize - 1);
+#pragma unroll
+    for (int w = 0; w < kBlock / 32; ++w) {
+      const float y0 = ty * kTileSize + 2 * w + 0.5f;
+      if (alphaEllipseMeetsRect(e, x0, y0, x1, y0 + 1.f)) warps |= 1u << w;
+    }
+  }
+  return warps;
+}
+
+// The warps each list entry reaches (warpsReached), computed once per render after the sort
+// rather than in the kernels' staging, where its temporaries would raise their register peak.
+__global__ void warpMasksKernel(int64_t m, const int64_t* __restrict__ keys,
+                                const int* __restrict__ ids, const float* __restrict__ means2d,
+                                const float* __restrict__ conics,
+                                const float* __restrict__ opacities, int tiles_x, int num_tiles,
+                                unsigned char* masks) {
+  const int64_t k = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (k >= m) return;
+  const int tile = static_cast<int>(keys[k] >> 32);
+  unsigned warps = 0;
+  if (tile < num_tiles) {
+    const int g = ids[k];
+    const float mean[2] = {means2d[2 * g], means2d[2 * g + 1]};
+    const float conic[3] = {conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]};
+    warps = warpsReached(mean, conic, opacities[g], tile % tiles_x, tile / tiles_x);
+  }
+  masks[k] = static_cast<unsigned char>(warps);
+}
+
 // The (Gaussian, tile) list of one render: count each Gaussian's tiles, write the keys at the
 // counts' running sum, sort, and mark each tile's range. The list's length is the total count,
 // read from the GPU (the host waits for the queue); with a capacity that knows earlier counts,
@@ -270,6 +309,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
   b.tile_ranges = at::zeros({num_tiles, 2}, opts.dtype(at::kInt));
   if (n == 0) {
     b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
+    b.warp_masks = at::empty({0}, opts.dtype(at::kByte));
     return b;
   }
   at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
@@ -309,19 +349,35 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
         m, keys.data_ptr<int64_t>(), num_tiles, b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");
   }
+  b.warp_masks = at::empty({m}, opts.dtype(at::kByte));
+  if (m > 0) {
+    warpMasksKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(
+        m, keys.data_ptr<int64_t>(), values.data_ptr<int>(), means2d.data_ptr<float>(),
+        conics.data_ptr<float>(), opacities.data_ptr<float>(), tiles_x, num_tiles,
+        b.warp_masks.data_ptr<unsigned char>());
+    checkLaunch("warpMasksKernel");
+  }
   b.gaussian_ids = values;
   return b;
 }
 
 // ---- rasterization ---------------------------------------------------------------------------
 
-// Copies Gaussian g's 2D data into this thread's slot of the block's shared batch.
-__device__ __forceinline__ void stageGaussian(int g, const float* __restrict__ means2d,
+const unsigned char* warpMasks(const Binning& b) {
+  return b.warp_masks.data_ptr<unsigned char>();
+}
+
+// Copies list entry k (Gaussian ids[k]) into this thread's slot of the block's shared batch: its
+// 2D data and the warps it reaches.
+__device__ __forceinline__ void stageGaussian(int k, const int* __restrict__ ids,
+                                              const unsigned char* __restrict__ warp_masks,
+                                              const float* __restrict__ means2d,
                                               const float* __restrict__ conics,
                                               const float* __restrict__ opacities, int* s_id,
                                               float (*s_mean)[2], float (*s_conic)[3],
-                                              float* s_opacity) {
+                                              float* s_opacity, unsigned char* s_warps) {
   const int slot = threadIdx.x;
+  const int g = ids[k];
   s_id[slot] = g;
   s_mean[slot][0] = means2d[2 * g];
   s_mean[slot][1] = means2d[2 * g + 1];
@@ -329,6 +385,7 @@ __device__ __forceinline__ void stageGaussian(int g, const float* __restrict__ m
   s_conic[slot][1] = conics[3 * g + 1];
   s_conic[slot][2] = conics[3 * g + 2];
   s_opacity[slot] = opacities[g];
+  s_warps[slot] = warp_masks[k];
 }
 
 // ---- forward
@@ -378,6 +435,7 @@ template <int CH>
 __global__ void __launch_bounds__(kBlock)
     rasterizeForwardKernel(int width, int height, int tiles_x, int D,
                            const int* __restrict__ ranges, const int* __restrict__ ids,
+                           const unsigned char* __restrict__ warp_masks,
                            const float* __restrict__ means2d, const float* __restrict__ conics,
                            const float* __restrict__ opacities, const float* __restrict__ values,
                            float* image, float* alpha_out, int* last_out) {
@@ -393,6 +451,8 @@ __global__ void __launch_bounds__(kBlock)
   __shared__ float s_mean[kBlock][2];
   __shared__ float s_conic[kBlock][3];
   __shared__ float s_opacity[kBlock];
+  __shared__ unsigned char s_warps[kBlock];
+  const int warp_bit = 1 << (threadIdx.x / 32);
   constexpr bool kStaged = forwardStagesValues(CH);
   static_assert(!kStaged || CH % 4 == 0, "staged values are read as whole float4s");
   __shared__ __align__(16) float s_values[kStaged ? kBlock : 1][kStaged ? CH : 4];
@@ -407,9 +467,10 @@ __global__ void __launch_bounds__(kBlock)
     if (__syncthreads_count(done) == kBlock) break;
     const int k = batch + threadIdx.x;
     if (k < stop) {
-      const int g = ids[k];
-      stageGaussian(g, means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
+      stageGaussian(k, ids, warp_masks, means2d, conics, opacities, s_id, s_mean, s_conic,
+                    s_opacity, s_warps);
       if constexpr (kStaged) {
+        const int g = s_id[threadIdx.x];
         const float* src = values + static_cast<int64_t>(g) * D;
 #pragma unroll
         for (int q = 0; q < CH / 4; ++q) {
@@ -423,6 +484,7 @@ __global__ void __launch_bounds__(kBlock)
     __syncthreads();
     const int count = min(kBlock, stop - batch);
     for (int j = 0; j < count && !done; ++j) {
+      if (!(s_warps[j] & warp_bit)) continue;  // warp-uniform: no pixel of the warp is reached
       float G;
       bool clamped;
       const float alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
@@ -485,8 +547,8 @@ __global__ void __launch_bounds__(kBlock)
 // shared memory in batches of kBlock and every thread visits them in the same order, back to
 // front. A warp holds two rows of its tile (32 pixels) and takes a batch in groups of 32
 // Gaussians:
-//  1. lane l tests whether Gaussian l of the group can reach the warp's 16 x 2 pixels at all
-//     (alphaMayReach) and lies before the last contributor of one of its pixels; the ballot is
+//  1. lane l tests whether Gaussian l of the group reaches the warp's 16 x 2 pixels at all (its
+//     bit of warp_masks) and lies before the last contributor of one of its pixels; the ballot is
 //     the group's mask, and a Gaussian outside it costs the warp nothing more;
 //  then steps 2-4 for each half of 16 Gaussians with a bit in the mask:
 //  2. the dot products of the half's values with the pixel gradients, values [16 x D] x pixel
@@ -508,26 +570,11 @@ constexpr unsigned kFullMask = 0xffffffffu;
 // Tiles of 8 channels that hold CH channels (the N or K extent of the channel products).
 constexpr int channelTiles(int CH) { return (CH + 7) / 8; }
 
-// Pixel-centre rectangle of warp `warp`'s pixels in tile (tx, ty): 16 columns, 2 rows.
-struct WarpRect {
-  float x0, y0, x1, y1;
-};
-
-__device__ __forceinline__ WarpRect warpRect(int tx, int ty, int warp) {
-  const float x0 = tx * kTileSize + 0.5f, y0 = ty * kTileSize + 2 * warp + 0.5f;
-  return {x0, y0, x0 + float(kTileSize - 1), y0 + 1.f};
-}
-
-// Step 1: bit l set when Gaussian j0 + l of the batch (l < in_group) may reach the rectangle and
-// `wanted` holds for lane l.
+// Step 1: bit l set when Gaussian j0 + l of the batch (l < in_group) reaches warp `warp`'s
+// pixels (its staged bit) and `wanted` holds for lane l.
 __device__ __forceinline__ unsigned groupMask(int j0, int in_group, int lane, bool wanted,
-                                              const float (*s_mean)[2], const float (*s_conic)[3],
-                                              const float* s_opacity, const WarpRect& r) {
-  bool reach = false;
-  if (lane < in_group && wanted) {
-    const int j = j0 + lane;
-    reach = alphaMayReach(s_mean[j], s_conic[j], s_opacity[j], r.x0, r.y0, r.x1, r.y1);
-  }
+                                              const unsigned char* s_warps, int warp) {
+  const bool reach = lane < in_group && wanted && ((s_warps[j0 + lane] >> warp) & 1u);
   return __ballot_sync(kFullMask, reach);
 }
 
@@ -660,6 +707,7 @@ template <int CH>
 __global__ void __launch_bounds__(kBlock)
     rasterizeBackwardKernel(int width, int height, int tiles_x, int D,
                             const int* __restrict__ ranges, const int* __restrict__ ids,
+                           const unsigned char* __restrict__ warp_masks,
                             const float* __restrict__ means2d, const float* __restrict__ conics,
                             const float* __restrict__ opacities, const float* __restrict__ values,
                             const float* __restrict__ alpha_fwd, const int* __restrict__ last_fwd,
@@ -676,12 +724,12 @@ __global__ void __launch_bounds__(kBlock)
   const int start = ranges[2 * tile], stop = ranges[2 * tile + 1];
   const int lane = threadIdx.x % 32, warp = threadIdx.x / 32;
   const int group = lane / 4, quad = lane % 4;
-  const WarpRect rect = warpRect(tx, ty, warp);
 
   __shared__ int s_id[kBlock];
   __shared__ float s_mean[kBlock][2];
   __shared__ float s_conic[kBlock][3];
   __shared__ float s_opacity[kBlock];
+  __shared__ unsigned char s_warps[kBlock];
   // [warp][Gaussian in half group][pixel]: the half's dot products, overwritten by its weights
   __shared__ __align__(16) float s_rows[kWarps][16][kBackwardRowStride];
   extern __shared__ float s_gpix[];  // [warp][pixel][S], channels >= D zero
@@ -728,15 +776,16 @@ __global__ void __launch_bounds__(kBlock)
     __syncthreads();
     const int k = batch_end - 1 - threadIdx.x;
     if (k >= start) {
-      stageGaussian(ids[k], means2d, conics, opacities, s_id, s_mean, s_conic, s_opacity);
+      stageGaussian(k, ids, warp_masks, means2d, conics, opacities, s_id, s_mean, s_conic,
+                    s_opacity, s_warps);
     }
     __syncthreads();
     const int count = min(kBlock, batch_end - start);
     const int first_position = batch_end - 1 - start;  // list position of batch entry 0
     for (int j0 = 0; j0 < count; j0 += 32) {
       const int in_group = min(32, count - j0);
-      const unsigned mask = groupMask(j0, in_group, lane, first_position - j0 - lane < warp_last,
-                                      s_mean, s_conic, s_opacity, rect);
+      const unsigned mask =
+          groupMask(j0, in_group, lane, first_position - j0 - lane < warp_last, s_warps, warp);
       // Half by half (16 Gaussians, one row tile of the products): the products' rows then take
       // half the shared memory, which lets three blocks share an SM at 36 channels instead of two.
 #pragma unroll
@@ -938,7 +987,8 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
 #define SADSPLAT_LAUNCH_FORWARD(CH)                                                         \
   rasterizeForwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                             \
       width, height, tiles_x, static_cast<int>(D), out.binning.tile_ranges.data_ptr<int>(), \
-      out.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),                  \
+      out.binning.gaussian_ids.data_ptr<int>(), warpMasks(out.binning),                      \
+      means2d.data_ptr<float>(),                                                            \
       conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),      \
       out.image.data_ptr<float>(), out.alpha.data_ptr<float>(), out.last.data_ptr<int>())
   SADSPLAT_FOR_CHANNEL_CAPACITY(D, SADSPLAT_LAUNCH_FORWARD)
@@ -972,7 +1022,8 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   launchBackward(rasterizeBackwardKernel<CH>, num_tiles,                                           \
                  sizeof(float) * kBlock * gradientRowStride(CH), stream, width, height, tiles_x,   \
                  static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),                     \
-                 fwd.binning.gaussian_ids.data_ptr<int>(), means2d.data_ptr<float>(),              \
+                 fwd.binning.gaussian_ids.data_ptr<int>(), warpMasks(fwd.binning),                 \
+                 means2d.data_ptr<float>(),                                                        \
                  conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),  \
                  fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(), \
                  g_alpha_ptr, g.means2d.data_ptr<float>(), g.conics.data_ptr<float>(),             \

@@ -490,11 +490,12 @@ SADSPLAT_HD void alphaBox(int radius, T opacity, const T conic[3], int* rx, int*
 /// testing tiles against it exactly (alphaEllipseMeetsTile) instead of against its box.
 template <typename T>
 struct AlphaEllipse {
-  T mean[2];
-  T a, b, c;     ///< the conic: d^T C d = a dx^2 + 2 b dx dy + c dy^2
-  T det;         ///< a c - b^2
-  T k2;          ///< the bound on d^T C d
-  bool bounded;  ///< false when the conic is not positive definite: every tile may be reached
+  T mean[2] = {T(0), T(0)};
+  T a = T(0), b = T(0), c = T(0);  ///< the conic: d^T C d = a dx^2 + 2 b dx dy + c dy^2
+  T det = T(0);                    ///< a c - b^2
+  T k2 = T(0);                     ///< the bound on d^T C d
+  bool bounded =
+      false;  ///< false when the conic is not positive definite: every tile may be reached
 };
 
 /// Fills *e; false when no pixel can reach kMinAlpha (the opacity is too low).
@@ -546,19 +547,6 @@ template <typename T>
 SADSPLAT_HD bool alphaEllipseMeetsTile(const AlphaEllipse<T>& e, int tx, int ty) {
   const T x0 = T(tx * kTileSize) + T(0.5), y0 = T(ty * kTileSize) + T(0.5);
   return alphaEllipseMeetsRect(e, x0, y0, x0 + T(kTileSize - 1), y0 + T(kTileSize - 1));
-}
-
-/// Whether a Gaussian can reach kMinAlpha at any pixel centre of the rectangle [x0, x1] x [y0, y1]
-/// (centre coordinates): its alphaEllipseHalfWidths box meets the rectangle. Conservative: false
-/// only where pixelAlpha would return 0 at every centre of the rectangle.
-template <typename T>
-SADSPLAT_HD bool alphaMayReach(const T mean2d[2], const T conic[3], T opacity, T x0, T y0, T x1,
-                               T y1) {
-  T sx, sy;
-  if (!alphaEllipseHalfWidths(opacity, conic, &sx, &sy)) return false;
-  const T dx = mmax(mmax(x0 - mean2d[0], mean2d[0] - x1), T(0));
-  const T dy = mmax(mmax(y0 - mean2d[1], mean2d[1] - y1), T(0));
-  return dx <= sx && dy <= sy;
 }
 
 /// Alpha of a Gaussian at a pixel centre (px, py), or 0 when it is skipped (power > 0 or alpha
