@@ -548,7 +548,7 @@ TEST(Rasterizer, AlphaEllipseMeetsEveryWarpRectangleAGaussianReaches) {
   // "always yes"), more of them than the ellipse's box would.
   using gaussians::raster::alphaEllipseMeetsRect;
   std::mt19937 rng(23);
-  int reached = 0, skipped = 0, boxed_in = 0;
+  int reached = 0, skipped = 0, skipped_rows = 0, boxed_in = 0;
   for (int k = 0; k < 80; ++k) {
     gaussians::raster::Projected<double> p;
     if (!randomBinningGaussian(rng, k, &p)) continue;
@@ -574,12 +574,21 @@ TEST(Rasterizer, AlphaEllipseMeetsEveryWarpRectangleAGaussianReaches) {
           }
           const bool meets =
               can_reach && alphaEllipseMeetsRect(e, x0 + 0.5f, y0 + 0.5f, x0 + 15.5f, y0 + 1.5f);
+          // What the CUDA warp masks test: the rows the ellipse reaches within the columns.
+          float rows0 = 0.f, rows1 = 0.f;
+          const bool band = can_reach && gaussians::raster::alphaEllipseRows(
+                                             e, x0 + 0.5f, x0 + 15.5f, &rows0, &rows1);
+          const bool in_rows = band && y0 + 1.5f >= rows0 && y0 + 0.5f <= rows1;
           if (any) {
             ++reached;
             EXPECT_TRUE(meets) << "Gaussian " << k << " opacity " << opacity << " at " << x0 << ", "
                                << y0;
+            EXPECT_TRUE(in_rows) << "Gaussian " << k << " opacity " << opacity << " at " << x0
+                                 << ", " << y0 << ": rows " << rows0 << " .. " << rows1;
           }
           skipped += !meets;
+          skipped_rows += !in_rows;
+          EXPECT_TRUE(in_rows || !meets) << "the row range is the exact band's";
           // In the ellipse's box (what the kernels tested before) but not met.
           const float dx = std::max({x0 + 0.5f - m[0], m[0] - (x0 + 15.5f), 0.f});
           const float dy = std::max({y0 + 0.5f - m[1], m[1] - (y0 + 1.5f), 0.f});
@@ -591,6 +600,7 @@ TEST(Rasterizer, AlphaEllipseMeetsEveryWarpRectangleAGaussianReaches) {
   EXPECT_GT(reached, 2000);
   EXPECT_GT(skipped, 2000);
   EXPECT_GT(boxed_in, 500) << "the exact test skips no more than the box";
+  EXPECT_GT(skipped_rows, skipped * 9 / 10);
 }
 
 TEST(Rasterizer, AlphaEllipseMeetsEveryTileAGaussianReachesAndSkipsMostOfANeedlesBox) {

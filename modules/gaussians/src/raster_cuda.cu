@@ -258,16 +258,19 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
 // get alpha 0.
 __device__ __forceinline__ unsigned warpsReached(const float mean[2], const float conic[3],
                                                  float opacity, int tx, int ty) {
-  unsigned warps = 0;
   AlphaEllipse<float> e;
-  if (alphaEllipse(mean, conic, opacity, &e)) {
-    const float x0 = tx * kTileSize + 0.5f, x1 = x0 + float(kTileSize - 1);
-#pragma unroll
-    for (int w = 0; w < kBlock / 32; ++w) {
-      const float y0 = ty * kTileSize + 2 * w + 0.5f;
-      if (alphaEllipseMeetsRect(e, x0, y0, x1, y0 + 1.f)) warps |= 1u << w;
-    }
-  }
+  if (!alphaEllipse(mean, conic, opacity, &e)) return 0;
+  const float x0 = tx * kTileSize + 0.5f;
+  float y0, y1;
+  if (!alphaEllipseRows(e, x0, x0 + float(kTileSize - 1), &y0, &y1)) return 0;
+  // Warp w holds the pixel centres ty * 16 + 2 w + 0.5 and + 1.5: the warps from the one whose
+  // second row reaches y0 to the one whose first row is within y1.
+  const float first_row = ty * kTileSize + 0.5f;
+  const float lo = fminf(fmaxf((y0 - first_row - 1.f) * 0.5f, -1.f), 8.f);
+  const float hi = fminf(fmaxf((y1 - first_row) * 0.5f, -1.f), 8.f);
+  const int w0 = static_cast<int>(ceilf(lo)), w1 = static_cast<int>(floorf(hi));
+  unsigned warps = 0;
+  for (int w = max(w0, 0); w <= min(w1, kBlock / 32 - 1); ++w) warps |= 1u << w;
   return warps;
 }
 

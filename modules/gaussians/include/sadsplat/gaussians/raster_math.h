@@ -541,6 +541,32 @@ SADSPLAT_HD bool alphaEllipseMeetsRect(const AlphaEllipse<T>& e, T x0, T y0, T x
   return least <= e.k2;
 }
 
+/// The rows the alpha ellipse reaches within the columns [x0, x1] (pixel-centre coordinates): the
+/// least and greatest y of the ellipse's part inside that band, as *y0, *y1, widened by 0.01
+/// pixel; false when the band misses the ellipse. The ellipse's top point is (-b sy / a, sy)
+/// from its mean (sy = sqrt(k2 a / det)): clamped into the band it is where the band's part is
+/// highest, and there the top is (-b dx + sqrt(c k2 - det dx^2)) / c; likewise the bottom.
+/// Conservative like alphaEllipseMeetsRect (the 1 % opacity margin in k2 widens the range by far
+/// more than the rounding); an unbounded ellipse reaches every row.
+template <typename T>
+SADSPLAT_HD bool alphaEllipseRows(const AlphaEllipse<T>& e, T x0, T x1, T* y0, T* y1) {
+  if (!e.bounded) {
+    *y0 = -std::numeric_limits<T>::infinity();
+    *y1 = std::numeric_limits<T>::infinity();
+    return true;
+  }
+  const T sx = msqrt(e.k2 * e.c / e.det), sy = msqrt(e.k2 * e.a / e.det);
+  const T dx0 = x0 - e.mean[0], dx1 = x1 - e.mean[0];
+  if (dx1 < -sx || dx0 > sx) return false;
+  const T top_x = mmin(mmax(-e.b * sy / e.a, dx0), dx1);
+  const T bottom_x = mmin(mmax(e.b * sy / e.a, dx0), dx1);
+  const T top_r = msqrt(mmax(e.c * e.k2 - e.det * top_x * top_x, T(0)));
+  const T bottom_r = msqrt(mmax(e.c * e.k2 - e.det * bottom_x * bottom_x, T(0)));
+  *y1 = e.mean[1] + (-e.b * top_x + top_r) / e.c + T(0.01);
+  *y0 = e.mean[1] + (-e.b * bottom_x - bottom_r) / e.c - T(0.01);
+  return true;
+}
+
 /// Whether the alpha ellipse meets tile (tx, ty) (its pixel centres; columns and rows past the
 /// image's edge included, which only makes the test looser).
 template <typename T>
