@@ -37,9 +37,9 @@ struct ProjectionResult {
 struct Binning {
   at::Tensor tile_ranges;   ///< [tiles_y * tiles_x, 2] int32
   at::Tensor gaussian_ids;  ///< [M] int32
-  /// CUDA: [M] uint8, bit w when the entry's Gaussian reaches warp w's two rows of its tile
-  /// (the kernels skip it for the other warps); not used on the CPU
-  at::Tensor warp_masks;
+  /// CUDA: gaussian_ids holds the id in its low 24 bits and in the 8 above the warps (two rows
+  /// of the tile each) that the Gaussian reaches (fewer than 2^24 Gaussians); never on the CPU
+  bool warps_packed = false;
 };
 
 struct RasterResult {

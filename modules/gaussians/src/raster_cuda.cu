@@ -150,6 +150,29 @@ at::Tensor shRowsUpToDegree3(const at::Tensor& sh) {
 
 // ---- binning ---------------------------------------------------------------------------------
 
+// Bits of the warps of a tile row ty (warp w: pixel centres ty * 16 + 2 w + 0.5 and + 1.5) whose
+// rows meet [y0, y1]: from the warp whose second row reaches y0 to the one whose first row is
+// within y1. A list entry carries them (packWarps) so that a warp skips a Gaussian without its
+// bit before any pixel work: each of its pixels would get alpha 0.
+__device__ __forceinline__ unsigned warpsOfRows(float y0, float y1, int ty) {
+  const float first_row = ty * kTileSize + 0.5f;
+  const float lo = fminf(fmaxf((y0 - first_row - 1.f) * 0.5f, -1.f), 8.f);
+  const float hi = fminf(fmaxf((y1 - first_row) * 0.5f, -1.f), 8.f);
+  const int w0 = max(static_cast<int>(ceilf(lo)), 0);
+  const int w1 = min(static_cast<int>(floorf(hi)), kBlock / 32 - 1);
+  return w1 < w0 ? 0u : ((2u << w1) - 1u) & ~((1u << w0) - 1u);
+}
+
+// A list entry's value: the Gaussian's id, and where ids fit in 24 bits the warps its ellipse
+// reaches in the 8 bits above (the sort carries them for free); with more Gaussians every warp
+// takes every entry.
+constexpr int kIdBits = 24;
+constexpr int64_t kMaxPackedGaussians = int64_t{1} << kIdBits;
+__device__ __forceinline__ int packWarps(int64_t id, unsigned warps, bool packed) {
+  return packed ? static_cast<int>(static_cast<unsigned>(id) | (warps << kIdBits))
+                : static_cast<int>(id);
+}
+
 __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
                                  const float* __restrict__ conics, const int* __restrict__ radii,
                                  const float* __restrict__ opacities, int tiles_x, int tiles_y,
@@ -176,7 +199,8 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
                                 const float* __restrict__ opacities,
                                 const float* __restrict__ depths,
                                 const int64_t* __restrict__ offsets, int tiles_x, int tiles_y,
-                                int64_t capacity, int64_t* keys, int* values) {
+                                int64_t capacity, bool pack_warps, int64_t* keys,
+                                int* values) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   int64_t out = i == 0 ? 0 : offsets[i - 1];
@@ -188,11 +212,17 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
-    for (int ty = y0; ty < y1 && out < end; ++ty) {
-      for (int tx = x0; tx < x1 && out < end; ++tx) {
+    for (int tx = x0; tx < x1 && out < end; ++tx) {
+      // The rows the ellipse reaches within this tile column, for the entries' warp bits.
+      const float column = tx * kTileSize + 0.5f;
+      float rows0 = 0.f, rows1 = 0.f;
+      if (!alphaEllipseRows(ellipse, column, column + float(kTileSize - 1), &rows0, &rows1)) {
+        rows0 = rows1 = -1e30f;  // no row; the tile test below then fails as well
+      }
+      for (int ty = y0; ty < y1 && out < end; ++ty) {
         if (!alphaEllipseMeetsTile(ellipse, tx, ty)) continue;
         keys[out] = (static_cast<int64_t>(ty * tiles_x + tx) << 32) | depth_bits;
-        values[out] = static_cast<int>(i);
+        values[out] = packWarps(i, warpsOfRows(rows0, rows1, ty), pack_warps);
         ++out;
       }
     }
@@ -252,48 +282,6 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
   return {sorted_keys, sorted_values};
 }
 
-// The warps of tile (tx, ty) whose pixel centres a Gaussian's alpha ellipse meets: bit w when it
-// meets warp w's two rows (alphaEllipseMeetsRect: exact, and conservative like the binning's tile
-// test). A warp skips a Gaussian without its bit before any pixel work: each of its pixels would
-// get alpha 0.
-__device__ __forceinline__ unsigned warpsReached(const float mean[2], const float conic[3],
-                                                 float opacity, int tx, int ty) {
-  AlphaEllipse<float> e;
-  if (!alphaEllipse(mean, conic, opacity, &e)) return 0;
-  const float x0 = tx * kTileSize + 0.5f;
-  float y0, y1;
-  if (!alphaEllipseRows(e, x0, x0 + float(kTileSize - 1), &y0, &y1)) return 0;
-  // Warp w holds the pixel centres ty * 16 + 2 w + 0.5 and + 1.5: the warps from the one whose
-  // second row reaches y0 to the one whose first row is within y1.
-  const float first_row = ty * kTileSize + 0.5f;
-  const float lo = fminf(fmaxf((y0 - first_row - 1.f) * 0.5f, -1.f), 8.f);
-  const float hi = fminf(fmaxf((y1 - first_row) * 0.5f, -1.f), 8.f);
-  const int w0 = static_cast<int>(ceilf(lo)), w1 = static_cast<int>(floorf(hi));
-  unsigned warps = 0;
-  for (int w = max(w0, 0); w <= min(w1, kBlock / 32 - 1); ++w) warps |= 1u << w;
-  return warps;
-}
-
-// The warps each list entry reaches (warpsReached), computed once per render after the sort
-// rather than in the kernels' staging, where its temporaries would raise their register peak.
-__global__ void warpMasksKernel(int64_t m, const int64_t* __restrict__ keys,
-                                const int* __restrict__ ids, const float* __restrict__ means2d,
-                                const float* __restrict__ conics,
-                                const float* __restrict__ opacities, int tiles_x, int num_tiles,
-                                unsigned char* masks) {
-  const int64_t k = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (k >= m) return;
-  const int tile = static_cast<int>(keys[k] >> 32);
-  unsigned warps = 0;
-  if (tile < num_tiles) {
-    const int g = ids[k];
-    const float mean[2] = {means2d[2 * g], means2d[2 * g + 1]};
-    const float conic[3] = {conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]};
-    warps = warpsReached(mean, conic, opacities[g], tile % tiles_x, tile / tiles_x);
-  }
-  masks[k] = static_cast<unsigned char>(warps);
-}
-
 // The (Gaussian, tile) list of one render: count each Gaussian's tiles, write the keys at the
 // counts' running sum, sort, and mark each tile's range. The list's length is the total count,
 // read from the GPU (the host waits for the queue); with a capacity that knows earlier counts,
@@ -309,10 +297,10 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
   const int num_tiles = tiles_x * tiles_y;
   const auto opts = means2d.options();
   Binning b;
+  b.warps_packed = n <= kMaxPackedGaussians;
   b.tile_ranges = at::zeros({num_tiles, 2}, opts.dtype(at::kInt));
   if (n == 0) {
     b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
-    b.warp_masks = at::empty({0}, opts.dtype(at::kByte));
     return b;
   }
   at::Tensor counts = at::empty({n}, opts.dtype(at::kLong));
@@ -344,7 +332,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
     writeKeysKernel<<<blocksFor(n), kThreads1d, 0, stream>>>(
         n, means2d.data_ptr<float>(), conics.data_ptr<float>(), radii.data_ptr<int>(),
         opacities.data_ptr<float>(), depths.data_ptr<float>(), offsets.data_ptr<int64_t>(), tiles_x,
-        tiles_y, m, keys.data_ptr<int64_t>(), values.data_ptr<int>());
+        tiles_y, m, b.warps_packed, keys.data_ptr<int64_t>(), values.data_ptr<int>());
     checkLaunch("writeKeysKernel");
     const ScopedPhase sort_phase("sort");
     std::tie(keys, values) = sortByTileAndDepth(keys, values, num_tiles + 1, stream);
@@ -352,35 +340,26 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
         m, keys.data_ptr<int64_t>(), num_tiles, b.tile_ranges.data_ptr<int>());
     checkLaunch("tileRangesKernel");
   }
-  b.warp_masks = at::empty({m}, opts.dtype(at::kByte));
-  if (m > 0) {
-    warpMasksKernel<<<blocksFor(m), kThreads1d, 0, stream>>>(
-        m, keys.data_ptr<int64_t>(), values.data_ptr<int>(), means2d.data_ptr<float>(),
-        conics.data_ptr<float>(), opacities.data_ptr<float>(), tiles_x, num_tiles,
-        b.warp_masks.data_ptr<unsigned char>());
-    checkLaunch("warpMasksKernel");
-  }
   b.gaussian_ids = values;
   return b;
 }
 
 // ---- rasterization ---------------------------------------------------------------------------
 
-const unsigned char* warpMasks(const Binning& b) {
-  return b.warp_masks.data_ptr<unsigned char>();
-}
 
-// Copies list entry k (Gaussian ids[k]) into this thread's slot of the block's shared batch: its
-// 2D data and the warps it reaches.
+
+// Copies list entry k into this thread's slot of the block's shared batch: its Gaussian's 2D
+// data and the warps it reaches (packWarps).
 __device__ __forceinline__ void stageGaussian(int k, const int* __restrict__ ids,
-                                              const unsigned char* __restrict__ warp_masks,
+                                              bool warps_packed,
                                               const float* __restrict__ means2d,
                                               const float* __restrict__ conics,
                                               const float* __restrict__ opacities, int* s_id,
                                               float (*s_mean)[2], float (*s_conic)[3],
                                               float* s_opacity, unsigned char* s_warps) {
   const int slot = threadIdx.x;
-  const int g = ids[k];
+  const unsigned v = static_cast<unsigned>(ids[k]);
+  const int g = warps_packed ? static_cast<int>(v & ((1u << kIdBits) - 1u)) : static_cast<int>(v);
   s_id[slot] = g;
   s_mean[slot][0] = means2d[2 * g];
   s_mean[slot][1] = means2d[2 * g + 1];
@@ -388,7 +367,7 @@ __device__ __forceinline__ void stageGaussian(int k, const int* __restrict__ ids
   s_conic[slot][1] = conics[3 * g + 1];
   s_conic[slot][2] = conics[3 * g + 2];
   s_opacity[slot] = opacities[g];
-  s_warps[slot] = warp_masks[k];
+  s_warps[slot] = static_cast<unsigned char>(warps_packed ? v >> kIdBits : 0xffu);
 }
 
 // ---- forward
@@ -438,7 +417,7 @@ template <int CH>
 __global__ void __launch_bounds__(kBlock)
     rasterizeForwardKernel(int width, int height, int tiles_x, int D,
                            const int* __restrict__ ranges, const int* __restrict__ ids,
-                           const unsigned char* __restrict__ warp_masks,
+                           bool warps_packed,
                            const float* __restrict__ means2d, const float* __restrict__ conics,
                            const float* __restrict__ opacities, const float* __restrict__ values,
                            float* image, float* alpha_out, int* last_out) {
@@ -470,7 +449,7 @@ __global__ void __launch_bounds__(kBlock)
     if (__syncthreads_count(done) == kBlock) break;
     const int k = batch + threadIdx.x;
     if (k < stop) {
-      stageGaussian(k, ids, warp_masks, means2d, conics, opacities, s_id, s_mean, s_conic,
+      stageGaussian(k, ids, warps_packed, means2d, conics, opacities, s_id, s_mean, s_conic,
                     s_opacity, s_warps);
       if constexpr (kStaged) {
         const int g = s_id[threadIdx.x];
@@ -551,7 +530,7 @@ __global__ void __launch_bounds__(kBlock)
 // front. A warp holds two rows of its tile (32 pixels) and takes a batch in groups of 32
 // Gaussians:
 //  1. lane l tests whether Gaussian l of the group reaches the warp's 16 x 2 pixels at all (its
-//     bit of warp_masks) and lies before the last contributor of one of its pixels; the ballot is
+//     entry's warp bit, packWarps) and lies before the last contributor of one of its pixels; the ballot is
 //     the group's mask, and a Gaussian outside it costs the warp nothing more;
 //  then steps 2-4 for each half of 16 Gaussians with a bit in the mask:
 //  2. the dot products of the half's values with the pixel gradients, values [16 x D] x pixel
@@ -710,7 +689,7 @@ template <int CH>
 __global__ void __launch_bounds__(kBlock)
     rasterizeBackwardKernel(int width, int height, int tiles_x, int D,
                             const int* __restrict__ ranges, const int* __restrict__ ids,
-                           const unsigned char* __restrict__ warp_masks,
+                           bool warps_packed,
                             const float* __restrict__ means2d, const float* __restrict__ conics,
                             const float* __restrict__ opacities, const float* __restrict__ values,
                             const float* __restrict__ alpha_fwd, const int* __restrict__ last_fwd,
@@ -779,7 +758,7 @@ __global__ void __launch_bounds__(kBlock)
     __syncthreads();
     const int k = batch_end - 1 - threadIdx.x;
     if (k >= start) {
-      stageGaussian(k, ids, warp_masks, means2d, conics, opacities, s_id, s_mean, s_conic,
+      stageGaussian(k, ids, warps_packed, means2d, conics, opacities, s_id, s_mean, s_conic,
                     s_opacity, s_warps);
     }
     __syncthreads();
@@ -990,7 +969,7 @@ RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& c
 #define SADSPLAT_LAUNCH_FORWARD(CH)                                                         \
   rasterizeForwardKernel<CH><<<num_tiles, kBlock, 0, stream>>>(                             \
       width, height, tiles_x, static_cast<int>(D), out.binning.tile_ranges.data_ptr<int>(), \
-      out.binning.gaussian_ids.data_ptr<int>(), warpMasks(out.binning),                      \
+      out.binning.gaussian_ids.data_ptr<int>(), out.binning.warps_packed,                      \
       means2d.data_ptr<float>(),                                                            \
       conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),      \
       out.image.data_ptr<float>(), out.alpha.data_ptr<float>(), out.last.data_ptr<int>())
@@ -1025,7 +1004,7 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   launchBackward(rasterizeBackwardKernel<CH>, num_tiles,                                           \
                  sizeof(float) * kBlock * gradientRowStride(CH), stream, width, height, tiles_x,   \
                  static_cast<int>(D), fwd.binning.tile_ranges.data_ptr<int>(),                     \
-                 fwd.binning.gaussian_ids.data_ptr<int>(), warpMasks(fwd.binning),                 \
+                 fwd.binning.gaussian_ids.data_ptr<int>(), fwd.binning.warps_packed,                 \
                  means2d.data_ptr<float>(),                                                        \
                  conics.data_ptr<float>(), opacities.data_ptr<float>(), values.data_ptr<float>(),  \
                  fwd.alpha.data_ptr<float>(), fwd.last.data_ptr<int>(), g_image.data_ptr<float>(), \

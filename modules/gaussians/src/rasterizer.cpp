@@ -164,7 +164,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     ctx->saved_data["last"] = r.last;
     ctx->saved_data["tile_ranges"] = r.binning.tile_ranges;
     ctx->saved_data["gaussian_ids"] = r.binning.gaussian_ids;
-    if (r.binning.warp_masks.defined()) ctx->saved_data["warp_masks"] = r.binning.warp_masks;
+    ctx->saved_data["warps_packed"] = r.binning.warps_packed;
     ctx->saved_data["split"] = split;
     const int64_t D = r.image.size(2);
     return {r.image.slice(2, 0, split).contiguous(), r.image.slice(2, split, D), r.alpha};
@@ -178,9 +178,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     fwd.last = ctx->saved_data["last"].toTensor();
     fwd.binning.tile_ranges = ctx->saved_data["tile_ranges"].toTensor();
     fwd.binning.gaussian_ids = ctx->saved_data["gaussian_ids"].toTensor();
-    if (ctx->saved_data.count("warp_masks") != 0) {
-      fwd.binning.warp_masks = ctx->saved_data["warp_masks"].toTensor();
-    }
+    fwd.binning.warps_packed = ctx->saved_data["warps_packed"].toBool();
     const at::Tensor& val = saved[3];
     const int64_t split = ctx->saved_data["split"].toInt(), D = val.size(1);
     at::Tensor g_img;
