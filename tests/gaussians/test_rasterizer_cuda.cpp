@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <iostream>
 #include <utility>
 
@@ -110,6 +111,22 @@ void expectCudaMatchesCpu(const gaussians::RasterCamera& cam, int C, bool isolat
     EXPECT_LT(e, 2e-3) << names[k];
     EXPECT_TRUE(at::isfinite(gb[k]).all().item<bool>()) << names[k];
   }
+}
+
+// Without the warp bits in the tile lists (SADSPLAT_CUDA_WARP_BITS=0: every warp takes every
+// entry, the path of renders with 2^24 Gaussians or more) the CUDA renders still match the CPU.
+TEST(RasterizerCudaWarpBits, WithoutWarpBitsTheRenderMatchesTheCpuReference) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  gaussians::RasterCamera cam;
+  cam.width = 120;
+  cam.height = 90;
+  cam.fx = cam.fy = 100.0;
+  cam.cx = 61.3;
+  cam.cy = 44.1;
+  setenv("SADSPLAT_CUDA_WARP_BITS", "0", 1);
+  expectCudaMatchesCpu(cam, 3);
+  expectCudaMatchesCpu(cam, 32);
+  unsetenv("SADSPLAT_CUDA_WARP_BITS");
 }
 
 TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {

@@ -6,7 +6,9 @@
 #include <cuda_runtime.h>
 #include <cub/device/device_radix_sort.cuh>
 
+#include <cstdlib>
 #include <limits>
+#include <string>
 #include <tuple>
 
 #include "raster_backend.h"
@@ -168,6 +170,20 @@ __device__ __forceinline__ unsigned warpsOfRows(float y0, float y1, int ty) {
 // takes every entry.
 constexpr int kIdBits = 24;
 constexpr int64_t kMaxPackedGaussians = int64_t{1} << kIdBits;
+
+// Whether a render of n Gaussians packs the warp bits: below 2^24 Gaussians, unless the
+// environment variable SADSPLAT_CUDA_WARP_BITS is 0 (every warp then takes every entry, as above
+// 2^24: for testing that path and for timing; any other value than 0 or 1 is an error).
+// Read at every render (a getenv per render), so that a test can switch it.
+bool packsWarpBits(int64_t n) {
+  const char* env = std::getenv("SADSPLAT_CUDA_WARP_BITS");
+  if (env != nullptr && *env != '\0') {
+    const std::string v = env;
+    if (v != "0" && v != "1") throw Error("SADSPLAT_CUDA_WARP_BITS", "value", "0 or 1", v);
+    if (v == "0") return false;
+  }
+  return n <= kMaxPackedGaussians;
+}
 __device__ __forceinline__ int packWarps(int64_t id, unsigned warps, bool packed) {
   return packed ? static_cast<int>(static_cast<unsigned>(id) | (warps << kIdBits))
                 : static_cast<int>(id);
@@ -297,7 +313,7 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
   const int num_tiles = tiles_x * tiles_y;
   const auto opts = means2d.options();
   Binning b;
-  b.warps_packed = n <= kMaxPackedGaussians;
+  b.warps_packed = packsWarpBits(n);
   b.tile_ranges = at::zeros({num_tiles, 2}, opts.dtype(at::kInt));
   if (n == 0) {
     b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
