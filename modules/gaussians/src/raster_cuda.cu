@@ -165,9 +165,7 @@ __device__ __forceinline__ unsigned warpsOfRows(float y0, float y1, int ty) {
   return w1 < w0 ? 0u : ((2u << w1) - 1u) & ~((1u << w0) - 1u);
 }
 
-// A list entry's value: the Gaussian's id, and where ids fit in 24 bits the warps its ellipse
-// reaches in the 8 bits above (the sort carries them for free); with more Gaussians every warp
-// takes every entry.
+// Gaussian ids below 2^24 leave a list entry's value 8 bits for its warps.
 constexpr int kIdBits = 24;
 constexpr int64_t kMaxPackedGaussians = int64_t{1} << kIdBits;
 
@@ -184,6 +182,10 @@ bool packsWarpBits(int64_t n) {
   }
   return n <= kMaxPackedGaussians;
 }
+
+// A list entry's value: the Gaussian's id, and where ids fit in 24 bits the warps its ellipse
+// reaches in the 8 bits above (the sort carries them for free); with more Gaussians every warp
+// takes every entry.
 __device__ __forceinline__ int packWarps(int64_t id, unsigned warps, bool packed) {
   return packed ? static_cast<int>(static_cast<unsigned>(id) | (warps << kIdBits))
                 : static_cast<int>(id);
