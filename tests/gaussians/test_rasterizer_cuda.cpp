@@ -113,16 +113,22 @@ void expectCudaMatchesCpu(const gaussians::RasterCamera& cam, int C, bool isolat
   }
 }
 
-// Without the warp bits in the tile lists (SADSPLAT_CUDA_WARP_BITS=0: every warp takes every
-// entry, the path of renders with 2^24 Gaussians or more) the CUDA renders still match the CPU.
-TEST(RasterizerCudaWarpBits, WithoutWarpBitsTheRenderMatchesTheCpuReference) {
-  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+// The perspective camera of the CUDA-against-CPU renders: 120 x 90, principal point off centre.
+gaussians::RasterCamera perspectiveCamera() {
   gaussians::RasterCamera cam;
   cam.width = 120;
   cam.height = 90;
   cam.fx = cam.fy = 100.0;
   cam.cx = 61.3;
   cam.cy = 44.1;
+  return cam;
+}
+
+// Without the warp bits in the tile lists (SADSPLAT_CUDA_WARP_BITS=0: every warp takes every
+// entry, the path of renders with 2^24 Gaussians or more) the CUDA renders still match the CPU.
+TEST(RasterizerCudaWarpBits, WithoutWarpBitsTheRenderMatchesTheCpuReference) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const gaussians::RasterCamera cam = perspectiveCamera();
   setenv("SADSPLAT_CUDA_WARP_BITS", "0", 1);
   expectCudaMatchesCpu(cam, 3);
   expectCudaMatchesCpu(cam, 32);
@@ -130,13 +136,7 @@ TEST(RasterizerCudaWarpBits, WithoutWarpBitsTheRenderMatchesTheCpuReference) {
 }
 
 TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {
-  gaussians::RasterCamera cam;
-  cam.width = 120;
-  cam.height = 90;
-  cam.fx = cam.fy = 100.0;
-  cam.cx = 61.3;
-  cam.cy = 44.1;
-  expectCudaMatchesCpu(cam, GetParam());
+  expectCudaMatchesCpu(perspectiveCamera(), GetParam());
 }
 
 // The orthographic camera (a top-down map render) through the same kernels.
