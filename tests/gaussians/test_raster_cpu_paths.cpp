@@ -74,13 +74,17 @@ std::vector<std::pair<CpuTileLoops, const char*>> vectorisedLoops() {
 }
 
 // coverage: the largest alpha the scene must reach (0.999: pixels near saturation, which stop at
-// a transmittance of 1e-4).
+// a transmittance of 1e-4). closed_share: that share of the Gaussians (at random) gets its
+// opacity negated, a closed gate (raster_backend.h).
 void expectPathsAgree(int width, int height, int n, int D, double opacity, double coverage,
-                      std::uint64_t seed, bool needles = false) {
+                      std::uint64_t seed, bool needles = false, double closed_share = 0) {
   SCOPED_TRACE(testing::Message() << width << "x" << height << ", " << n << " Gaussians, D " << D
-                                  << ", opacity up to " << opacity);
+                                  << ", opacity up to " << opacity << ", closed " << closed_share);
   const CameraParams cam = frontCamera(width, height, 0.9 * width);
-  const Scene s = projectedScene(n, D, cam, seed, opacity, needles);
+  Scene s = projectedScene(n, D, cam, seed, opacity, needles);
+  if (closed_share > 0) {
+    s.opacities = at::where(at::rand({n}) < closed_share, -s.opacities, s.opacities);
+  }
   using gaussians::raster::rasterizeBackwardCpu;
   using gaussians::raster::rasterizeForwardCpu;
   const auto scalar = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
@@ -175,6 +179,13 @@ TEST(RasterCpuPaths, FaintGaussiansThatNeverSaturateAreBitIdentical) {
 TEST(RasterCpuPaths, ThinRotatedGaussiansAreBitIdentical) {
   expectPathsAgree(64, 48, 2500, 3, 0.95, 0.999, 5, true);
   expectPathsAgree(45, 33, 1200, 35, 0.9, 0.999, 6, true);
+}
+
+// Closed gates: the lane loops hand such renders to the rows (or scalar) loops; every loop gives
+// the scalar loops' bits, and the closed gates get opacity gradients.
+TEST(RasterCpuPaths, ClosedGatesAreBitIdentical) {
+  expectPathsAgree(64, 48, 3000, 3, 0.95, 0.999, 8, false, 0.3);
+  expectPathsAgree(45, 33, 1200, 35, 0.9, 0.999, 9, true, 0.3);
 }
 
 // rowRange directly: on the first pixel-centre rows outside the range of random Gaussians (thin

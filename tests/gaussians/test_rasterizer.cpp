@@ -142,6 +142,70 @@ TEST(Rasterizer, GradientsOfEveryInputMatchFiniteDifferences) {
   expectGradientsMatchFiniteDifferences(randomScene(5, 3, 1), cam, settings, 1e-5);
 }
 
+// Closed gates (RenderSettings::closed_gate_gradients): a Gaussian whose gate is 0 renders
+// nothing, and its gate gets the derivative of the render at gate 0. Without depth the loss is
+// linear in the pixels, and each pixel is affine in one Gaussian's alpha over the pixels where
+// the Gaussian blends (none saturates here, no alpha reaches the 0.99 clamp); opacity x gate 1
+// blends at exactly the pixels where the closed gate is counted. So that derivative is
+// L(gate 1) - L(gate 0). The render and every other gradient are those without the setting, bit
+// for bit; without it a closed gate gets no gradient.
+TEST(Rasterizer, AClosedGateGetsTheRendersDerivativeAtZero) {
+  const RasterCamera cam = frontCamera(40, 36, 30.0);  // 3 x 3 tiles
+  const GaussianParams g = randomScene(8, 3, 21, 0.6);
+  const at::Tensor gate = at::tensor({1.0, 0.0, 0.6, 0.0, 1.0, 0.0, 0.3, 1.0}, g.means.options());
+  RenderSettings settings;
+  settings.depth = false;
+  settings.background = {0.1f, 0.2f, 0.3f};
+  at::manual_seed(7);
+  const at::Tensor w_rgb = at::randn({36, 40, 3}, g.means.options());
+  const at::Tensor w_feat = at::randn({36, 40, 3}, g.means.options());
+  const at::Tensor w_alpha = at::randn({36, 40}, g.means.options());
+  const auto loss = [&](const gaussians::RenderResult& r) {
+    return (r.rgb * w_rgb).sum() + (r.features * w_feat).sum() + (r.alpha * w_alpha).sum();
+  };
+  struct Run {
+    gaussians::RenderResult render;
+    std::vector<at::Tensor> grads;  // gate, opacity_logits, means, log_scales, sh, features
+  };
+  const auto run = [&](bool closed_gate_gradients) {
+    settings.closed_gate_gradients = closed_gate_gradients;
+    GaussianParams p = g;
+    std::vector<at::Tensor> inputs;
+    for (at::Tensor* t :
+         {&p.opacity_gate, &p.opacity_logits, &p.means, &p.log_scales, &p.sh, &p.features}) {
+      *t = (t == &p.opacity_gate ? gate : *t).detach().clone().requires_grad_(true);
+      inputs.push_back(*t);
+    }
+    Run out;
+    out.render = gaussians::render(p, cam, settings);
+    out.grads = torch::autograd::grad({loss(out.render)}, inputs);
+    return out;
+  };
+  const Run with = run(true), without = run(false);
+  EXPECT_TRUE(at::equal(with.render.rgb, without.render.rgb));
+  EXPECT_TRUE(at::equal(with.render.alpha, without.render.alpha));
+  for (std::size_t k = 1; k < with.grads.size(); ++k) {
+    EXPECT_TRUE(at::equal(with.grads[k], without.grads[k])) << "gradient " << k;
+  }
+  c10::AutoGradMode no_grad(false);
+  int reached = 0;
+  for (int64_t i = 0; i < 8; ++i) {
+    if (gate[i].item<double>() != 0) {
+      EXPECT_EQ(with.grads[0][i].item<double>(), without.grads[0][i].item<double>()) << i;
+      continue;
+    }
+    EXPECT_EQ(without.grads[0][i].item<double>(), 0.0) << i;
+    GaussianParams open = g;
+    open.opacity_gate = gate.clone();
+    open.opacity_gate[i] = 1.0;
+    const double expected = loss(gaussians::render(open, cam, settings)).item<double>() -
+                            loss(with.render).item<double>();
+    EXPECT_NEAR(with.grads[0][i].item<double>(), expected, 1e-9 * (1 + std::abs(expected))) << i;
+    reached += std::abs(expected) > 1e-3;
+  }
+  EXPECT_EQ(reached, 3) << "every closed gate reaches pixels";
+}
+
 TEST(Rasterizer, BlackAndGreyBackgroundsComposeLikeAColouredOne) {
   // Black and grey take their own paths (no colour tensor): the same image as rgb + (1 - alpha)
   // * background, and gradients that match finite differences.

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <utility>
+#include <vector>
 
 #include "sadsplat/gaussians/rasterizer.h"
 
@@ -53,15 +54,27 @@ double shareOff(const at::Tensor& a, const at::Tensor& b) {
 // isolated_pixels: the forward images may differ beyond 1e-4 in at most 0.1 % of their elements
 // (by at most 1 %): seen with the orthographic camera, where a few pixels differ by a few 1e-4
 // (seed 49: rgb 4.5e-4, features 9.8e-4), as FMA contraction moves a Gaussian across a threshold.
-void expectCudaMatchesCpu(const gaussians::RasterCamera& cam, int C, bool isolated_pixels = false) {
+// closed_gates: gates on the opacities, 30 % of them closed (0), rendered with
+// closed_gate_gradients; the gates' gradients are compared too.
+void expectCudaMatchesCpu(const gaussians::RasterCamera& cam, int C, bool isolated_pixels = false,
+                          bool closed_gates = false) {
   gaussians::RenderSettings settings;
   settings.background = {0.3f, 0.2f, 0.1f};
-  const GaussianParams cpu = scene(3000, C, 17 + C);
+  settings.closed_gate_gradients = closed_gates;
+  GaussianParams cpu = scene(3000, C, 17 + C);
   GaussianParams cuda;
-  at::Tensor GaussianParams::*const members[] = {
+  std::vector<at::Tensor GaussianParams::*> members = {
       &GaussianParams::means,          &GaussianParams::quats, &GaussianParams::log_scales,
       &GaussianParams::opacity_logits, &GaussianParams::sh,    &GaussianParams::features};
-  const char* names[] = {"means", "quats", "log_scales", "opacity_logits", "sh", "features"};
+  std::vector<const char*> names = {"means",          "quats", "log_scales",
+                                    "opacity_logits", "sh",    "features"};
+  if (closed_gates) {
+    at::manual_seed(3);
+    const at::Tensor u = at::rand({3000});
+    cpu.opacity_gate = at::where(u < 0.3, at::zeros_like(u), u);
+    members.push_back(&GaussianParams::opacity_gate);
+    names.push_back("opacity_gate");
+  }
   GaussianParams a = cpu;
   std::vector<at::Tensor> ta, tb;
   for (auto m : members) {
@@ -111,6 +124,10 @@ void expectCudaMatchesCpu(const gaussians::RasterCamera& cam, int C, bool isolat
     EXPECT_LT(e, 2e-3) << names[k];
     EXPECT_TRUE(at::isfinite(gb[k]).all().item<bool>()) << names[k];
   }
+  if (closed_gates) {  // the closed gates do get gradients
+    const at::Tensor closed = cpu.opacity_gate == 0;
+    EXPECT_GT(ga.back().masked_select(closed).abs().gt(0).sum().item<int64_t>(), 300);
+  }
 }
 
 // The perspective camera of the CUDA-against-CPU renders: 120 x 90, principal point off centre.
@@ -133,6 +150,14 @@ TEST(RasterizerCudaWarpBits, WithoutWarpBitsTheRenderMatchesTheCpuReference) {
   expectCudaMatchesCpu(cam, 3);
   expectCudaMatchesCpu(cam, 32);
   unsetenv("SADSPLAT_CUDA_WARP_BITS");
+}
+
+// Closed gates (RenderSettings::closed_gate_gradients): binned as if open, counted in `last`, a
+// gradient for the gate at 0; RGB and 32 features.
+TEST(RasterizerCudaClosedGates, ClosedGateGradientsMatchTheCpuReference) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  expectCudaMatchesCpu(perspectiveCamera(), 0, false, true);
+  expectCudaMatchesCpu(perspectiveCamera(), 32, false, true);
 }
 
 TEST_P(RasterizerCuda, ForwardAndBackwardMatchTheCpuReference) {

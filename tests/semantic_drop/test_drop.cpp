@@ -98,6 +98,40 @@ TEST(HardConcrete, CounterGateIsSampleGateOfTheCounterNoise) {
       << (cuda_grad.cpu() - reference_grad).abs().max();
 }
 
+// closed_gradient (for closed gates' gradients): the same gates; where the clamp closes one the
+// gradient is that of the stretched sample, (r - l) s (1 - s) / beta, where the paper's gate has
+// none; elsewhere the same gradient. The fused CUDA kernels agree.
+TEST(HardConcrete, ClosedGradientPassesTheClampAtZeroOnly) {
+  at::manual_seed(6);
+  const HardConcreteParams p;
+  const at::Tensor log_alpha =
+      (at::randn({5000}, at::TensorOptions().dtype(at::kDouble)) * 3).requires_grad_(true);
+  const at::Tensor u = gaussians::counterUniform(5000, 42, 13, 78, log_alpha.options());
+  const at::Tensor plain = sampleGate(log_alpha, u, p);
+  const at::Tensor through = sampleGate(log_alpha, u, p, true);
+  EXPECT_TRUE(at::equal(plain, through));
+  const at::Tensor g_plain = torch::autograd::grad({plain.sum()}, {log_alpha})[0];
+  const at::Tensor g_through = torch::autograd::grad({through.sum()}, {log_alpha})[0];
+  const at::Tensor closed = plain.detach() == 0, open = plain.detach() == 1;
+  ASSERT_GT(closed.sum().item<int64_t>(), 500);
+  const at::Tensor uc = u.clamp(1e-6, 1 - 1e-6);
+  const at::Tensor s = at::sigmoid((at::log(uc) - at::log(1 - uc) + log_alpha.detach()) / p.beta);
+  const at::Tensor expected = (p.r - p.l) * s * (1 - s) / p.beta;
+  EXPECT_TRUE(
+      at::allclose(g_through.masked_select(closed), expected.masked_select(closed), 1e-12, 1e-15));
+  EXPECT_GT(g_through.masked_select(closed).abs().max().item<double>(), 1e-3);
+  EXPECT_EQ(g_plain.masked_select(closed).abs().max().item<double>(), 0.0);
+  const at::Tensor rest = closed.logical_not();
+  EXPECT_TRUE(at::equal(g_plain.masked_select(rest), g_through.masked_select(rest)));
+  EXPECT_GT(open.sum().item<int64_t>(), 100) << "gates clamped at 1 (no gradient) are in the test";
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const at::Tensor cuda_alpha = log_alpha.detach().to(at::kFloat).cuda().requires_grad_(true);
+  const at::Tensor cuda_gate = sampleCounterGate(cuda_alpha, 42, 13, 78, p, true);
+  const at::Tensor cuda_grad = torch::autograd::grad({cuda_gate.sum()}, {cuda_alpha})[0];
+  EXPECT_TRUE(at::allclose(cuda_grad.cpu().to(at::kDouble), g_through, 1e-4, 1e-5))
+      << (cuda_grad.cpu().to(at::kDouble) - g_through).abs().max();
+}
+
 TEST(SemanticConfidence, EqualsAHandComputationOnATwoViewToyScene) {
   // Two cameras at the origin looking down +z, 4x4 images, f = 4: a point (x, y, z) lands on
   // pixel (4x/z + 2, 4y/z + 2).

@@ -42,6 +42,13 @@ struct Binning {
   bool warps_packed = false;
 };
 
+/// Closed gates (RenderSettings::closed_gate_gradients): a Gaussian passed with a negative
+/// opacity -o is one whose gate is 0 this render. It blends nothing and changes no pixel, but the
+/// backends bin it with opacity o, count it in `last` where it would blend, and give it the
+/// gradient of the loss with respect to its opacity at 0: per pixel that it would reach with
+/// opacity o, G (dot - behind) T + the alpha term, exactly as for a contributor of alpha 0
+/// (raster_cpu_tiles.h, unblendClosedGate). Its other gradients are 0. Opacities >= 0 are
+/// rendered as always.
 struct RasterResult {
   at::Tensor image;  ///< [H, W, D] composited channels (no background)
   at::Tensor alpha;  ///< [H, W] accumulated opacity, 1 - final transmittance

@@ -145,11 +145,12 @@ Binning binGaussians(const T* means2d, const T* conics, const int* radii, const 
   const int num_tiles = tiles_x * tiles_y;
   std::vector<std::vector<int>> lists(num_tiles);
   for (int64_t i = 0; i < n; ++i) {
+    const T opacity = std::abs(opacities[i]);  // a closed gate's (raster_backend.h) as if open
     int rx, ry;
-    alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+    alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
     if (rx <= 0) continue;
     AlphaEllipse<T> ellipse;
-    if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) continue;
+    if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) continue;
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {
@@ -188,15 +189,32 @@ Binning binGaussians(const T* means2d, const T* conics, const int* radii, const 
 
 // Below this power a Gaussian's alpha is certainly under kMinAlpha, so pixelAlpha (and its exp)
 // can be skipped; the 1e-3 margin leaves every borderline case to pixelAlpha itself, so results
-// are exactly those of the CUDA backend's unconditional calls.
+// are exactly those of the CUDA backend's unconditional calls. A closed gate's (a negative
+// opacity, raster_backend.h) is that of its opacity: the pixels it would reach are visited.
 template <typename T>
 std::vector<T> skipThresholds(const T* opacities, int64_t n) {
   std::vector<T> thresholds(static_cast<std::size_t>(n));
   for (int64_t i = 0; i < n; ++i) {
-    thresholds[i] = opacities[i] > T(0) ? std::log(T(kMinAlpha) / opacities[i]) - T(1e-3)
-                                        : std::numeric_limits<T>::infinity();
+    const T opacity = std::abs(opacities[i]);
+    thresholds[i] = opacity > T(0) ? std::log(T(kMinAlpha) / opacity) - T(1e-3)
+                                   : std::numeric_limits<T>::infinity();
   }
   return thresholds;
+}
+
+// Whether any opacity is negative (a closed gate, raster_backend.h).
+template <typename T>
+bool hasClosedGates(const T* opacities, int64_t n) {
+  return std::any_of(opacities, opacities + n, [](T o) { return o < T(0); });
+}
+
+// The loops for a render with closed gates: the lane loops compute their own alphas without
+// them, so the SSE2 rows (or the scalar loops) take such renders; the same bits either way.
+CpuTileLoops loopsForClosedGates(CpuTileLoops resolved) {
+  if (resolved != CpuTileLoops::kLanesAvx2 && resolved != CpuTileLoops::kLanesAvx512) {
+    return resolved;
+  }
+  return cpuTileLoopsAvailable(CpuTileLoops::kRows) ? CpuTileLoops::kRows : CpuTileLoops::kScalar;
 }
 
 using cpu_tiles::TileList;
@@ -346,11 +364,13 @@ RasterResult rasterizeForwardCpu(const at::Tensor& means2d, const at::Tensor& co
   out.last = at::zeros({height, width}, values.options().dtype(at::kInt));
   AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeForwardCpu", [&] {
     using T = scalar_t;
-    const CpuTileLoops tile_loops = resolveLoops<T>(loops);
     const T* m2 = means2d.data_ptr<T>();
     const T* co = conics.data_ptr<T>();
     const T* op = opacities.data_ptr<T>();
     const T* val = values.data_ptr<T>();
+    const CpuTileLoops resolved = resolveLoops<T>(loops);
+    const CpuTileLoops tile_loops =
+        hasClosedGates(op, n) ? loopsForClosedGates(resolved) : resolved;
     out.binning =
         binGaussians(m2, co, radii.data_ptr<int>(), op, depths.data_ptr<T>(), n, width, height);
     const int* ranges = out.binning.tile_ranges.data_ptr<int>();
@@ -396,11 +416,13 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
   at::Tensor buffers = at::zeros({threads, n, row}, values.options());
   AT_DISPATCH_FLOATING_TYPES(means2d.scalar_type(), "rasterizeBackwardCpu", [&] {
     using T = scalar_t;
-    const CpuTileLoops tile_loops = resolveLoops<T>(loops);
     const T* m2 = means2d.data_ptr<T>();
     const T* co = conics.data_ptr<T>();
     const T* op = opacities.data_ptr<T>();
     const T* val = values.data_ptr<T>();
+    const CpuTileLoops resolved = resolveLoops<T>(loops);
+    const CpuTileLoops tile_loops =
+        hasClosedGates(op, n) ? loopsForClosedGates(resolved) : resolved;
     const T* gimg = g_image.data_ptr<T>();
     const T* galpha = g_alpha.data_ptr<T>();
     const T* alpha_fwd = fwd.alpha.data_ptr<T>();

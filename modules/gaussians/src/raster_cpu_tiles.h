@@ -107,10 +107,14 @@ struct TileList {
 template <typename T>
 inline bool blendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, int j, T fx, T fy,
                           T* accum, T* trans, int* last) {
-  T G;
+  T G = T(0);
   bool clamped;
   const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-  if (alpha == T(0)) return true;
+  if (alpha == T(0)) {
+    // A closed gate it would blend at counts in `last`: the backward visits it there.
+    if (closedGateReaches(p.opacity, G)) *last = j + 1;
+    return true;
+  }
   const T next = *trans * (T(1) - alpha);
   if (next < T(kMinTransmittance)) return false;
   const T w = alpha * *trans;
@@ -129,14 +133,36 @@ inline bool blendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, int
 // fewer than carrying the D-channel colour (the CUDA backward does the same). The pixel's state:
 // `trans`, `last_alpha`, `behind`, `last_dot` (updated); gpix its image gradient, g_alpha_out its
 // alpha gradient, final_trans its transmittance after the forward. Shared by both loops, as above.
+// A closed gate (raster_backend.h) at a pixel it would reach: a contributor of alpha 0 — the
+// transmittance stays, no value or geometry gradient; its opacity gradient is G times the alpha
+// gradient at alpha 0.
+template <typename T>
+inline void unblendClosedGate(T G, const T* v, int64_t D, const T* gpix, T g_alpha_out,
+                              T final_trans, T trans, T* last_alpha, T* behind, T* last_dot,
+                              T* gb) {
+  T dot = T(0);
+  for (int64_t ch = 0; ch < D; ++ch) dot += v[ch] * gpix[ch];
+  *behind = *last_alpha * *last_dot + (T(1) - *last_alpha) * *behind;
+  const T g_a = (dot - *behind) * trans + g_alpha_out * final_trans;
+  *last_dot = dot;
+  *last_alpha = T(0);
+  gb[5] += G * g_a;
+}
+
 template <typename T>
 inline void unblendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, T fx, T fy,
                             const T* gpix, T g_alpha_out, T final_trans, T* trans, T* last_alpha,
                             T* behind, T* last_dot, T* gb) {
-  T G;
+  T G = T(0);
   bool clamped;
   const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
-  if (alpha == T(0)) return;
+  if (alpha == T(0)) {
+    if (closedGateReaches(p.opacity, G)) {
+      unblendClosedGate(G, v, D, gpix, g_alpha_out, final_trans, *trans, last_alpha, behind,
+                        last_dot, gb);
+    }
+    return;
+  }
   *trans = *trans / (T(1) - alpha);
   const T w = alpha * *trans;
   T dot = T(0);

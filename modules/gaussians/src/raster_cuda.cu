@@ -198,10 +198,11 @@ __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   int64_t count = 0;
+  const float opacity = fabsf(opacities[i]);  // a closed gate's (raster_backend.h) as if open
   int rx, ry;
-  alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+  alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
   AlphaEllipse<float> ellipse;
-  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) {
+  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {
@@ -223,10 +224,11 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
   if (i >= n) return;
   int64_t out = i == 0 ? 0 : offsets[i - 1];
   const int64_t end = min(offsets[i], capacity);  // a list sized before the count may end early
+  const float opacity = fabsf(opacities[i]);  // a closed gate's (raster_backend.h) as if open
   int rx, ry;
-  alphaBox(radii[i], opacities[i], conics + 3 * i, &rx, &ry);
+  alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
   AlphaEllipse<float> ellipse;
-  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacities[i], &ellipse)) {
+  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));
@@ -485,10 +487,14 @@ __global__ void __launch_bounds__(kBlock)
     const int count = min(kBlock, stop - batch);
     for (int j = 0; j < count && !done; ++j) {
       if (!(s_warps[j] & warp_bit)) continue;  // warp-uniform: no pixel of the warp is reached
-      float G;
+      float G = 0.f;
       bool clamped;
       const float alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
-      if (alpha == 0.f) continue;
+      if (alpha == 0.f) {
+        // A closed gate it would blend at counts in `last`: the backward visits it there.
+        if (closedGateReaches(s_opacity[j], G)) last = batch + j - start + 1;
+        continue;
+      }
       const float next = trans * (1.f - alpha);
       if (next < float(kMinTransmittance)) {
         done = true;
@@ -807,8 +813,17 @@ __global__ void __launch_bounds__(kBlock)
               alpha = pixelAlpha(s_mean[j], s_conic[j], s_opacity[j], fx, fy, &G, &clamped);
             }
             const bool contributes = alpha > 0.f;
-            if (__any_sync(kFullMask, contributes)) {
+            const bool closed = !contributes && closedGateReaches(s_opacity[j], G);
+            if (__any_sync(kFullMask, contributes || closed)) {
               float grads[6] = {0.f, 0.f, 0.f, 0.f, 0.f, 0.f};  // mean2d, conic, opacity
+              if (closed) {  // raster_cpu_tiles.h, unblendClosedGate
+                const float dot = rows[r][lane];
+                behind = last_alpha * last_dot + (1.f - last_alpha) * behind;
+                const float g_a = (dot - behind) * trans + ga_out * final_trans;
+                last_dot = dot;
+                last_alpha = 0.f;
+                grads[5] = G * g_a;
+              }
               if (contributes) {
                 const float inv_keep = 1.f / (1.f - alpha);  // one division, used twice
                 trans *= inv_keep;

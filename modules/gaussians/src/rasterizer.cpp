@@ -461,7 +461,13 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   at::Tensor opacities = at::sigmoid(g.opacity_logits);
   if (g.opacity_gate.defined()) {
     expectTensor(g.opacity_gate, "opacity_gate", n, {}, g.means);
+    const at::Tensor open = opacities;
     opacities = opacities * g.opacity_gate;
+    if (settings.closed_gate_gradients) {
+      // A closed gate goes to the backends as its negative opacity (raster_backend.h): the same
+      // value 0 of opacity x gate to every gradient but the backends', which read the sign.
+      opacities = opacities - (open * (g.opacity_gate == 0)).detach();
+    }
   }
   // RGB apart from the features (and depth): the losses' gradients reach the rasterizer without
   // a slice backward of the whole image.

@@ -232,6 +232,10 @@ const std::vector<TrainOption> kOptions = {
      "(rendered as for evaluation) from one drop event to the next that halves the L0 strength "
      "and the cap; not across an opacity reset (0: off)",
      nullptr, 0, kInf},
+    {"closed_gate_gradients", &C::closed_gate_gradients,
+     "gates closed in a step's sample still get the render's gradient at 0 (MaskGaussian's "
+     "masked rasterisation; not the paper)",
+     "--closed-gate-gradients"},
 };
 
 std::string numberText(double v) {

@@ -241,6 +241,7 @@ StepStats Trainer::step(bool read_losses) {
   settings.background = c.background;
   GaussianParams g = s.params.gaussians();
   const bool gated = s.drop.gated(it);
+  settings.closed_gate_gradients = gated && c.closed_gate_gradients;
   if (s.drop.refreshesL0Weights(it)) {
     enterPhase(profile, "L0 weights");
     s.drop.refreshL0Weights(s.params, s.views, s.iteration);

@@ -24,6 +24,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         lambda_l0_ramp_(c.lambda_l0_ramp),
         seed_(c.seed),
         balanced_(c.drop_rule == "balanced"),
+        closed_gate_gradients_(c.closed_gate_gradients),
         hc_(hc) {}
 
   at::Tensor l0Derivative(const at::Tensor& log_alpha) const override {
@@ -36,7 +37,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
     // Counter-based noise on the parameters' device: nothing drawn on the host and copied.
-    return sampleCounterGate(log_alpha, seed_, 13, static_cast<std::uint64_t>(iteration), hc_);
+    return sampleCounterGate(log_alpha, seed_, 13, static_cast<std::uint64_t>(iteration), hc_,
+                             closed_gate_gradients_);
   }
 
   at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
@@ -126,6 +128,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   int lambda_l0_from_, lambda_l0_ramp_;
   std::uint64_t seed_;
   bool balanced_;
+  bool closed_gate_gradients_;
   HardConcreteParams hc_;
 };
 

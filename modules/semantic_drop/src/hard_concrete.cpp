@@ -28,6 +28,7 @@ hard_concrete_fused::GateParams gateParams(const AutogradContext* ctx) {
   p.inv_beta = static_cast<float>(ctx->saved_data.at("inv_beta").toDouble());
   p.l = static_cast<float>(ctx->saved_data.at("l").toDouble());
   p.r = static_cast<float>(ctx->saved_data.at("r").toDouble());
+  p.closed_gradient = ctx->saved_data.at("closed_gradient").toBool();
   return p;
 }
 
@@ -35,7 +36,8 @@ hard_concrete_fused::GateParams gateParams(const AutogradContext* ctx) {
 class FusedCounterGate : public torch::autograd::Function<FusedCounterGate> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& log_alpha,
-                            gaussians::CounterKey key, const HardConcreteParams& p) {
+                            gaussians::CounterKey key, const HardConcreteParams& p,
+                            bool closed_gradient) {
     const c10::cuda::CUDAGuard guard(log_alpha.device());
     const at::Tensor a = log_alpha.contiguous();
     ctx->saved_data["key_low"] = static_cast<std::int64_t>(key.low);
@@ -43,6 +45,7 @@ class FusedCounterGate : public torch::autograd::Function<FusedCounterGate> {
     ctx->saved_data["inv_beta"] = 1.0 / p.beta;
     ctx->saved_data["l"] = p.l;
     ctx->saved_data["r"] = p.r;
+    ctx->saved_data["closed_gradient"] = closed_gradient;
     ctx->save_for_backward({a});
     at::Tensor gate = at::empty_like(a);
     hard_concrete_fused::forwardCuda(a.data_ptr<float>(), a.numel(), gateParams(ctx),
@@ -56,7 +59,7 @@ class FusedCounterGate : public torch::autograd::Function<FusedCounterGate> {
     at::Tensor grad = at::empty_like(a);
     hard_concrete_fused::backwardCuda(a.data_ptr<float>(), g.data_ptr<float>(), a.numel(),
                                       gateParams(ctx), grad.data_ptr<float>(), currentStream(a));
-    return {grad, at::Tensor(), at::Tensor()};
+    return {grad, at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };
 #endif
@@ -70,10 +73,14 @@ at::Tensor probabilityNonZero(const at::Tensor& log_alpha, const HardConcretePar
 }
 
 at::Tensor sampleGate(const at::Tensor& log_alpha, const at::Tensor& uniform,
-                      const HardConcreteParams& p) {
+                      const HardConcreteParams& p, bool closed_gradient) {
   const at::Tensor u = uniform.clamp(1e-6, 1 - 1e-6);
   const at::Tensor s = at::sigmoid((at::log(u) - at::log(1 - u) + log_alpha) / p.beta);
-  return (s * (p.r - p.l) + p.l).clamp(0, 1);
+  const at::Tensor stretched = s * (p.r - p.l) + p.l;
+  if (!closed_gradient) return stretched.clamp(0, 1);
+  // The value of clamp(0, 1), the gradient of clamp_max(1): it passes below 0.
+  const at::Tensor open_above = stretched.clamp_max(1);
+  return open_above + (open_above.clamp_min(0) - open_above).detach();
 }
 
 bool counterGateIsFused(const at::Tensor& log_alpha) {
@@ -85,18 +92,19 @@ bool counterGateIsFused(const at::Tensor& log_alpha) {
 #endif
 }
 
-at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed,
-                             std::uint64_t purpose, std::uint64_t iteration,
-                             const HardConcreteParams& p) {
+at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed, std::uint64_t purpose,
+                             std::uint64_t iteration, const HardConcreteParams& p,
+                             bool closed_gradient) {
 #if SADSPLAT_HAVE_CUDA
   if (counterGateIsFused(log_alpha)) {
-    return FusedCounterGate::apply(log_alpha, gaussians::counterKey(seed, purpose, iteration), p);
+    return FusedCounterGate::apply(log_alpha, gaussians::counterKey(seed, purpose, iteration), p,
+                                   closed_gradient);
   }
 #endif
   const at::Tensor u =
       gaussians::counterUniform(log_alpha.numel(), seed, purpose, iteration, log_alpha.options())
           .view(log_alpha.sizes());
-  return sampleGate(log_alpha, u, p);
+  return sampleGate(log_alpha, u, p, closed_gradient);
 }
 
 at::Tensor deterministicGate(const at::Tensor& log_alpha, const HardConcreteParams& p) {

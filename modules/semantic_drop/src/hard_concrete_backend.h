@@ -2,7 +2,8 @@
 // Internal interface of the fused Hard Concrete training gate (hard_concrete.cpp <->
 // hard_concrete_cuda.cu): per Gaussian i, u = counterUniformAt(key, i) clamped to
 // [1e-6, 1 - 1e-6], s = sigmoid((log u - log(1 - u) + log_alpha) / beta), z = clamp(s (r - l) + l,
-// 0, 1); the backward recomputes u and s (nothing stored but log_alpha).
+// 0, 1); the backward recomputes u and s (nothing stored but log_alpha). With closed_gradient the
+// gradient also passes where the clamp closes the gate (s (r - l) + l < 0).
 
 #include <cstdint>
 
@@ -17,6 +18,7 @@ struct GateParams {
   float inv_beta = 1.5f;
   float l = -0.1f;
   float r = 1.1f;
+  bool closed_gradient = false;
 };
 
 #if SADSPLAT_COMPILE_CUDA

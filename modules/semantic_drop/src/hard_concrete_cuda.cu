@@ -37,8 +37,9 @@ __global__ void backwardKernel(const float* __restrict__ log_alpha,
   if (i >= n) return;
   float s;
   const float z = stretched(log_alpha[i], i, p, &s);
-  // The clamp passes the gradient on [0, 1] (its bounds included), as ATen's clamp does.
-  const bool inside = z >= 0.f && z <= 1.f;
+  // The clamp passes the gradient on [0, 1] (its bounds included), as ATen's clamp does, and
+  // below 0 too with closed_gradient.
+  const bool inside = (p.closed_gradient || z >= 0.f) && z <= 1.f;
   grad_log_alpha[i] = inside ? grad_gate[i] * (p.r - p.l) * s * (1.f - s) * p.inv_beta : 0.f;
 }
 

@@ -589,6 +589,14 @@ SADSPLAT_HD T pixelAlpha(const T mean2d[2], const T conic[3], T opacity, T px, T
   return alpha < T(kMinAlpha) ? T(0) : alpha;
 }
 
+/// Whether a Gaussian with a closed gate reaches the pixel: rendered with the negative opacity
+/// -o (raster_backend.h, "closed gates") it blends nothing, but with opacity o it would, o G >=
+/// kMinAlpha (G = exp(power) from pixelAlpha, left 0 where pixelAlpha returned before it).
+template <typename T>
+SADSPLAT_HD bool closedGateReaches(T opacity, T G) {
+  return opacity < T(0) && -opacity * G >= T(kMinAlpha);
+}
+
 /// Backward of pixelAlpha for a contributing Gaussian: adds the gradients of mean2d, conic and
 /// opacity for a gradient g_alpha of its alpha.
 template <typename T>

@@ -55,6 +55,11 @@ struct RenderSettings {
   /// to count it; the caller checks with tile_capacity->renderedAll() before using the render's
   /// gradients (tile_list_capacity.h). Null: exact lists. Kept alive by the caller. CPU: unused.
   TileListCapacity* tile_capacity = nullptr;
+  /// Gradients for closed gates (not the paper; MaskGaussian's masked rasterisation): a Gaussian
+  /// whose opacity_gate is exactly 0 still renders nothing, but its gate gets the derivative of
+  /// the render at gate 0 — the pixels it would reach if open, behind and in front of the others
+  /// as the list orders them — instead of none. Costs its (Gaussian, tile) pairs in the lists.
+  bool closed_gate_gradients = false;
 };
 
 /// \brief The Gaussians to render: N rows, float32 (or float64 on CPU), one device.

@@ -149,6 +149,11 @@ struct TrainConfig {
   double l0_strength = 1.0;
   double drop_max_fraction = 0.15;
   double drop_guard = 0.05;
+  /// Not the paper (MaskGaussian's masked rasterisation, CVPR 2025): a Gaussian whose sampled gate
+  /// is 0 this step still gets a gate gradient — the derivative of the render at gate 0
+  /// (RenderSettings::closed_gate_gradients) through a clamp that passes it below 0
+  /// (semantic_drop::sampleGate) — so that a closed gate the views need can open again.
+  bool closed_gate_gradients = false;
 
   /// \brief The same training for a global batch of `views` training views per step (ranks x
   /// views_per_step): every iteration count of the schedule (iterations, densification, opacity

@@ -27,16 +27,19 @@ using filters::probabilityNonZero;
 /// \brief P(z > 0) for a tensor of log_alphas (differentiable).
 at::Tensor probabilityNonZero(const at::Tensor& log_alpha, const HardConcreteParams& p = {});
 /// \brief A sample of gates for `log_alpha` (differentiable in log_alpha) from `uniform` noise
-/// in (0, 1) of the same shape.
+/// in (0, 1) of the same shape. The clamp passes no gradient where it closes a gate (z = 0)
+/// unless `closed_gradient` (not the paper; for gradients of closed gates,
+/// gaussians::RenderSettings::closed_gate_gradients): then the gradient is that of
+/// s (r - l) + l there, a straight-through estimator at 0.
 at::Tensor sampleGate(const at::Tensor& log_alpha, const at::Tensor& uniform,
-                      const HardConcreteParams& p = {});
+                      const HardConcreteParams& p = {}, bool closed_gradient = false);
 /// \brief sampleGate with the trainer's counter-based noise, counterUniform(n, seed, purpose,
 /// iteration) (sadsplat/gaussians/counter_random.h). On CUDA (float32) the noise, the gate and
 /// its gradient come from one kernel each (nothing but log_alpha kept for the backward pass);
 /// elsewhere sampleGate(log_alpha, counterUniform(...)).
-at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed,
-                             std::uint64_t purpose, std::uint64_t iteration,
-                             const HardConcreteParams& p = {});
+at::Tensor sampleCounterGate(const at::Tensor& log_alpha, std::uint64_t seed, std::uint64_t purpose,
+                             std::uint64_t iteration, const HardConcreteParams& p = {},
+                             bool closed_gradient = false);
 /// \brief Whether sampleCounterGate takes the fused path for this tensor.
 bool counterGateIsFused(const at::Tensor& log_alpha);
 /// \brief The deterministic gate used at evaluation: clamp(sigmoid(log_alpha) (r - l) + l, 0, 1).
