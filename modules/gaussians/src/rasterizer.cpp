@@ -138,7 +138,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                const at::Tensor& conics, const at::Tensor& opacities,
                                const at::Tensor& values, const at::Tensor& radii,
                                const at::Tensor& depths, int64_t width, int64_t height,
-                               int64_t split, TileListCapacity* capacity) {
+                               int64_t split, TileListCapacity* capacity, bool closed_gates) {
     const ScopedPhase phase("rasterize");
     const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
                      op = opacities.contiguous(), val = values.contiguous();
@@ -166,6 +166,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     ctx->saved_data["gaussian_ids"] = r.binning.gaussian_ids;
     ctx->saved_data["warps_packed"] = r.binning.warps_packed;
     ctx->saved_data["split"] = split;
+    ctx->saved_data["closed_gates"] = closed_gates;
     const int64_t D = r.image.size(2);
     return {r.image.slice(2, 0, split).contiguous(), r.image.slice(2, split, D), r.alpha};
   }
@@ -179,6 +180,7 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     fwd.binning.tile_ranges = ctx->saved_data["tile_ranges"].toTensor();
     fwd.binning.gaussian_ids = ctx->saved_data["gaussian_ids"].toTensor();
     fwd.binning.warps_packed = ctx->saved_data["warps_packed"].toBool();
+    fwd.closed_gates = ctx->saved_data["closed_gates"].toBool();
     const at::Tensor& val = saved[3];
     const int64_t split = ctx->saved_data["split"].toInt(), D = val.size(1);
     at::Tensor g_img;
@@ -212,8 +214,8 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha.sizes(), fwd.alpha.options());
       g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
     }
-    // No gradient for radii, depths, width, height, split and the tile-list capacity.
-    return {g.means2d,    g.conics,     g.opacities,  g.values,    at::Tensor(),
+    // No gradient for radii, depths, width, height, split, the tile-list capacity and the flag.
+    return {g.means2d,    g.conics,     g.opacities,  g.values,     at::Tensor(), at::Tensor(),
             at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };
@@ -381,19 +383,22 @@ std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Te
 namespace {
 
 // rasterizeToPixels with the image's first `split` channels apart (RasterizeFunction): returns
-// {head [H, W, split], tail [H, W, D - split], alpha [H, W]}.
+// {head [H, W, split], tail [H, W, D - split], alpha [H, W]}. closed_gates: negative opacities
+// are closed gates (raster_backend.h).
 std::array<at::Tensor, 3> splitRasterize(const at::Tensor& means2d, const at::Tensor& conics,
                                          const at::Tensor& opacities, const at::Tensor& values,
                                          const at::Tensor& radii, const at::Tensor& depths,
                                          int width, int height, int64_t split,
-                                         TileListCapacity* capacity = nullptr) {
+                                         TileListCapacity* capacity = nullptr,
+                                         bool closed_gates = false) {
   const int64_t n = means2d.size(0);
   expectTensor(conics, "conics", n, {3}, means2d);
   expectTensor(opacities, "opacities", n, {}, means2d);
   expectTensor(values, "values", n, {-1}, means2d);
   expectTensor(depths, "depths", n, {}, means2d);
-  const auto out = RasterizeFunction::apply(means2d, conics, opacities, values, radii,
-                                            depths.detach(), width, height, split, capacity);
+  const auto out =
+      RasterizeFunction::apply(means2d, conics, opacities, values, radii, depths.detach(), width,
+                               height, split, capacity, closed_gates);
   return {out[0], out[1], out[2]};
 }
 
@@ -464,16 +469,17 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
     const at::Tensor open = opacities;
     opacities = opacities * g.opacity_gate;
     if (settings.closed_gate_gradients) {
-      // A closed gate goes to the backends as its negative opacity (raster_backend.h): the same
-      // value 0 of opacity x gate to every gradient but the backends', which read the sign.
+      // A closed gate goes to the backends as its negative opacity (raster_backend.h); the
+      // subtracted part is detached, so gradients flow through opacity x gate as without it.
       opacities = opacities - (open * (g.opacity_gate == 0)).detach();
     }
   }
   // RGB apart from the features (and depth): the losses' gradients reach the rasterizer without
   // a slice backward of the whole image.
-  auto [rgb, rest, alpha] = splitRasterize(means2d, conics, opacities, values, radii, depths,
-                                           camera.width, camera.height, 3,
-                                           settings.tile_capacity);
+  const bool closed_gates = settings.closed_gate_gradients && g.opacity_gate.defined();
+  auto [rgb, rest, alpha] =
+      splitRasterize(means2d, conics, opacities, values, radii, depths, camera.width, camera.height,
+                     3, settings.tile_capacity, closed_gates);
   const int64_t C = features.size(1);
   RenderResult result;
   result.rgb = composeBackground(rgb, alpha, settings.background);
