@@ -605,6 +605,50 @@ TEST(Rasterizer, AlphaBoxHoldsEveryPixelAGaussianCanReachAndCutsElongatedOnes) {
   EXPECT_GT(narrower, boxes / 5) << narrower << " of " << boxes;
 }
 
+// The box from the alpha ellipse (what the binning takes: one log of the opacity) is
+// alphaBox's, bit for bit, in float and double, for every opacity with a box, degenerate conics
+// and zero radii included.
+template <typename T>
+void expectEllipseBoxesEqualAlphaBoxes() {
+  using gaussians::raster::alphaBox;
+  using gaussians::raster::AlphaEllipse;
+  using gaussians::raster::alphaEllipse;
+  std::mt19937 rng(12);
+  int compared = 0, cut = 0;
+  for (int k = 0; k < 200; ++k) {
+    gaussians::raster::Projected<double> p;
+    if (!randomBinningGaussian(rng, k, &p)) continue;
+    const T mean[2] = {T(p.mean2d[0]), T(p.mean2d[1])};
+    T conic[3] = {T(p.conic[0]), T(p.conic[1]), T(p.conic[2])};
+    if (k % 17 == 0) conic[1] = std::sqrt(conic[0] * conic[2]) * T(1.5);  // not positive definite
+    for (double o : {1.0 / 300, 1.0 / 255, 0.0045, 0.02, 0.3, 0.99, 1.0}) {
+      for (int radius : {0, p.radius, 3 * p.radius + 1}) {
+        const T opacity = T(o);
+        int rx = -1, ry = -1;
+        alphaBox(radius, opacity, conic, &rx, &ry);
+        AlphaEllipse<T> e;
+        if (!alphaEllipse(mean, conic, opacity, &e)) {
+          EXPECT_EQ(rx, 0) << k << " " << o;
+          continue;
+        }
+        int ex = -1, ey = -1;
+        alphaBox(radius, e, &ex, &ey);
+        EXPECT_EQ(ex, rx) << k << " " << o << " " << radius;
+        EXPECT_EQ(ey, ry) << k << " " << o << " " << radius;
+        ++compared;
+        cut += rx > 0 && (rx < radius || ry < radius);
+      }
+    }
+  }
+  EXPECT_GT(compared, 1500);
+  EXPECT_GT(cut, 300) << "boxes cut below the radius are in the test";
+}
+
+TEST(Rasterizer, AlphaBoxFromTheEllipseIsAlphaBox) {
+  expectEllipseBoxesEqualAlphaBoxes<float>();
+  expectEllipseBoxesEqualAlphaBoxes<double>();
+}
+
 TEST(Rasterizer, AlphaEllipseMeetsEveryWarpRectangleAGaussianReaches) {
   // The CUDA kernels skip a Gaussian for a warp's 16 x 2 pixels when alphaEllipseMeetsRect says
   // no (the binning's warp masks): in float, as the kernels run it, no pixel centre of a skipped

@@ -146,11 +146,11 @@ Binning binGaussians(const T* means2d, const T* conics, const int* radii, const 
   std::vector<std::vector<int>> lists(num_tiles);
   for (int64_t i = 0; i < n; ++i) {
     const T opacity = std::abs(opacities[i]);  // a closed gate's (raster_backend.h) as if open
-    int rx, ry;
-    alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
-    if (rx <= 0) continue;
     AlphaEllipse<T> ellipse;
     if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) continue;
+    int rx, ry;
+    alphaBox(radii[i], ellipse, &rx, &ry);
+    if (rx <= 0) continue;
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {

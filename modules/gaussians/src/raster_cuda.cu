@@ -199,10 +199,12 @@ __global__ void countTilesKernel(int64_t n, const float* __restrict__ means2d,
   if (i >= n) return;
   int64_t count = 0;
   const float opacity = fabsf(opacities[i]);  // a closed gate's (raster_backend.h) as if open
-  int rx, ry;
-  alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
   AlphaEllipse<float> ellipse;
-  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
+  int rx = 0, ry = 0;
+  if (alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
+    alphaBox(radii[i], ellipse, &rx, &ry);
+  }
+  if (rx > 0) {
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     for (int ty = y0; ty < y1; ++ty) {
@@ -225,10 +227,12 @@ __global__ void writeKeysKernel(int64_t n, const float* __restrict__ means2d,
   int64_t out = i == 0 ? 0 : offsets[i - 1];
   const int64_t end = min(offsets[i], capacity);  // a list sized before the count may end early
   const float opacity = fabsf(opacities[i]);  // a closed gate's (raster_backend.h) as if open
-  int rx, ry;
-  alphaBox(radii[i], opacity, conics + 3 * i, &rx, &ry);
   AlphaEllipse<float> ellipse;
-  if (rx > 0 && alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
+  int rx = 0, ry = 0;
+  if (alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) {
+    alphaBox(radii[i], ellipse, &rx, &ry);
+  }
+  if (rx > 0) {
     int x0, y0, x1, y1;
     tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
     const int64_t depth_bits = static_cast<int64_t>(__float_as_uint(depths[i]));

@@ -514,6 +514,22 @@ SADSPLAT_HD bool alphaEllipse(const T mean2d[2], const T conic[3], T opacity, Al
   return true;
 }
 
+/// alphaBox from the Gaussian's alpha ellipse (filled by alphaEllipse, which returned true): the
+/// same box bit for bit — alphaExtent's k is sqrt(k2) / 3 and alphaEllipseHalfWidths' sx, sy
+/// take the same k2 and det — without taking the opacity's log again (alphaBox takes it twice).
+template <typename T>
+SADSPLAT_HD void alphaBox(int radius, const AlphaEllipse<T>& e, int* rx, int* ry) {
+  *rx = *ry = 0;
+  if (radius <= 0) return;
+  const T k = msqrt(e.k2) / T(3);
+  const int extent = !(k < T(1)) ? radius : static_cast<int>(mceil(k * T(radius)));
+  *rx = *ry = extent;
+  if (extent <= 0 || !(e.det > T(0))) return;
+  const T sx = msqrt(e.k2 * e.c / e.det), sy = msqrt(e.k2 * e.a / e.det);
+  if (sx < T(extent)) *rx = static_cast<int>(mceil(sx));
+  if (sy < T(extent)) *ry = static_cast<int>(mceil(sy));
+}
+
 /// Whether the alpha ellipse meets the rectangle of pixel centres [x0, x1] x [y0, y1]: the least
 /// d^T C d over the rectangle is <= k2. With the mean outside the rectangle the least value lies
 /// on an edge; on the edge x = x_e it is c (dy - dy*)^2 + det / c dx^2 with dy* = -b dx / c
