@@ -125,5 +125,38 @@ TEST(ImageMetrics, FusedCudaSsimMatchesTheReferenceValueAndGradient) {
   EXPECT_FALSE(gaussians::ssimIsFused(t, t));
 }
 
+// rgbLoss, the training's RGB loss: on the CPU exactly the composition of the L1 term and the
+// fused SSIM (the CPU trainings' bits); on CUDA one fused node with the composition's value and
+// gradient (pixels where the render equals the target included: the L1 term's gradient is 0 there).
+TEST(ImageMetrics, RgbLossIsTheCompositionOfL1AndSsim) {
+  using gaussians::rgbLoss;
+  at::manual_seed(3);
+  const at::Tensor b = at::rand({37, 53, 3});
+  at::Tensor a0 = at::rand({37, 53, 3});
+  a0.narrow(0, 0, 5).copy_(b.narrow(0, 0, 5));  // equal rows
+  const double lambda = 0.2;
+  const auto composed = [&](const at::Tensor& a, const at::Tensor& t) {
+    return (1 - lambda) * (a - t).abs().mean() + lambda * (1 - ssim(a, t));
+  };
+  const at::Tensor ref_a = a0.clone().requires_grad_(true);
+  const at::Tensor ref = composed(ref_a, b);
+  const at::Tensor ref_grad = torch::autograd::grad({ref}, {ref_a})[0];
+  const at::Tensor cpu_a = a0.clone().requires_grad_(true);
+  EXPECT_FALSE(gaussians::rgbLossIsFused(cpu_a, b));
+  const at::Tensor cpu = rgbLoss(cpu_a, b, lambda);
+  EXPECT_TRUE(at::equal(cpu, ref));
+  EXPECT_TRUE(at::equal(torch::autograd::grad({cpu}, {cpu_a})[0], ref_grad));
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  const at::Tensor cuda_a = a0.cuda().requires_grad_(true);
+  EXPECT_TRUE(gaussians::rgbLossIsFused(cuda_a, b.cuda()));
+  const at::Tensor cuda = rgbLoss(cuda_a, b.cuda(), lambda);
+  EXPECT_NEAR(cuda.item<float>(), ref.item<float>(), 1e-6);
+  const at::Tensor cuda_grad = torch::autograd::grad({cuda * 3.0}, {cuda_a})[0].cpu();
+  EXPECT_TRUE(at::allclose(cuda_grad, ref_grad * 3.0, 1e-4, 1e-9))
+      << (cuda_grad - ref_grad * 3.0).abs().max();
+  EXPECT_EQ(cuda_grad.narrow(0, 0, 5).abs().max().item<float>() > 0, true)
+      << "the SSIM term still reaches the equal rows";
+}
+
 }  // namespace
 }  // namespace sadsplat

@@ -72,6 +72,38 @@ class FusedSsim : public torch::autograd::Function<FusedSsim> {
   }
 };
 
+#if SADSPLAT_HAVE_CUDA
+// rgbLoss on CUDA: the fused SSIM and the L1 term in one node; gradient for `a` only.
+class FusedRgbLoss : public torch::autograd::Function<FusedRgbLoss> {
+ public:
+  static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a, const at::Tensor& b,
+                            double lambda_ssim) {
+    const ScopedPhase phase("SSIM");
+    const c10::cuda::CUDAGuard guard(a.device());
+    const at::Tensor ac = a.contiguous(), bc = b.contiguous();
+    const std::array<at::Tensor, 2> out = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
+    const at::Tensor diff = ac - bc;
+    ctx->save_for_backward({ac, bc, out[1], diff});
+    ctx->saved_data["lambda_ssim"] = lambda_ssim;
+    return diff.abs().mean().mul_(1 - lambda_ssim).add_(out[0].mean().neg_().add_(1), lambda_ssim);
+  }
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const at::Tensor &a = saved[0], &diff = saved[3];
+    const double lambda_ssim = ctx->saved_data["lambda_ssim"].toDouble();
+    const ScopedPhase phase("SSIM backward");
+    const c10::cuda::CUDAGuard guard(a.device());
+    const at::Tensor upstream = grads[0].to(at::kFloat);
+    // d/da of lambda (1 - mean SSIM) is -lambda x the SSIM's; of (1 - lambda) mean|a - b| it is
+    // (1 - lambda) sign(a - b) / N (abs' gradient at 0 is 0, as ATen's).
+    at::Tensor grad = ssim_fused::backwardCuda(
+        a, saved[1], saved[2], (upstream * -lambda_ssim).contiguous(), currentStream(a));
+    grad.add_(diff.sign().mul_(upstream * ((1 - lambda_ssim) / static_cast<double>(a.numel()))));
+    return {grad, at::Tensor(), at::Tensor()};
+  }
+};
+#endif
+
 }  // namespace
 
 at::Tensor ssimReference(const at::Tensor& a, const at::Tensor& b) {
@@ -107,6 +139,17 @@ bool ssimIsFused(const at::Tensor& a, const at::Tensor& b) {
 
 at::Tensor ssim(const at::Tensor& a, const at::Tensor& b) {
   return ssimIsFused(a, b) ? FusedSsim::apply(a, b) : ssimReference(a, b);
+}
+
+bool rgbLossIsFused(const at::Tensor& a, const at::Tensor& b) {
+  return a.is_cuda() && ssimIsFused(a, b);
+}
+
+at::Tensor rgbLoss(const at::Tensor& a, const at::Tensor& b, double lambda_ssim) {
+#if SADSPLAT_HAVE_CUDA
+  if (rgbLossIsFused(a, b)) return FusedRgbLoss::apply(a, b, lambda_ssim);
+#endif
+  return (1 - lambda_ssim) * (a - b).abs().mean() + lambda_ssim * (1 - ssim(a, b));
 }
 
 double psnr(const at::Tensor& a, const at::Tensor& b) {

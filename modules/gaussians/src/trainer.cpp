@@ -278,11 +278,15 @@ StepStats Trainer::step(bool read_losses) {
       const bool masked = !s.views.mask_is_full[v];
       const at::Tensor mask = masked ? s.views.masks[v].unsqueeze(2) : at::Tensor();
       const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
-      const at::Tensor l1 = masking((r.rgb - gt).abs()).mean();
+      // Unmasked with the fused SSIM: rgbLoss (on CUDA one autograd node; elsewhere this very
+      // composition).
       const at::Tensor rgb_loss =
-          (1 - c.lambda_ssim) * l1 +
-          c.lambda_ssim * (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
-                                             : ssimReference(masking(r.rgb), masking(gt))));
+          !masked && c.fused_ssim
+              ? rgbLoss(r.rgb, gt, c.lambda_ssim)
+              : (1 - c.lambda_ssim) * masking((r.rgb - gt).abs()).mean() +
+                    c.lambda_ssim *
+                        (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
+                                           : ssimReference(masking(r.rgb), masking(gt))));
       at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
       accumulate(rgb_sum, rgb_loss);
       if (role.semantic) {

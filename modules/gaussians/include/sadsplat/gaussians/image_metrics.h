@@ -17,6 +17,14 @@ at::Tensor ssim(const at::Tensor& a, const at::Tensor& b);
 at::Tensor ssimReference(const at::Tensor& a, const at::Tensor& b);
 /// \brief Whether ssim(a, b) takes the fused path.
 bool ssimIsFused(const at::Tensor& a, const at::Tensor& b);
+/// \brief The training's RGB loss of a render `a` against its target `b` (3DGS):
+/// (1 - lambda_ssim) mean|a - b| + lambda_ssim (1 - ssim(a, b)). On CUDA, where ssim is fused, it
+/// is one autograd node (the L1 term's gradient added in the SSIM's backward: ~7 fewer nodes and
+/// their operator calls per render for the host to issue); elsewhere the composition of ATen
+/// operations and ssim (whose bits the CPU trainings keep). The same values up to rounding.
+at::Tensor rgbLoss(const at::Tensor& a, const at::Tensor& b, double lambda_ssim);
+/// \brief Whether rgbLoss(a, b, ...) is the one fused node.
+bool rgbLossIsFused(const at::Tensor& a, const at::Tensor& b);
 /// \brief PSNR in dB of two images with values in [0, 1].
 double psnr(const at::Tensor& a, const at::Tensor& b);
 
