@@ -87,8 +87,9 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
   }
   using gaussians::raster::rasterizeBackwardCpu;
   using gaussians::raster::rasterizeForwardCpu;
-  const auto scalar = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
-                                          s.depths, width, height, CpuTileLoops::kScalar);
+  auto scalar = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii, s.depths,
+                                    width, height, CpuTileLoops::kScalar);
+  scalar.closed_gates = closed_share > 0;
   ASSERT_GT(scalar.alpha.max().item<float>(), coverage) << "the scene must cover pixels";
   at::manual_seed(static_cast<int64_t>(seed) + 1);
   const at::Tensor g_image = at::randn({height, width, D});
@@ -96,6 +97,15 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
   const auto gs = rasterizeBackwardCpu(s.means2d, s.conics, s.opacities, s.values, scalar, g_image,
                                        g_alpha, CpuTileLoops::kScalar);
   ASSERT_GT(gs.opacities.abs().sum().item<float>(), 0.f) << "the gradients must not all be 0";
+  if (closed_share > 0) {  // closed gates get opacity gradients, and only with the flag
+    const at::Tensor closed = s.opacities < 0;
+    EXPECT_GT(gs.opacities.masked_select(closed).abs().sum().item<float>(), 0.f);
+    auto unflagged = scalar;
+    unflagged.closed_gates = false;
+    const auto gu = rasterizeBackwardCpu(s.means2d, s.conics, s.opacities, s.values, unflagged,
+                                         g_image, g_alpha, CpuTileLoops::kScalar);
+    EXPECT_EQ(gu.opacities.masked_select(closed).abs().max().item<float>(), 0.f);
+  }
   const auto loops = vectorisedLoops();
   if (loops.empty()) GTEST_SKIP() << "this build or CPU has no vectorised tile loops";
   for (const auto& [l, name] : loops) {

@@ -48,9 +48,9 @@ struct Binning {
 /// gradient of the loss with respect to its opacity at 0: per pixel that it would reach with
 /// opacity o, G (dot - behind) T + the alpha term, exactly as for a contributor of alpha 0
 /// (raster_cpu_tiles.h, unblendClosedGate). Its other gradients are 0. Opacities >= 0 are
-/// rendered as always. The CPU backward does so wherever an opacity is negative; the CUDA
-/// backward only for a RasterResult with closed_gates set (a kernel of its own, so that renders
-/// without closed gates keep the kernel that has no such branch).
+/// rendered as always. Both backwards give that gradient only for a RasterResult with
+/// closed_gates set (on CUDA a kernel of its own, so that renders without closed gates keep the
+/// kernel that has no such branch); without it a closed gate gets no gradient at all.
 struct RasterResult {
   at::Tensor image;  ///< [H, W, D] composited channels (no background)
   at::Tensor alpha;  ///< [H, W] accumulated opacity, 1 - final transmittance

@@ -463,6 +463,7 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
       std::vector<T> scratch(static_cast<std::size_t>(cpu_lanes::backwardScratchFloats(D)));
       std::vector<T> grads;
       TileList<T> list;
+      list.closed_gates = fwd.closed_gates;
       for (int64_t k = first_run; k < end_run; ++k) {
         T* buf = buf_base + k * n * row;
         for (int tile = run_start[k]; tile < run_start[k + 1]; ++tile) {

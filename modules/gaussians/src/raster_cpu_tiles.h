@@ -74,6 +74,8 @@ struct TileList {
   std::vector<PackedGaussian<T>> gaussians;
   std::vector<T> values;
   const int* ids = nullptr;  // into the binning's gaussian_ids
+  // The backward gives closed gates (negative opacities, raster_backend.h) their gradient.
+  bool closed_gates = false;
 
   int size() const { return static_cast<int>(gaussians.size()); }
 
@@ -152,12 +154,12 @@ inline void unblendClosedGate(T G, const T* v, int64_t D, const T* gpix, T g_alp
 template <typename T>
 inline void unblendGaussian(const PackedGaussian<T>& p, const T* v, int64_t D, T fx, T fy,
                             const T* gpix, T g_alpha_out, T final_trans, T* trans, T* last_alpha,
-                            T* behind, T* last_dot, T* gb) {
+                            T* behind, T* last_dot, T* gb, bool closed_gates) {
   T G = T(0);
   bool clamped;
   const T alpha = pixelAlpha(p.mean2d, p.conic, p.opacity, fx, fy, &G, &clamped);
   if (alpha == T(0)) {
-    if (closedGateReaches(p.opacity, G)) {
+    if (closed_gates && closedGateReaches(p.opacity, G)) {
       unblendClosedGate(G, v, D, gpix, g_alpha_out, final_trans, *trans, last_alpha, behind,
                         last_dot, gb);
     }
@@ -225,7 +227,7 @@ void backwardTile(const TileList<T>& list, int64_t dynamic_d, int tx, int ty, in
       const PackedGaussian<T>& p = pg[j];
       if (gaussianPower(p.conic, p.mean2d[0] - fx, p.mean2d[1] - fy) < p.skip) continue;
       unblendGaussian(p, val + j * D, D, fx, fy, gpix, galpha[pix], final_trans, &trans,
-                      &last_alpha, &behind, &last_dot, grads + j * row);
+                      &last_alpha, &behind, &last_dot, grads + j * row, list.closed_gates);
     }
   });
 }
@@ -361,7 +363,7 @@ void backwardTileRows(const TileList<float>& list, int64_t dynamic_d, int tx, in
         const int l = __builtin_ctz(bits);
         unblendGaussian(p, val + j * D, D, float(x0 + l) + 0.5f, fy, gimg + (pix0 + l) * D,
                         g_out[l], final_trans[l], &trans[l], &last_alpha[l], &behind[l],
-                        &last_dot[l], gb);
+                        &last_dot[l], gb, list.closed_gates);
       }
       std::copy(gb, gb + grad_row, gj);
     }
