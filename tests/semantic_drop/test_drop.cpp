@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <vector>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
@@ -243,6 +244,28 @@ TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
   c.lambda_l0_from = 0;
   c.lambda_l0_ramp = -5;
   EXPECT_THROW(makeDropStrategy(c), Error);
+}
+
+// --closed-gate-gradients reaches the training: the same 20 steps on the tiny scene end with other
+// gates with it than without it (gates sampled shut got gradients), and the same gates when run
+// twice with it.
+TEST(DropStrategy, ClosedGateGradientsReachTheGates) {
+  const io::Scene scene = tinyScene();
+  const auto gates_after = [&](bool closed_gate_gradients) {
+    gaussians::TrainConfig c = tinyDropConfig(20, "structure", 1000);
+    c.log_alpha_init = 0.0;  // ~17 % of the gates sampled shut in each step
+    c.closed_gate_gradients = closed_gate_gradients;
+    gaussians::Trainer trainer(scene, c);
+    trainer.setDropStrategy(makeDropStrategy(c));
+    for (int i = 0; i < 20; ++i) trainer.step();
+    std::vector<float> log_alpha;
+    for (const auto& p : trainer.toCloud()) log_alpha.push_back(p.log_alpha);
+    return log_alpha;
+  };
+  const std::vector<float> plain = gates_after(false), with = gates_after(true);
+  ASSERT_EQ(plain.size(), with.size());
+  EXPECT_NE(plain, with);
+  EXPECT_EQ(with, gates_after(true));
 }
 
 TEST(DropStrategy, L0WeightFollowsItsSchedule) {
