@@ -2,9 +2,12 @@
 // AVX-512 lanes of raster_cpu_lanes.h, each where this CPU runs it) against its scalar reference
 // loops: images, alphas, last contributors and every gradient must be bit-identical, in images
 // whose edge tiles have partial rows and with lists long enough for pixels to saturate.
+#include <ATen/Parallel.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -201,6 +204,64 @@ TEST(RasterCpuPaths, ClosedGatesAreBitIdentical) {
 // rowRange directly: on the first pixel-centre rows outside the range of random Gaussians (thin
 // ones and high opacities included), no pixel of a wide span of x passes the skip test as the
 // vectorised loops compute it (gaussianPower in float).
+// The tile lists of the CPU binning: each tile holds exactly the Gaussians whose alpha ellipse
+// meets it, ordered by (float depth, id) — the order the CUDA backend's stable sort gives —
+// whatever the thread count. Depths rounded to quarters give many equal depths, so ties must
+// keep the ids' order, in lists both short (a plain sort) and long (the radix sort); more
+// Gaussians than one binning run.
+TEST(RasterCpuPaths, TileListsAreInDepthThenIdOrderWithAnyThreadCount) {
+  const int width = 70, height = 50;
+  const CameraParams cam = frontCamera(width, height, 60.0);
+  Scene s = projectedScene(9000, 3, cam, 21, 0.9);
+  s.depths = at::round(s.depths * 4) / 4;
+  // Reference: per tile, the ids that meet it (in id order), stable-sorted by depth.
+  const auto [tiles_x, tiles_y] = gaussians::raster::tileGrid(width, height);
+  std::vector<std::vector<int>> expected(static_cast<std::size_t>(tiles_x * tiles_y));
+  const float* m2 = s.means2d.data_ptr<float>();
+  const float* co = s.conics.data_ptr<float>();
+  const float* op = s.opacities.data_ptr<float>();
+  const float* depth = s.depths.data_ptr<float>();
+  const int* radii = s.radii.data_ptr<int>();
+  for (int i = 0; i < 9000; ++i) {
+    gaussians::raster::AlphaEllipse<float> e;
+    if (!gaussians::raster::alphaEllipse(m2 + 2 * i, co + 3 * i, op[i], &e)) continue;
+    int rx, ry;
+    gaussians::raster::alphaBox(radii[i], e, &rx, &ry);
+    if (rx <= 0) continue;
+    int x0, y0, x1, y1;
+    gaussians::raster::tileRect(m2 + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+    for (int ty = y0; ty < y1; ++ty) {
+      for (int tx = x0; tx < x1; ++tx) {
+        if (gaussians::raster::alphaEllipseMeetsTile(e, tx, ty)) {
+          expected[ty * tiles_x + tx].push_back(i);
+        }
+      }
+    }
+  }
+  std::size_t longest = 0, shortest = SIZE_MAX;
+  for (auto& list : expected) {
+    std::stable_sort(list.begin(), list.end(), [&](int a, int b) { return depth[a] < depth[b]; });
+    longest = std::max(longest, list.size());
+    shortest = std::min(shortest, list.size());
+  }
+  ASSERT_GT(longest, 1000u);  // the radix sort's lists
+  ASSERT_LE(shortest, 64u);   // and the short ones'
+  const int threads = at::get_num_threads();
+  for (const int t : {1, 2, 3}) {
+    at::set_num_threads(t);
+    const auto r =
+        gaussians::raster::rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
+                                               s.depths, width, height, CpuTileLoops::kFastest);
+    const int* ranges = r.binning.tile_ranges.data_ptr<int>();
+    const int* ids = r.binning.gaussian_ids.data_ptr<int>();
+    for (int tile = 0; tile < tiles_x * tiles_y; ++tile) {
+      const std::vector<int> got(ids + ranges[2 * tile], ids + ranges[2 * tile + 1]);
+      ASSERT_EQ(got, expected[tile]) << "tile " << tile << ", " << t << " threads";
+    }
+  }
+  at::set_num_threads(threads);
+}
+
 TEST(RasterCpuPaths, NoPixelOutsideTheRowRangePassesTheSkipTest) {
   at::manual_seed(7);
   const int n = 20000;

@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "raster_backend.h"
@@ -136,54 +139,124 @@ std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::
 
 namespace {
 
+// A float's bits as an unsigned integer of the same order (negative values flipped): sorting
+// these orders as the float `<` does, except that -0 sorts before +0 (binned depths lie beyond
+// the near plane, so neither occurs).
+inline std::uint32_t orderedBits(float value) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &value, sizeof bits);
+  return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+}
+
+// Sorts (depth bits << 32 | id) keys whose ids ascend: by the whole key (short lists) or by the
+// depth bits alone with a stable radix sort (a pass per byte, skipped where every key has the
+// same byte), which keeps the ids' order among equal depths — the same order either way.
+inline void sortByDepthKeepingIdOrder(std::uint64_t* keys, int64_t count,
+                                      std::vector<std::uint64_t>* scratch) {
+  if (count <= 64) {
+    std::sort(keys, keys + count);
+    return;
+  }
+  scratch->resize(static_cast<std::size_t>(count));
+  std::uint64_t* from = keys;
+  std::uint64_t* to = scratch->data();
+  for (int shift = 32; shift < 64; shift += 8) {
+    int64_t offsets[256] = {};
+    for (int64_t k = 0; k < count; ++k) ++offsets[(from[k] >> shift) & 0xff];
+    if (offsets[(from[0] >> shift) & 0xff] == count) continue;
+    int64_t sum = 0;
+    for (int64_t& offset : offsets) {
+      const int64_t c = offset;
+      offset = sum;
+      sum += c;
+    }
+    for (int64_t k = 0; k < count; ++k) to[offsets[(from[k] >> shift) & 0xff]++] = from[k];
+    std::swap(from, to);
+  }
+  if (from != keys) std::copy(from, from + count, keys);
+}
+
 // Per-tile lists sorted by (depth, id): the same order the CUDA backend's stable sort gives.
+// Gaussians are binned in fixed runs of kBinningRun ids, each run on one thread into its own
+// (tile, id) pairs in id order; each tile's entries are then laid out run after run (so in id
+// order) as (depth, id) keys and sorted: the result does not depend on the thread count.
+constexpr int64_t kBinningRun = 4096;
+
 template <typename T>
 Binning binGaussians(const T* means2d, const T* conics, const int* radii, const T* opacities,
                      const T* depths, int64_t n, int width, int height) {
   const ScopedPhase phase("binning");
   const auto [tiles_x, tiles_y] = tileGrid(width, height);
   const int num_tiles = tiles_x * tiles_y;
-  std::vector<std::vector<int>> lists(num_tiles);
-  for (int64_t i = 0; i < n; ++i) {
-    const T opacity = std::abs(opacities[i]);  // a closed gate's (raster_backend.h) as if open
-    AlphaEllipse<T> ellipse;
-    if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) continue;
-    int rx, ry;
-    alphaBox(radii[i], ellipse, &rx, &ry);
-    if (rx <= 0) continue;
-    int x0, y0, x1, y1;
-    tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
-    for (int ty = y0; ty < y1; ++ty) {
-      for (int tx = x0; tx < x1; ++tx) {
-        if (alphaEllipseMeetsTile(ellipse, tx, ty)) {
-          lists[ty * tiles_x + tx].push_back(static_cast<int>(i));
+  const int64_t runs = (n + kBinningRun - 1) / kBinningRun;
+  std::vector<std::vector<std::pair<int, int>>> hits(static_cast<std::size_t>(runs));
+  // counts[run * num_tiles + tile]: then, after the prefix sum, where the run's entries of the
+  // tile start.
+  std::vector<int64_t> counts(static_cast<std::size_t>(runs * num_tiles), 0);
+  at::parallel_for(0, runs, 1, [&](int64_t run_begin, int64_t run_end) {
+    for (int64_t run = run_begin; run < run_end; ++run) {
+      auto& run_hits = hits[run];
+      int64_t* run_counts = counts.data() + run * num_tiles;
+      const int64_t last = std::min(n, (run + 1) * kBinningRun);
+      for (int64_t i = run * kBinningRun; i < last; ++i) {
+        if (radii[i] <= 0) continue;               // culled in projection (alphaBox would give 0)
+        const T opacity = std::abs(opacities[i]);  // a closed gate's (raster_backend.h) as if open
+        AlphaEllipse<T> ellipse;
+        if (!alphaEllipse(means2d + 2 * i, conics + 3 * i, opacity, &ellipse)) continue;
+        int rx, ry;
+        alphaBox(radii[i], ellipse, &rx, &ry);
+        if (rx <= 0) continue;
+        int x0, y0, x1, y1;
+        tileRect(means2d + 2 * i, rx, ry, tiles_x, tiles_y, &x0, &y0, &x1, &y1);
+        for (int ty = y0; ty < y1; ++ty) {
+          for (int tx = x0; tx < x1; ++tx) {
+            if (alphaEllipseMeetsTile(ellipse, tx, ty)) {
+              const int tile = ty * tiles_x + tx;
+              run_hits.emplace_back(tile, static_cast<int>(i));
+              ++run_counts[tile];
+            }
+          }
         }
       }
     }
-  }
+  });
   Binning b;
-  b.tile_ranges = at::zeros({num_tiles, 2}, at::TensorOptions().dtype(at::kInt));
+  b.tile_ranges = at::empty({num_tiles, 2}, at::TensorOptions().dtype(at::kInt));
   int* ranges = b.tile_ranges.data_ptr<int>();
   int64_t total = 0;
-  for (int t = 0; t < num_tiles; ++t) total += static_cast<int64_t>(lists[t].size());
+  for (int t = 0; t < num_tiles; ++t) {
+    ranges[2 * t] = static_cast<int>(total);
+    for (int64_t run = 0; run < runs; ++run) {
+      const int64_t count = counts[run * num_tiles + t];
+      counts[run * num_tiles + t] = total;
+      total += count;
+    }
+    ranges[2 * t + 1] = static_cast<int>(total);
+  }
+  std::vector<std::uint64_t> keys(static_cast<std::size_t>(total));
+  at::parallel_for(0, runs, 1, [&](int64_t run_begin, int64_t run_end) {
+    for (int64_t run = run_begin; run < run_end; ++run) {
+      int64_t* next = counts.data() + run * num_tiles;
+      for (const auto& [tile, id] : hits[run]) {
+        keys[next[tile]++] =
+            (static_cast<std::uint64_t>(orderedBits(static_cast<float>(depths[id]))) << 32) |
+            static_cast<std::uint32_t>(id);
+      }
+    }
+  });
   b.gaussian_ids = at::empty({total}, at::TensorOptions().dtype(at::kInt));
   int* ids = b.gaussian_ids.data_ptr<int>();
   at::parallel_for(0, num_tiles, 16, [&](int64_t begin, int64_t end) {
+    std::vector<std::uint64_t> scratch;
     for (int64_t t = begin; t < end; ++t) {
-      auto& list = lists[t];
-      // Sorting by float depth, ties by id, matches the CUDA key (depth bits of a float).
-      std::stable_sort(list.begin(), list.end(), [&](int a, int c) {
-        return static_cast<float>(depths[a]) < static_cast<float>(depths[c]);
-      });
+      std::uint64_t* first = keys.data() + ranges[2 * t];
+      const int64_t count = ranges[2 * t + 1] - ranges[2 * t];
+      sortByDepthKeepingIdOrder(first, count, &scratch);
+      for (int64_t k = 0; k < count; ++k) {
+        ids[ranges[2 * t] + k] = static_cast<int>(first[k] & 0xffffffffu);
+      }
     }
   });
-  int offset = 0;
-  for (int t = 0; t < num_tiles; ++t) {
-    ranges[2 * t] = offset;
-    std::copy(lists[t].begin(), lists[t].end(), ids + offset);
-    offset += static_cast<int>(lists[t].size());
-    ranges[2 * t + 1] = offset;
-  }
   return b;
 }
 
@@ -194,11 +267,13 @@ Binning binGaussians(const T* means2d, const T* conics, const int* radii, const 
 template <typename T>
 std::vector<T> skipThresholds(const T* opacities, int64_t n) {
   std::vector<T> thresholds(static_cast<std::size_t>(n));
-  for (int64_t i = 0; i < n; ++i) {
-    const T opacity = std::abs(opacities[i]);
-    thresholds[i] = opacity > T(0) ? std::log(T(kMinAlpha) / opacity) - T(1e-3)
-                                   : std::numeric_limits<T>::infinity();
-  }
+  at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const T opacity = std::abs(opacities[i]);
+      thresholds[i] = opacity > T(0) ? std::log(T(kMinAlpha) / opacity) - T(1e-3)
+                                     : std::numeric_limits<T>::infinity();
+    }
+  });
   return thresholds;
 }
 
