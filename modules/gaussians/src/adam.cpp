@@ -122,7 +122,7 @@ void adamSteps(std::vector<AdamTensors>& tensors, std::int64_t step, const AdamS
     for (AdamTensors& t : tensors) {
       grads.push_back(checkedGradient(t.value, t.grad, t.m, t.v, step));
       const int k = batch.count++;
-      batch.value[k] = t.value.detach().data_ptr<float>();
+      batch.value[k] = t.value.data_ptr<float>();  // updated outside autograd
       batch.grad[k] = grads.back().defined() ? grads.back().data_ptr<float>() : nullptr;
       batch.m[k] = t.m.data_ptr<float>();
       batch.v[k] = t.v.data_ptr<float>();

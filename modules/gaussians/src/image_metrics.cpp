@@ -81,24 +81,22 @@ class FusedRgbLoss : public torch::autograd::Function<FusedRgbLoss> {
     const ScopedPhase phase("SSIM");
     const c10::cuda::CUDAGuard guard(a.device());
     const at::Tensor ac = a.contiguous(), bc = b.contiguous();
-    const std::array<at::Tensor, 2> out = ssim_fused::forwardCuda(ac, bc, currentStream(ac));
-    const at::Tensor diff = ac - bc;
-    ctx->save_for_backward({ac, bc, out[1], diff});
+    const auto lambda = static_cast<float>(lambda_ssim);
+    auto [loss, workspace] = ssim_fused::rgbLossForwardCuda(ac, bc, lambda, currentStream(ac));
+    ctx->save_for_backward({ac, bc, workspace});
     ctx->saved_data["lambda_ssim"] = lambda_ssim;
-    return diff.abs().mean().mul_(1 - lambda_ssim).add_(out[0].mean().neg_().add_(1), lambda_ssim);
+    return loss;
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const at::Tensor &a = saved[0], &diff = saved[3];
-    const double lambda_ssim = ctx->saved_data["lambda_ssim"].toDouble();
+    const at::Tensor& a = saved[0];
+    const auto lambda = static_cast<float>(ctx->saved_data["lambda_ssim"].toDouble());
     const ScopedPhase phase("SSIM backward");
     const c10::cuda::CUDAGuard guard(a.device());
-    const at::Tensor upstream = grads[0].to(at::kFloat);
-    // d/da of lambda (1 - mean SSIM) is -lambda x the SSIM's; of (1 - lambda) mean|a - b| it is
-    // (1 - lambda) sign(a - b) / N (abs' gradient at 0 is 0, as ATen's).
-    at::Tensor grad = ssim_fused::backwardCuda(
-        a, saved[1], saved[2], (upstream * -lambda_ssim).contiguous(), currentStream(a));
-    grad.add_(diff.sign().mul_(upstream * ((1 - lambda_ssim) / static_cast<double>(a.numel()))));
+    const at::Tensor& upstream =
+        grads[0].scalar_type() == at::kFloat ? grads[0] : grads[0].to(at::kFloat);
+    at::Tensor grad =
+        ssim_fused::rgbLossBackwardCuda(a, saved[1], saved[2], upstream, lambda, currentStream(a));
     return {grad, at::Tensor(), at::Tensor()};
   }
 };

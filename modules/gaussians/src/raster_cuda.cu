@@ -290,7 +290,8 @@ std::pair<at::Tensor, at::Tensor> sortByTileAndDepth(const at::Tensor& keys,
   const int end_bit = 32 + tile_bits;
   using Key = unsigned long long;  // keys are non-negative: the unsigned order is the same
   const auto* keys_in = reinterpret_cast<const Key*>(keys.data_ptr<int64_t>());
-  at::Tensor sorted_keys = at::empty_like(keys), sorted_values = at::empty_like(values);
+  at::Tensor sorted_keys = at::empty({m}, keys.options()),
+             sorted_values = at::empty({m}, values.options());
   auto* keys_out = reinterpret_cast<Key*>(sorted_keys.data_ptr<int64_t>());
   std::size_t temp_bytes = 0;
   cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys_in, keys_out, values.data_ptr<int>(),
@@ -322,7 +323,9 @@ Binning binGaussians(const at::Tensor& means2d, const at::Tensor& conics, const 
   const auto opts = means2d.options();
   Binning b;
   b.warps_packed = packsWarpBits(n);
-  b.tile_ranges = at::zeros({num_tiles, 2}, opts.dtype(at::kInt));
+  b.tile_ranges = at::empty({num_tiles, 2}, opts.dtype(at::kInt));  // tiles without entries: 0, 0
+  cudaMemsetAsync(b.tile_ranges.data_ptr<int>(), 0, 2 * sizeof(int) * num_tiles, stream);
+  checkLaunch("cudaMemsetAsync of the tile ranges");
   if (n == 0) {
     b.gaussian_ids = at::empty({0}, opts.dtype(at::kInt));
     return b;
@@ -1029,14 +1032,17 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
   const int64_t D = values.size(1);
   const int height = static_cast<int>(fwd.alpha.size(0));
   const int width = static_cast<int>(fwd.alpha.size(1));
-  // The kernel adds into the four gradients: one zero fill for all, contiguous parts of it.
+  // The kernel adds into the four gradients: one allocation cleared at once, contiguous parts of
+  // it (as_strided: one operator call each, where narrow and view take four).
   const int64_t n = means2d.size(0);
-  const at::Tensor zeros = at::zeros({n * (2 + 3 + 1 + D)}, values.options());
+  const at::Tensor zeros = at::empty({n * (2 + 3 + 1 + D)}, values.options());
+  cudaMemsetAsync(zeros.data_ptr<float>(), 0, zeros.numel() * sizeof(float), stream);
+  checkLaunch("cudaMemsetAsync of the gradients");
   RasterGrads g;
-  g.means2d = zeros.narrow(0, 0, 2 * n).view({n, 2});
-  g.conics = zeros.narrow(0, 2 * n, 3 * n).view({n, 3});
-  g.opacities = zeros.narrow(0, 5 * n, n).view(opacities.sizes());
-  g.values = zeros.narrow(0, 6 * n, D * n).view({n, D});
+  g.means2d = zeros.as_strided({n, 2}, {2, 1}, 0);
+  g.conics = zeros.as_strided({n, 3}, {3, 1}, 2 * n);
+  g.opacities = zeros.as_strided(opacities.sizes(), {1}, 5 * n);
+  g.values = zeros.as_strided({n, D}, {D, 1}, 6 * n);
   const float* g_alpha_ptr = g_alpha.defined() ? g_alpha.data_ptr<float>() : nullptr;
   const int tiles_x = tileGrid(width, height).first;
   const int num_tiles = static_cast<int>(fwd.binning.tile_ranges.size(0));

@@ -28,26 +28,27 @@ class FusedSemanticLoss : public torch::autograd::Function<FusedSemanticLoss> {
     const ScopedPhase phase("semantic loss");
     const c10::cuda::CUDAGuard guard(features.device());
     // The rasterizer's feature image is a slice of its [H, W, 3 + D] output: read in place when
-    // the pixels can be addressed with one stride (reshape then gives a view).
-    at::Tensor f = features.reshape({-1, features.size(-1)});
-    if (f.stride(1) != 1) f = f.contiguous();
-    const at::Tensor l = labels.reshape({-1}).contiguous();
+    // the pixels can be addressed with one stride.
+    const bool one_stride =
+        features.stride(2) == 1 && features.stride(0) == features.size(1) * features.stride(1);
+    const at::Tensor f = one_stride ? features : features.contiguous();
+    const at::Tensor l = labels.is_contiguous() ? labels : labels.contiguous();
     const at::Tensor w = weight.contiguous(), b = bias.contiguous();
-    const at::Tensor sums = semantic_loss_fused::forwardCuda(f, l, w, b, currentStream(f));
+    auto [sums, loss] = semantic_loss_fused::forwardCuda(f, l, w, b, currentStream(f));
     ctx->save_for_backward({f, l, w, b, sums});
-    ctx->saved_data["shape"] = features.sizes().vec();
-    return (sums[0] / sums[1].clamp_min(1)).to(at::kFloat);
+    return loss;
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const at::Tensor &f = saved[0], &w = saved[2];
     const ScopedPhase phase("semantic loss backward");
     const c10::cuda::CUDAGuard guard(f.device());
-    const at::Tensor upstream = grads[0].to(at::kFloat).contiguous();
+    const at::Tensor& upstream =
+        grads[0].scalar_type() == at::kFloat ? grads[0] : grads[0].to(at::kFloat);
     const bool decoder = ctx->needs_input_grad(2) || ctx->needs_input_grad(3);
     auto [grad_f, grad_w, grad_b] = semantic_loss_fused::backwardCuda(
         f, saved[1], w, saved[3], saved[4], upstream, decoder, currentStream(f));
-    return {grad_f.view(ctx->saved_data["shape"].toIntVector()), at::Tensor(), grad_w, grad_b};
+    return {grad_f, at::Tensor(), grad_w, grad_b};
   }
 };
 #endif

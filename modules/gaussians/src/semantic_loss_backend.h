@@ -20,15 +20,17 @@ constexpr int kMaxChannels = 32;
 constexpr int kMaxClasses = 16;
 
 #if SADSPLAT_COMPILE_CUDA
-/// [2] float64 on the device: the sum of the supervised pixels' losses and their count.
-/// features [P, D] float32 with unit channel stride (any pixel stride: a slice of the rasterizer's
-/// image is read in place), labels [P] int64, weight [C, D] and bias [C] contiguous float32, all
-/// on the current CUDA device; stream a cudaStream_t. The gradient of the features is contiguous.
-at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
-                       const at::Tensor& weight, const at::Tensor& bias, void* stream);
-/// {d(upstream * loss)/d features [P, D], .../d weight [C, D], .../d bias [C]} given forwardCuda's
-/// sums; `upstream` a float32 scalar tensor on the device (no host synchronisation). The decoder's
-/// gradients are undefined unless `decoder`.
+/// {[2] float64: the sum of the supervised pixels' losses and their count; the loss, a float32
+/// scalar} on the device. features [H, W, D] float32 with unit channel stride and one pixel
+/// stride (stride(0) = W stride(1): a slice of the rasterizer's image is read in place), labels
+/// [H, W] contiguous int64, weight [C, D] and bias [C] contiguous float32, all on the current
+/// CUDA device; stream a cudaStream_t.
+std::array<at::Tensor, 2> forwardCuda(const at::Tensor& features, const at::Tensor& labels,
+                                      const at::Tensor& weight, const at::Tensor& bias,
+                                      void* stream);
+/// {d(upstream * loss)/d features [H, W, D] (contiguous), .../d weight [C, D], .../d bias [C]}
+/// given forwardCuda's sums; `upstream` a float32 scalar tensor on the device (no host
+/// synchronisation). The decoder's gradients are undefined unless `decoder`.
 std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Tensor& labels,
                                        const at::Tensor& weight, const at::Tensor& bias,
                                        const at::Tensor& sums, const at::Tensor& upstream,

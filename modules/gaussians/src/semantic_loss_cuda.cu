@@ -209,6 +209,11 @@ __global__ void lossBackward(const float* features, int64_t ld, const int64_t* l
   for (int k = threadIdx.x; k < C; k += blockDim.x) atomicAdd(&grad_b[k], block_grad[C * D + k]);
 }
 
+// The loss from forwardCuda's sums, as the reference divides: sum / max(count, 1), in float.
+__global__ void lossValue(const double* sums, float* loss) {
+  *loss = static_cast<float>(sums[0] / fmax(sums[1], 1.0));
+}
+
 void check(const char* what) { checkCudaLaunch("<semantic loss>", what); }
 
 static_assert(kMaxChannels <= 32, "a lane holds one channel");
@@ -225,18 +230,25 @@ unsigned gridFor(int64_t P) {
 
 }  // namespace
 
-at::Tensor forwardCuda(const at::Tensor& features, const at::Tensor& labels,
-                       const at::Tensor& weight, const at::Tensor& bias, void* stream_ptr) {
+std::array<at::Tensor, 2> forwardCuda(const at::Tensor& features, const at::Tensor& labels,
+                                      const at::Tensor& weight, const at::Tensor& bias,
+                                      void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
-  const int64_t P = features.size(0);
-  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0))};
-  at::Tensor sums = at::zeros({2}, features.options().dtype(at::kDouble));
-  if (P == 0) return sums;
-  lossForward<<<gridFor(P), 32 * kWarps, L.bytes(false), stream>>>(
-      features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
-      weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>());
-  check("lossForward");
-  return sums;
+  const int64_t P = labels.numel();
+  const Layout L{static_cast<int>(features.size(2)), static_cast<int>(weight.size(0))};
+  at::Tensor sums = at::empty({2}, features.options().dtype(at::kDouble));
+  at::Tensor loss = at::empty({}, features.options());
+  cudaMemsetAsync(sums.data_ptr<double>(), 0, 2 * sizeof(double), stream);
+  check("cudaMemsetAsync of the sums");
+  if (P > 0) {
+    lossForward<<<gridFor(P), 32 * kWarps, L.bytes(false), stream>>>(
+        features.data_ptr<float>(), features.stride(1), labels.data_ptr<int64_t>(),
+        weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>());
+    check("lossForward");
+  }
+  lossValue<<<1, 1, 0, stream>>>(sums.data_ptr<double>(), loss.data_ptr<float>());
+  check("lossValue");
+  return {sums, loss};
 }
 
 std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Tensor& labels,
@@ -244,17 +256,21 @@ std::array<at::Tensor, 3> backwardCuda(const at::Tensor& features, const at::Ten
                                        const at::Tensor& sums, const at::Tensor& upstream,
                                        bool decoder, void* stream_ptr) {
   const auto stream = static_cast<cudaStream_t>(stream_ptr);
-  const int64_t P = features.size(0);
-  const Layout L{static_cast<int>(features.size(1)), static_cast<int>(weight.size(0))};
-  at::Tensor grad_features = at::empty({P, L.D}, features.options());
+  const int64_t P = labels.numel();
+  const Layout L{static_cast<int>(features.size(2)), static_cast<int>(weight.size(0))};
+  at::Tensor grad_features = at::empty(features.sizes(), features.options());
   at::Tensor grad_w, grad_b;
   if (decoder) {
-    grad_w = at::zeros_like(weight);
-    grad_b = at::zeros_like(bias);
+    // The kernel adds into them: cleared here without ATen's zero-fill operators.
+    grad_w = at::empty(weight.sizes(), weight.options());
+    grad_b = at::empty(bias.sizes(), bias.options());
+    cudaMemsetAsync(grad_w.data_ptr<float>(), 0, grad_w.numel() * sizeof(float), stream);
+    cudaMemsetAsync(grad_b.data_ptr<float>(), 0, grad_b.numel() * sizeof(float), stream);
+    check("cudaMemsetAsync of the decoder's gradients");
   }
   if (P == 0) return {grad_features, grad_w, grad_b};
   lossBackward<<<gridFor(P), 32 * kWarps, L.bytes(true), stream>>>(
-      features.data_ptr<float>(), features.stride(0), labels.data_ptr<int64_t>(),
+      features.data_ptr<float>(), features.stride(1), labels.data_ptr<int64_t>(),
       weight.data_ptr<float>(), bias.data_ptr<float>(), P, L, sums.data_ptr<double>(),
       upstream.data_ptr<float>(), grad_features.data_ptr<float>(),
       decoder ? grad_w.data_ptr<float>() : nullptr, decoder ? grad_b.data_ptr<float>() : nullptr);

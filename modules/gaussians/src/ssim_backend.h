@@ -32,6 +32,15 @@ std::array<at::Tensor, 2> forwardCuda(const at::Tensor& a, const at::Tensor& b, 
 /// scalar tensor on the device.
 at::Tensor backwardCuda(const at::Tensor& a, const at::Tensor& b, const at::Tensor& partials,
                         const at::Tensor& upstream, void* stream);
+/// The training's RGB loss (1 - lambda) mean|a - b| + lambda (1 - mean SSIM(a, b)) as a float32
+/// scalar on the device (the means summed in a fixed order: no atomics), and the workspace that
+/// rgbLossBackwardCuda takes (it holds forwardCuda's partials). Two allocations and three kernels.
+std::array<at::Tensor, 2> rgbLossForwardCuda(const at::Tensor& a, const at::Tensor& b, float lambda,
+                                             void* stream);
+/// d(upstream * loss)/da, [H, W, 3]; reuses part of `workspace` as scratch (the partials stay).
+at::Tensor rgbLossBackwardCuda(const at::Tensor& a, const at::Tensor& b,
+                               const at::Tensor& workspace, const at::Tensor& upstream,
+                               float lambda, void* stream);
 #endif
 
 }  // namespace ssim_fused
