@@ -104,6 +104,34 @@ TEST(StepProfile, EachPhaseCountsItsOwnOperatorCallsOnceWhateverTheNumberOfProfi
   EXPECT_NE(profile.table().find(" | 3.0 |"), std::string::npos);
 }
 
+TEST(StepProfile, TheOperatorTableNamesEachPhasesOperatorsPerIteration) {
+  StepProfile profile(at::Device(at::kCPU), StepProfile::Clock::kHost);
+  const at::Tensor x = at::ones({4});
+  at::Tensor y = x;
+  {
+    const gaussians::ActiveProfileScope active(&profile);
+    for (int iteration = 0; iteration < 2; ++iteration) {
+      profile.enter("adds");
+      for (int i = 0; i < 3; ++i) y = at::add(y, x);
+      profile.enter("outer");
+      {
+        const gaussians::ScopedPhase inner("inner");
+        y = at::mul(y, x);
+      }
+      profile.leave();
+      profile.countIteration();
+    }
+  }
+  y = at::sub(y, x);  // no active profile: not in the table
+  const std::string table = profile.operatorTable();
+  EXPECT_NE(table.find("**adds**: 3.0 calls per iteration"), std::string::npos) << table;
+  EXPECT_NE(table.find("- 3.00 `aten::add`"), std::string::npos) << table;
+  EXPECT_NE(table.find("**outer / inner**: 1.0 calls per iteration"), std::string::npos) << table;
+  EXPECT_NE(table.find("- 1.00 `aten::mul`"), std::string::npos) << table;
+  EXPECT_EQ(table.find("aten::sub"), std::string::npos) << table;
+  EXPECT_EQ(table.find("**outer**"), std::string::npos) << table;  // no call of its own
+}
+
 TEST(StepProfile, TheActiveProfileScopeRestoresThePreviousOne) {
   StepProfile a(at::Device(at::kCPU)), b(at::Device(at::kCPU));
   EXPECT_EQ(gaussians::activeProfile(), nullptr);

@@ -49,7 +49,8 @@ class TrainCommand : public Command {
         ->check(CLI::IsMember({"paper", "long"}));
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "
-                "and count its ATen operator calls; writes RUN/profile.md");
+                "and count its ATen operator calls; writes RUN/profile.md and, operator by "
+                "operator, RUN/profile_operators.md");
     c->add_flag("--profile-host", profile_host_,
                 "as --profile on the host's clock: no phase waits for the GPU, so each phase "
                 "gets the time the CPU spent issuing its work (or waiting for a value)")

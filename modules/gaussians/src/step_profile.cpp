@@ -26,16 +26,24 @@ std::mutex g_counter_mutex;
 int g_counting_profiles = 0;
 at::CallbackHandle g_counter_handle = 0;
 
-std::unique_ptr<at::ObserverContext> countOperatorCall(const at::RecordFunction&) {
-  g_operator_calls.fetch_add(1, std::memory_order_relaxed);
-  return nullptr;
-}
+}  // namespace
+
+struct OperatorCallObserver {
+  static std::unique_ptr<at::ObserverContext> onCall(const at::RecordFunction& fn) {
+    g_operator_calls.fetch_add(1, std::memory_order_relaxed);
+    if (StepProfile* profile = g_active.load()) profile->recordOperator(fn.name());
+    return nullptr;
+  }
+};
+
+namespace {
 
 void startCountingOperatorCalls() {
   const std::lock_guard<std::mutex> lock(g_counter_mutex);
   if (g_counting_profiles++ == 0) {
-    g_counter_handle = at::addGlobalCallback(
-        at::RecordFunctionCallback(countOperatorCall).scopes({at::RecordScope::FUNCTION}));
+    g_counter_handle =
+        at::addGlobalCallback(at::RecordFunctionCallback(OperatorCallObserver::onCall)
+                                  .scopes({at::RecordScope::FUNCTION}));
   }
 }
 
@@ -124,6 +132,7 @@ void StepProfile::closeSlice() {
 }
 
 void StepProfile::openSlice() {
+  open_phase_.store(stack_.empty() ? -1 : stack_.back());
   if (waitsForDevice()) resetDevicePeaks(device_);
   calls_at_open_ = g_operator_calls.load();
   start_ = std::chrono::steady_clock::now();  // closeSlice() has synchronised the device
@@ -137,6 +146,7 @@ void StepProfile::enter(const std::string& name) {
 void StepProfile::leave() {
   closeSlice();
   stack_.clear();
+  open_phase_.store(-1);
 }
 
 void StepProfile::push(const std::string& name) {
@@ -150,7 +160,49 @@ void StepProfile::push(const std::string& name) {
 void StepProfile::pop() {
   closeSlice();
   if (!stack_.empty()) stack_.pop_back();
-  if (!stack_.empty()) openSlice();
+  if (!stack_.empty()) {
+    openSlice();
+  } else {
+    open_phase_.store(-1);
+  }
+}
+
+void StepProfile::recordOperator(const char* name) {
+  const int phase = open_phase_.load();
+  if (phase < 0 || name == nullptr) return;
+  const std::lock_guard<std::mutex> lock(names_mutex_);
+  if (operator_names_.size() <= static_cast<std::size_t>(phase)) {
+    operator_names_.resize(static_cast<std::size_t>(phase) + 1);
+  }
+  ++operator_names_[static_cast<std::size_t>(phase)][name];
+}
+
+std::string StepProfile::operatorTable(double min_per_iteration) const {
+  const std::lock_guard<std::mutex> lock(names_mutex_);
+  const double iterations = std::max(1, iterations_);
+  std::string out;
+  char line[512];
+  for (std::size_t k = 0; k < operator_names_.size() && k < phases_.size(); ++k) {
+    std::vector<std::pair<std::int64_t, std::string>> calls;
+    std::int64_t total = 0;
+    for (const auto& [name, count] : operator_names_[k]) {
+      calls.emplace_back(count, name);
+      total += count;
+    }
+    if (calls.empty()) continue;
+    std::sort(calls.begin(), calls.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    std::snprintf(line, sizeof line, "\n**%s**: %.1f calls per iteration\n\n",
+                  phases_[k].name.c_str(), total / iterations);
+    out += line;
+    for (const auto& [count, name] : calls) {
+      if (count / iterations < min_per_iteration) break;
+      std::snprintf(line, sizeof line, "- %.2f `%s`\n", count / iterations, name.c_str());
+      out += line;
+    }
+  }
+  return out;
 }
 
 double StepProfile::seconds(const std::string& name) const {

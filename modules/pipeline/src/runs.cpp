@@ -384,7 +384,13 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                                    ? ", the host's clock: no phase waits for the device"
                                    : ", each phase boundary waits for the device") +
                               "):\n\n" + profile->table();
-    if (writer) writeText(o.out + "/profile.md", table);
+    if (writer) {
+      writeText(o.out + "/profile.md", table);
+      writeText(o.out + "/profile_operators.md",
+                "ATen operator calls per iteration by phase of the training step (nested calls "
+                "included; at least 0.05 per iteration):\n" +
+                    profile->operatorTable());
+    }
     if (o.progress) *o.progress << table;
   }
   const double total = seconds();

@@ -21,9 +21,12 @@
 
 #include <ATen/ATen.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -82,8 +85,15 @@ class StepProfile {
   /// calls per iteration (and on CUDA with device waits the peak allocated MiB per phase, and
   /// the peaks of the whole run).
   std::string table() const;
+  /// \brief Per phase, the ATen operators it called (by name, nested calls included, the
+  /// autograd engine's evaluate_function entries too) with their calls per iteration, most
+  /// first, those of at least `min_per_iteration`: a Markdown list. Where the host's time of a
+  /// phase goes, operator by operator.
+  std::string operatorTable(double min_per_iteration = 0.05) const;
 
  private:
+  friend struct OperatorCallObserver;  // step_profile.cpp: records each call's name
+  void recordOperator(const char* name);
   struct Phase {
     std::string name;
     double seconds = 0.0;
@@ -106,6 +116,11 @@ class StepProfile {
   std::int64_t peak_reserved_ = 0;
   // The device's peaks before this profile existed (scene loading, initialisation).
   std::int64_t peak_allocated_before_ = 0, peak_reserved_before_ = 0;
+  // The innermost open phase (-1: none) as the observer (any thread) reads it, and per phase
+  // the calls of each operator name.
+  std::atomic<int> open_phase_{-1};
+  mutable std::mutex names_mutex_;
+  std::vector<std::map<std::string, std::int64_t>> operator_names_;
 };
 
 /// \brief profile->enter(name), or nothing when `profile` is null.
