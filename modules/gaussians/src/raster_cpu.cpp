@@ -559,12 +559,31 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
       }
     });
   });
-  const at::Tensor total = buffers.sum(0);
+  // The buffers summed in order, straight into the four gradients.
   RasterGrads g;
-  g.means2d = total.slice(1, 0, 2).contiguous();
-  g.conics = total.slice(1, 2, 5).contiguous();
-  g.opacities = total.select(1, 5).contiguous();
-  g.values = total.slice(1, 6, row).contiguous();
+  g.means2d = at::empty({n, 2}, values.options());
+  g.conics = at::empty({n, 3}, values.options());
+  g.opacities = at::empty({n}, values.options());
+  g.values = at::empty({n, D}, values.options());
+  AT_DISPATCH_FLOATING_TYPES(values.scalar_type(), "rasterizeBackwardCpu sums", [&] {
+    using T = scalar_t;
+    const T* buf = buffers.data_ptr<T>();
+    T* out[4] = {g.means2d.data_ptr<T>(), g.conics.data_ptr<T>(), g.opacities.data_ptr<T>(),
+                 g.values.data_ptr<T>()};
+    const int64_t first[4] = {0, 2, 5, 6}, width[4] = {2, 3, 1, D};
+    at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        for (int part = 0; part < 4; ++part) {
+          for (int64_t c = 0; c < width[part]; ++c) {
+            const int64_t at_row = i * row + first[part] + c;
+            T sum = buf[at_row];
+            for (int k = 1; k < threads; ++k) sum += buf[k * n * row + at_row];
+            out[part][i * width[part] + c] = sum;
+          }
+        }
+      }
+    });
+  });
   return g;
 }
 
