@@ -17,10 +17,12 @@
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
 #       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
 #       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
-#       summary says at which iteration it stopped). The deadline counts from the start, scene
-#       making included: caches are made one at a time on the machine (lib.sh; city_0 with its
-#       pseudo-labels ~30 s on an H100 machine; several made at once took 150-300 s, 2026-11-26)
-#       — give the deadline room for them, or carry a cache made elsewhere
+#       summary says at which iteration it stopped). The deadline counts from the call's start
+#       (lib.sh's CALL_START), a fresh machine's build (~100-140 s) and scene making included:
+#       caches are made one at a time on the machine (lib.sh; city_0 with its pseudo-labels
+#       ~30 s on an H100 machine; several made at once took 150-300 s, 2026-11-26) — give the
+#       deadline room for them and for the evaluation after it (~50 s below the call's limit),
+#       or carry a cache made elsewhere
 #
 # RUN names (runs): none_nopl none_pl full_p1_nopl full_p{0,0.5,1,1.5,2}_pl semantic_p1_pl
 #   structure_p1_pl (suffix _pl: on the scene with pseudo-labels; _nopl: without); infixes set

@@ -13,7 +13,9 @@
 #                                or city-xl for the large preset)
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
 #   make_cache PATH LOG CMD...   run CMD (writing PATH.part) once per PATH, one maker per machine
-#   deadline_start SECONDS       start the call's clock; seconds_left prints what is left
+#   deadline_start SECONDS       the deadline: SECONDS after the first script of this call sourced
+#                                lib.sh (a fresh machine's build, ~100-140 s, counts), or after
+#                                CALL_START (env, epoch seconds); seconds_left prints what is left
 #   run_until_deadline CMD...    run CMD, killed at the deadline; returns its status
 #   metrics_line NAME JSON       one line of a run's `sadsplat eval` metrics
 # Variables: OUT (results folder, default /tmp/sadsplat-gpu-out), SADSPLAT_BIN (build-gpu/bin/sadsplat).
@@ -132,7 +134,12 @@ pl_cache() {
   echo "$pl"
 }
 
-deadline_start() { DEADLINE_AT=$(( $(date +%s) + $1 )); }
+# The call's clock starts when lib.sh is first sourced (exported, so scripts started from this
+# one share it): a deadline given as the call's limit minus a margin then holds even when the
+# build came first (a deadline counted from after a 104 s build let two long trainings and their
+# evaluation run past a 600 s call, 2026-11-27).
+export CALL_START="${CALL_START:-$(date +%s)}"
+deadline_start() { DEADLINE_AT=$(( CALL_START + $1 )); }
 seconds_left() { echo $(( ${DEADLINE_AT:?deadline_start first} - $(date +%s) )); }
 run_until_deadline() {
   local left; left=$(seconds_left)
