@@ -5,9 +5,11 @@
 #include <c10/core/GradMode.h>
 #include <torch/csrc/autograd/autograd.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -796,6 +798,52 @@ TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {
   EXPECT_FALSE(b[3].defined()) << "features were not rendered";
 }
 
+// The SH coefficients in two parts (the trainer's sh_dc and sh_rest, read in place) render the
+// same colours as one [N, K, 3] tensor, bit for bit, and each part's gradient is its slice of
+// the whole's; a part whose rows lie apart (a narrow view) reads the same; coefficients above
+// the degree get 0.
+TEST(Rasterizer, ShInTwoPartsRendersAndDifferentiatesAsOneTensor) {
+  const RasterCamera cam = frontCamera(40, 30, 36.0);
+  const std::array<double, 3> centre = cam.centre();
+  for (const int degree : {0, 1, 3}) {
+    GaussianParams whole = randomScene(30, 0, 23 + degree);
+    whole.sh = (at::randn({30, 16, 3}, whole.means.options()) * 0.5).requires_grad_(true);
+    GaussianParams parts = whole;
+    parts.sh = whole.sh.detach().narrow(1, 0, 1).clone().requires_grad_(true);
+    // The rest as a view with rows 48 floats apart, as the narrow of a wider tensor.
+    const at::Tensor wide = whole.sh.detach().clone();
+    const at::Tensor rest_view = wide.narrow(1, 1, 15);
+    ASSERT_FALSE(rest_view.is_contiguous());
+    parts.sh_rest = rest_view.detach().requires_grad_(true);
+    RenderSettings settings;
+    settings.sh_degree = degree;
+    const auto a = gaussians::render(whole, cam, settings);
+    const auto b = gaussians::render(parts, cam, settings);
+    EXPECT_TRUE(at::equal(a.rgb, b.rgb)) << "degree " << degree;
+    const at::Tensor w = at::randn_like(a.rgb);
+    const auto ga = torch::autograd::grad({(a.rgb * w).sum()}, {whole.sh});
+    const auto gb = torch::autograd::grad({(b.rgb * w).sum()}, {parts.sh, parts.sh_rest});
+    EXPECT_TRUE(at::equal(gb[0], ga[0].narrow(1, 0, 1))) << "degree " << degree;
+    EXPECT_TRUE(at::equal(gb[1], ga[0].narrow(1, 1, 15))) << "degree " << degree;
+    const int used = (degree + 1) * (degree + 1);
+    EXPECT_GT(ga[0].narrow(1, 0, used).abs().max().item<double>(), 0.0);
+    if (used < 16) {
+      EXPECT_EQ(gb[1].narrow(1, used - 1, 16 - used).abs().max().item<double>(), 0.0);
+    }
+    // The colours of evaluateSh agree with the render's inputs too: two parts, one tensor.
+    EXPECT_TRUE(
+        at::equal(gaussians::evaluateSh(whole.sh, whole.means, centre, degree),
+                  gaussians::evaluateSh(parts.sh, parts.sh_rest, parts.means, centre, degree)));
+  }
+  // Degree 0 from one coefficient: an empty rest.
+  GaussianParams one = randomScene(5, 0, 3);
+  one.sh = at::randn({5, 1, 3}, one.means.options());
+  one.sh_rest = at::zeros({5, 0, 3}, one.means.options());
+  RenderSettings flat;
+  flat.sh_degree = 0;
+  EXPECT_TRUE(at::isfinite(gaussians::render(one, cam, flat).rgb).all().item<bool>());
+}
+
 TEST(Rasterizer, ScreenSpaceGradientReachesMeans2d) {
   const RasterCamera cam = frontCamera(32, 32, 30.0);
   auto g = randomScene(10, 0, 8);
@@ -850,6 +898,24 @@ TEST(Rasterizer, BadInputsAreClearErrors) {
   g = randomScene(3, 2, 1);
   g.sh = g.sh.slice(1, 0, 4);
   EXPECT_THROW(gaussians::render(g, cam), Error);  // degree 3 needs 16 coefficients
+  // Two parts: the first must be one coefficient, and both together must hold the degree's.
+  g = randomScene(3, 2, 1);
+  g.sh_rest = g.sh.narrow(1, 1, 15);
+  try {
+    gaussians::render(g, cam);  // sh still holds all 16
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "sh");
+  }
+  g.sh = g.sh.narrow(1, 0, 1);
+  g.sh_rest = g.sh_rest.narrow(1, 0, 8);
+  try {
+    gaussians::render(g, cam);  // 9 coefficients, degree 3
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "sh");
+    EXPECT_NE(std::string(e.what()).find("16"), std::string::npos) << e.what();
+  }
   RasterCamera bad = cam;
   bad.fx = 0;
   EXPECT_THROW(gaussians::render(randomScene(3, 2, 1), bad), Error);

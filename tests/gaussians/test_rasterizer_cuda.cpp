@@ -212,6 +212,20 @@ TEST(RasterizerCudaSh, EveryDegreeAndCoefficientCountMatchesTheCpuReference) {
     if (K > used) {
       EXPECT_EQ(g_gpu[0].narrow(1, used, K - used).abs().max().item<float>(), 0.f);
     }
+    // In two parts (the trainer's sh_dc and sh_rest), the rest's rows 3 (K + 1) floats apart:
+    // the same colours and each part's slice of the gradient, bit for bit.
+    const at::Tensor dc_gpu = sh.narrow(1, 0, 1).to(at::kCUDA).requires_grad_(true);
+    const at::Tensor wide = at::cat({sh, at::zeros({n, 2, 3})}, 1).to(at::kCUDA);
+    const at::Tensor rest_gpu = wide.narrow(1, 1, K - 1).detach().requires_grad_(true);
+    ASSERT_TRUE(K == 1 || !rest_gpu.is_contiguous());
+    const at::Tensor m2_gpu = means.to(at::kCUDA).requires_grad_(true);
+    const at::Tensor c_parts = gaussians::evaluateSh(dc_gpu, rest_gpu, m2_gpu, centre, degree);
+    EXPECT_TRUE(at::equal(c_parts, c_gpu)) << "degree " << degree << " K " << K;
+    const auto g_parts =
+        torch::autograd::grad({(c_parts * w.to(at::kCUDA)).sum()}, {dc_gpu, rest_gpu, m2_gpu});
+    EXPECT_TRUE(at::equal(g_parts[0], g_gpu[0].narrow(1, 0, 1))) << "degree " << degree;
+    EXPECT_TRUE(at::equal(g_parts[1], g_gpu[0].narrow(1, 1, K - 1))) << "degree " << degree;
+    EXPECT_TRUE(at::equal(g_parts[2], g_gpu[1])) << "degree " << degree;
   }
 }
 

@@ -46,7 +46,8 @@ GaussianParams ParameterStore::gaussians() const {
   g.quats = (*this)["quats"].value;
   g.log_scales = (*this)["scales"].value;
   g.opacity_logits = (*this)["opacity"].value;
-  g.sh = at::cat({(*this)["sh_dc"].value, (*this)["sh_rest"].value}, 1);
+  g.sh = (*this)["sh_dc"].value;  // the two parts as they are stored: no copy per render
+  g.sh_rest = (*this)["sh_rest"].value;
   g.features = (*this)["features"].value;
   return g;
 }

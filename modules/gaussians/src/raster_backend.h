@@ -67,6 +67,19 @@ struct RasterGrads {
   at::Tensor means2d, conics, opacities, values;
 };
 
+/// SH coefficients [N, K, 3] in two parts: the first coefficient `dc` [N, 1, 3] and the others
+/// `rest` [N, K - 1, 3] (K = 1: [N, 0, 3]). Unlike the other inputs, each part's rows may lie
+/// apart (any stride(0); stride(1) = 3, stride(2) = 1), so the trainer's two parameters, or two
+/// narrow views of one [N, K, 3] tensor, are read where they lie: no [N, K, 3] copy per render.
+struct ShParts {
+  at::Tensor dc, rest;
+  int64_t coefficients() const { return 1 + rest.size(1); }
+};
+
+struct ShGrads {
+  at::Tensor dc, rest, means;
+};
+
 ProjectionResult projectForwardCpu(const at::Tensor& means, const at::Tensor& quats,
                                    const at::Tensor& log_scales, const CameraParams& cam);
 ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& quats,
@@ -97,13 +110,14 @@ RasterGrads rasterizeBackwardCpu(const at::Tensor& means2d, const at::Tensor& co
 // needs no CUDA) and expects the tensors' device to be current: the caller, which links LibTorch's
 // CUDA libraries, supplies both. The kernels themselves need no c10 CUDA headers, so they also
 // compile against a CPU-only LibTorch.
-/// SH colours [N, 3] of sh [N, K, 3] (contiguous) seen from `campos` (see raster::shColor).
-at::Tensor shForwardCpu(const at::Tensor& sh, const at::Tensor& means,
+/// SH colours [N, 3] of `sh` seen from `campos` (see raster::shColor); reads the first
+/// (degree + 1)^2 coefficients.
+at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
                         const std::array<double, 3>& campos, int degree);
-/// Gradients {sh, means} of shForwardCpu for g_colors [N, 3].
-std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::Tensor& means,
-                                                const std::array<double, 3>& campos, int degree,
-                                                const at::Tensor& g_colors);
+/// Gradients of shForwardCpu for g_colors [N, 3]: contiguous tensors shaped as sh.dc, sh.rest
+/// and means, 0 for the coefficients above the degree.
+ShGrads shBackwardCpu(const ShParts& sh, const at::Tensor& means,
+                      const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors);
 
 #if SADSPLAT_COMPILE_CUDA
 ProjectionResult projectForwardCuda(const at::Tensor& means, const at::Tensor& quats,
@@ -125,11 +139,11 @@ RasterGrads rasterizeBackwardCuda(const at::Tensor& means2d, const at::Tensor& c
                                   const at::Tensor& opacities, const at::Tensor& values,
                                   const RasterResult& forward, const at::Tensor& g_image,
                                   const at::Tensor& g_alpha, void* stream);
-at::Tensor shForwardCuda(const at::Tensor& sh, const at::Tensor& means,
+at::Tensor shForwardCuda(const ShParts& sh, const at::Tensor& means,
                          const std::array<double, 3>& campos, int degree, void* stream);
-std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh, const at::Tensor& means,
-                                                 const std::array<double, 3>& campos, int degree,
-                                                 const at::Tensor& g_colors, void* stream);
+ShGrads shBackwardCuda(const ShParts& sh, const at::Tensor& means,
+                       const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors,
+                       void* stream);
 #endif
 
 /// The camera in the scalar type of a computation.

@@ -98,43 +98,60 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
   return g;
 }
 
-at::Tensor shForwardCpu(const at::Tensor& sh, const at::Tensor& means,
+at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
                         const std::array<double, 3>& campos, int degree) {
-  const int64_t n = means.size(0), K = sh.size(1);
+  const int64_t n = means.size(0), used = (degree + 1) * (degree + 1);
   at::Tensor colors = at::empty({n, 3}, means.options());
   AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shForwardCpu", [&] {
     const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
-    const scalar_t* s = sh.data_ptr<scalar_t>();
+    const scalar_t* dc = sh.dc.data_ptr<scalar_t>();
+    const scalar_t* rest = sh.rest.data_ptr<scalar_t>();
+    const int64_t dc_stride = sh.dc.stride(0), rest_stride = sh.rest.stride(0);
     const scalar_t* m = means.data_ptr<scalar_t>();
     scalar_t* c = colors.data_ptr<scalar_t>();
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
-      for (int64_t i = begin; i < end; ++i)
-        shColor(s + i * K * 3, degree, m + 3 * i, cam, c + 3 * i);
+      scalar_t row[16 * 3];  // the coefficients the degree uses, in one row
+      for (int64_t i = begin; i < end; ++i) {
+        std::copy(dc + i * dc_stride, dc + i * dc_stride + 3, row);
+        std::copy(rest + i * rest_stride, rest + i * rest_stride + 3 * (used - 1), row + 3);
+        shColor(row, degree, m + 3 * i, cam, c + 3 * i);
+      }
     });
   });
   return colors;
 }
 
-std::pair<at::Tensor, at::Tensor> shBackwardCpu(const at::Tensor& sh, const at::Tensor& means,
-                                                const std::array<double, 3>& campos, int degree,
-                                                const at::Tensor& g_colors) {
-  const int64_t n = means.size(0), K = sh.size(1);
-  at::Tensor g_sh = at::zeros_like(sh), g_means = at::zeros_like(means);
+ShGrads shBackwardCpu(const ShParts& sh, const at::Tensor& means,
+                      const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors) {
+  const int64_t n = means.size(0), used = (degree + 1) * (degree + 1);
+  ShGrads g;
+  g.dc = at::empty({n, 1, 3}, means.options());
+  g.rest = at::zeros({n, sh.rest.size(1), 3}, means.options());
+  g.means = at::zeros_like(means);
   AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shBackwardCpu", [&] {
     const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
-    const scalar_t* s = sh.data_ptr<scalar_t>();
+    const scalar_t* dc = sh.dc.data_ptr<scalar_t>();
+    const scalar_t* rest = sh.rest.data_ptr<scalar_t>();
+    const int64_t dc_stride = sh.dc.stride(0), rest_stride = sh.rest.stride(0);
+    const int64_t rest_row = 3 * sh.rest.size(1);
     const scalar_t* m = means.data_ptr<scalar_t>();
     const scalar_t* gc = g_colors.data_ptr<scalar_t>();
-    scalar_t* gs = g_sh.data_ptr<scalar_t>();
-    scalar_t* gm = g_means.data_ptr<scalar_t>();
+    scalar_t* g_dc = g.dc.data_ptr<scalar_t>();
+    scalar_t* g_rest = g.rest.data_ptr<scalar_t>();
+    scalar_t* gm = g.means.data_ptr<scalar_t>();
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
+      scalar_t row[16 * 3], g_row[16 * 3];
       for (int64_t i = begin; i < end; ++i) {
-        shColorBackward(s + i * K * 3, degree, m + 3 * i, cam, gc + 3 * i, gs + i * K * 3,
-                        gm + 3 * i);
+        std::copy(dc + i * dc_stride, dc + i * dc_stride + 3, row);
+        std::copy(rest + i * rest_stride, rest + i * rest_stride + 3 * (used - 1), row + 3);
+        std::fill(g_row, g_row + 3 * used, scalar_t(0));
+        shColorBackward(row, degree, m + 3 * i, cam, gc + 3 * i, g_row, gm + 3 * i);
+        std::copy(g_row, g_row + 3, g_dc + 3 * i);
+        std::copy(g_row + 3, g_row + 3 * used, g_rest + i * rest_row);
       }
     });
   });
-  return {g_sh, g_means};
+  return g;
 }
 
 namespace {

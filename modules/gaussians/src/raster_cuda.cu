@@ -33,6 +33,15 @@ void check(const at::Tensor& t, const char* name) {
   }
 }
 
+// An SH part (ShParts): rows of 3-float coefficients, the rows any distance apart.
+void checkShPart(const at::Tensor& t, const char* name) {
+  if (!t.is_cuda() || t.scalar_type() != at::kFloat || t.dim() != 3 || t.size(2) != 3 ||
+      t.stride(2) != 1 || (t.size(1) > 1 && t.stride(1) != 3)) {
+    throw Error("<render>", name, "a float32 CUDA tensor [N, K, 3] of row-major rows",
+                std::string(c10::toString(t.scalar_type())) + " on " + t.device().str());
+  }
+}
+
 void checkLaunch(const char* kernel) { checkCudaLaunch("<render>", kernel); }
 
 int blocksFor(int64_t n) { return static_cast<int>((n + kThreads1d - 1) / kThreads1d); }
@@ -86,30 +95,40 @@ __global__ void projectBackwardKernel(
 
 // ---- spherical harmonics ---------------------------------------------------------------------
 
-// One thread per Gaussian, kShBlock Gaussians per block. A Gaussian's coefficients are one row of
-// 3K consecutive floats (192 bytes at K = 16); read or written a thread per row, a warp's access
-// would touch 32 rows at once. The block's rows go through shared memory instead, copied with
+// One thread per Gaussian, kShBlock Gaussians per block. A Gaussian's coefficients are a row of
+// 3 (degree + 1)^2 floats (192 bytes at degree 3) in two parts (dc, rest); read or written a
+// thread per row, a warp's access would touch 32 rows at once. The block's rows go through shared memory instead, copied with
 // consecutive threads on consecutive floats. Shared rows are kShStride (odd) floats apart, so the
 // 32 threads of a warp, each on its own row, hit 32 different banks.
 constexpr int kShBlock = 64;
 constexpr int kShMaxRow = 16 * 3;  // degree 3
 constexpr int kShStride = kShMaxRow + 1;
 
-__device__ __forceinline__ void copyShRowsIn(const float* __restrict__ sh, int64_t first, int rows,
+// A row of `used` coefficients of Gaussian i: the first from dc, the others from rest (each
+// part's rows `*_stride` floats apart, raster_backend.h's ShParts).
+struct ShRows {
+  const float* __restrict__ dc;
+  const float* __restrict__ rest;
+  int64_t dc_stride, rest_stride;
+};
+
+__device__ __forceinline__ void copyShRowsIn(const ShRows& sh, int64_t first, int rows,
                                              int row_len, float* s_rows) {
-  const float* src = sh + first * row_len;
   for (int e = threadIdx.x; e < rows * row_len; e += blockDim.x) {
-    s_rows[(e / row_len) * kShStride + e % row_len] = src[e];
+    const int64_t i = first + e / row_len;
+    const int c = e % row_len;
+    s_rows[(e / row_len) * kShStride + c] =
+        c < 3 ? sh.dc[i * sh.dc_stride + c] : sh.rest[i * sh.rest_stride + c - 3];
   }
 }
 
 __global__ void __launch_bounds__(kShBlock)
-    shForwardKernel(int64_t n, int64_t K, int degree, float3 campos, const float* __restrict__ sh,
+    shForwardKernel(int64_t n, int used, int degree, float3 campos, ShRows sh,
                     const float* __restrict__ means, float* colors) {
   __shared__ float s_sh[kShBlock * kShStride];
   const int64_t first = static_cast<int64_t>(blockIdx.x) * kShBlock;
   const int rows = static_cast<int>(min(static_cast<int64_t>(kShBlock), n - first));
-  copyShRowsIn(sh, first, rows, static_cast<int>(3 * K), s_sh);
+  copyShRowsIn(sh, first, rows, 3 * used, s_sh);
   __syncthreads();
   if (static_cast<int>(threadIdx.x) >= rows) return;
   const int64_t i = first + threadIdx.x;
@@ -117,16 +136,17 @@ __global__ void __launch_bounds__(kShBlock)
   shColor(s_sh + threadIdx.x * kShStride, degree, means + 3 * i, cam, colors + 3 * i);
 }
 
-// Writes every coefficient's gradient (0 above the degree), so g_sh needs no zeroing.
+// Writes the gradients of the `used` coefficients (g_dc [N, 1, 3] and the first used - 1 of
+// g_rest's rest_row / 3 per Gaussian, both contiguous); the others are the caller's to clear.
 __global__ void __launch_bounds__(kShBlock)
-    shBackwardKernel(int64_t n, int64_t K, int degree, float3 campos, const float* __restrict__ sh,
+    shBackwardKernel(int64_t n, int used, int degree, float3 campos, ShRows sh,
                      const float* __restrict__ means, const float* __restrict__ g_colors,
-                     float* g_sh, float* g_means) {
+                     float* g_dc, float* g_rest, int64_t rest_row, float* g_means) {
   __shared__ float s_sh[kShBlock * kShStride];
   __shared__ float s_g_sh[kShBlock * kShStride];
   const int64_t first = static_cast<int64_t>(blockIdx.x) * kShBlock;
   const int rows = static_cast<int>(min(static_cast<int64_t>(kShBlock), n - first));
-  const int row_len = static_cast<int>(3 * K);
+  const int row_len = 3 * used;
   copyShRowsIn(sh, first, rows, row_len, s_sh);
   for (int e = threadIdx.x; e < kShBlock * kShStride; e += blockDim.x) s_g_sh[e] = 0.f;
   __syncthreads();
@@ -137,17 +157,23 @@ __global__ void __launch_bounds__(kShBlock)
                     s_g_sh + threadIdx.x * kShStride, g_means + 3 * i);
   }
   __syncthreads();
-  float* dst = g_sh + first * row_len;
   for (int e = threadIdx.x; e < rows * row_len; e += blockDim.x) {
-    dst[e] = s_g_sh[(e / row_len) * kShStride + e % row_len];
+    const int64_t i = first + e / row_len;
+    const int c = e % row_len;
+    const float v = s_g_sh[(e / row_len) * kShStride + c];
+    if (c < 3) {
+      g_dc[3 * i + c] = v;
+    } else {
+      g_rest[i * rest_row + c - 3] = v;
+    }
   }
 }
 
 int shBlocksFor(int64_t n) { return static_cast<int>((n + kShBlock - 1) / kShBlock); }
 
-// The first 16 coefficients of sh (all that degree 3 uses) as [N, K <= 16, 3] contiguous rows.
-at::Tensor shRowsUpToDegree3(const at::Tensor& sh) {
-  return sh.size(1) > kShMaxRow / 3 ? sh.narrow(1, 0, kShMaxRow / 3).contiguous() : sh;
+ShRows shRows(const ShParts& sh) {
+  return {sh.dc.data_ptr<float>(), sh.rest.data_ptr<float>(), sh.dc.stride(0),
+          sh.rest.stride(0)};
 }
 
 // ---- binning ---------------------------------------------------------------------------------
@@ -954,39 +980,44 @@ ProjectionGrads projectBackwardCuda(const at::Tensor& means, const at::Tensor& q
   return g;
 }
 
-at::Tensor shForwardCuda(const at::Tensor& sh_all, const at::Tensor& means,
+at::Tensor shForwardCuda(const ShParts& sh, const at::Tensor& means,
                          const std::array<double, 3>& campos, int degree, void* stream_ptr) {
-  check(sh_all, "sh");
+  checkShPart(sh.dc, "sh");
+  checkShPart(sh.rest, "sh");
   check(means, "means");
   const int64_t n = means.size(0);
   at::Tensor colors = at::empty({n, 3}, means.options());
   if (n == 0) return colors;
-  const at::Tensor sh = shRowsUpToDegree3(sh_all);
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
   shForwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
-      n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
+      n, (degree + 1) * (degree + 1), degree, cam, shRows(sh), means.data_ptr<float>(),
       colors.data_ptr<float>());
   checkLaunch("shForwardKernel");
   return colors;
 }
 
-std::pair<at::Tensor, at::Tensor> shBackwardCuda(const at::Tensor& sh_all, const at::Tensor& means,
-                                                 const std::array<double, 3>& campos, int degree,
-                                                 const at::Tensor& g_colors, void* stream_ptr) {
+ShGrads shBackwardCuda(const ShParts& sh, const at::Tensor& means,
+                       const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors,
+                       void* stream_ptr) {
+  checkShPart(sh.dc, "sh");
+  checkShPart(sh.rest, "sh");
   check(g_colors, "grad colors");
-  const int64_t n = means.size(0);
-  const at::Tensor sh = shRowsUpToDegree3(sh_all);
-  at::Tensor g_sh = at::empty_like(sh), g_means = at::zeros_like(means);
-  if (n == 0) return {at::zeros_like(sh_all), g_means};
+  const int64_t n = means.size(0), rest_coefficients = sh.rest.size(1);
+  const int used = (degree + 1) * (degree + 1);
+  ShGrads g;
+  g.dc = at::empty({n, 1, 3}, means.options());
+  // Coefficients above the degree get no gradient: cleared here, the kernel writes the others.
+  g.rest = used - 1 < rest_coefficients ? at::zeros({n, rest_coefficients, 3}, means.options())
+                                        : at::empty({n, rest_coefficients, 3}, means.options());
+  g.means = at::zeros_like(means);
+  if (n == 0) return g;
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
   shBackwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
-      n, sh.size(1), degree, cam, sh.data_ptr<float>(), means.data_ptr<float>(),
-      g_colors.data_ptr<float>(), g_sh.data_ptr<float>(), g_means.data_ptr<float>());
+      n, used, degree, cam, shRows(sh), means.data_ptr<float>(), g_colors.data_ptr<float>(),
+      g.dc.data_ptr<float>(), g.rest.data_ptr<float>(), 3 * rest_coefficients,
+      g.means.data_ptr<float>());
   checkLaunch("shBackwardKernel");
-  if (sh.size(1) == sh_all.size(1)) return {g_sh, g_means};
-  at::Tensor g_sh_all = at::zeros_like(sh_all);  // coefficients above degree 3: no gradient
-  g_sh_all.narrow(1, 0, sh.size(1)).copy_(g_sh);
-  return {g_sh_all, g_means};
+  return g;
 }
 
 RasterResult rasterizeForwardCuda(const at::Tensor& means2d, const at::Tensor& conics,

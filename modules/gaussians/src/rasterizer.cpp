@@ -222,11 +222,21 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   }
 };
 
+// An SH part as the backends read it (raster::ShParts): row-major rows, any distance apart.
+at::Tensor shRowsReadable(const at::Tensor& part) {
+  const bool rows = part.stride(2) == 1 && (part.size(1) <= 1 || part.stride(1) == 3);
+  return rows ? part : part.contiguous();
+}
+
+// The SH coefficients in two parts (raster::ShParts): the first and the others, each part's
+// gradient its own contiguous tensor.
 struct ShFunction : public torch::autograd::Function<ShFunction> {
   // camera: centre x, y, z and the SH degree.
-  static variable_list forward(AutogradContext* ctx, const at::Tensor& sh, const at::Tensor& means,
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& sh_dc,
+                               const at::Tensor& sh_rest, const at::Tensor& means,
                                const std::vector<double>& camera) {
-    const at::Tensor s = sh.contiguous(), m = means.contiguous();
+    const raster::ShParts sh{shRowsReadable(sh_dc), shRowsReadable(sh_rest)};
+    const at::Tensor m = means.contiguous();
     const ScopedPhase phase("SH");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
@@ -234,14 +244,14 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
     if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
       const c10::cuda::CUDAGuard guard(m.device());
-      colors = raster::shForwardCuda(s, m, campos, degree, currentStream(m));
+      colors = raster::shForwardCuda(sh, m, campos, degree, currentStream(m));
 #else
       noCuda();
 #endif
     } else {
-      colors = raster::shForwardCpu(s, m, campos, degree);
+      colors = raster::shForwardCpu(sh, m, campos, degree);
     }
-    ctx->save_for_backward({s, m});
+    ctx->save_for_backward({sh.dc, sh.rest, m});
     ctx->saved_data["camera"] = camera;
     return {colors};
   }
@@ -252,19 +262,21 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
     const ScopedPhase phase("SH backward");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
-    const at::Tensor g = orZeros(grads[0], {saved[1].size(0), 3}, saved[1].options());
-    std::pair<at::Tensor, at::Tensor> out;
-    if (saved[1].is_cuda()) {
+    const raster::ShParts sh{saved[0], saved[1]};
+    const at::Tensor& m = saved[2];
+    const at::Tensor g = orZeros(grads[0], {m.size(0), 3}, m.options());
+    raster::ShGrads out;
+    if (m.is_cuda()) {
 #if SADSPLAT_HAVE_CUDA
-      const c10::cuda::CUDAGuard guard(saved[1].device());
-      out = raster::shBackwardCuda(saved[0], saved[1], campos, degree, g, currentStream(saved[1]));
+      const c10::cuda::CUDAGuard guard(m.device());
+      out = raster::shBackwardCuda(sh, m, campos, degree, g, currentStream(m));
 #else
       noCuda();
 #endif
     } else {
-      out = raster::shBackwardCpu(saved[0], saved[1], campos, degree, g);
+      out = raster::shBackwardCpu(sh, m, campos, degree, g);
     }
-    return {out.first, out.second, at::Tensor()};
+    return {out.dc, out.rest, out.means, at::Tensor()};
   }
 };
 
@@ -353,20 +365,34 @@ std::array<double, 3> RasterCamera::shViewpoint() const {
 
 at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
                       const std::array<double, 3>& camera_centre, int degree) {
+  return evaluateSh(sh, at::Tensor(), means, camera_centre, degree);
+}
+
+at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& sh_rest, const at::Tensor& means,
+                      const std::array<double, 3>& camera_centre, int degree) {
   if (degree < 0 || degree > 3) {
     throw Error("<render>", "sh_degree", "0..3", std::to_string(degree));
   }
   const int64_t n = means.size(0);
   expectTensor(means, "means", n, {3}, means);
-  expectTensor(sh, "sh", n, {-1, 3}, means);
-  if (sh.size(1) < (degree + 1) * (degree + 1)) {
+  if (sh_rest.defined()) {
+    expectTensor(sh, "sh", n, {1, 3}, means);
+    expectTensor(sh_rest, "sh_rest", n, {-1, 3}, means);
+  } else {
+    expectTensor(sh, "sh", n, {-1, 3}, means);
+  }
+  const int64_t coefficients = sh_rest.defined() ? 1 + sh_rest.size(1) : sh.size(1);
+  if (coefficients < (degree + 1) * (degree + 1)) {
     throw Error("<render>", "sh",
                 "at least " + std::to_string((degree + 1) * (degree + 1)) +
                     " coefficients for SH degree " + std::to_string(degree),
-                std::to_string(sh.size(1)));
+                std::to_string(coefficients));
   }
+  // One [N, K, 3] tensor is read as two views of itself, the first coefficient and the others.
+  const at::Tensor dc = sh_rest.defined() ? sh : sh.narrow(1, 0, 1);
+  const at::Tensor rest = sh_rest.defined() ? sh_rest : sh.narrow(1, 1, coefficients - 1);
   return ShFunction::apply(
-      sh, means,
+      dc, rest, means,
       std::vector<double>{camera_centre[0], camera_centre[1], camera_centre[2], double(degree)})[0];
 }
 
@@ -444,24 +470,17 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   if (g.means.scalar_type() != at::kFloat && g.means.scalar_type() != at::kDouble) {
     throw Error("<render>", "means", "float32 or float64", c10::toString(g.means.scalar_type()));
   }
-  const int coefficients = (settings.sh_degree + 1) * (settings.sh_degree + 1);
   if (settings.sh_degree < 0 || settings.sh_degree > 3) {
     throw Error("<render>", "sh_degree", "0..3", std::to_string(settings.sh_degree));
   }
   expectTensor(g.opacity_logits, "opacity_logits", n, {}, g.means);
-  expectTensor(g.sh, "sh", n, {-1, 3}, g.means);
-  if (g.sh.size(1) < coefficients) {
-    throw Error("<render>", "sh",
-                "at least " + std::to_string(coefficients) + " coefficients for SH degree " +
-                    std::to_string(settings.sh_degree),
-                std::to_string(g.sh.size(1)));
-  }
   if (g.features.defined()) expectTensor(g.features, "features", n, {-1}, g.means);
   const at::Tensor features =
       g.features.defined() && settings.features ? g.features : at::zeros({n, 0}, g.means.options());
 
   auto [means2d, conics, depths, radii] = projectGaussians(g.means, g.quats, g.log_scales, camera);
-  const at::Tensor colors = evaluateSh(g.sh, g.means, camera.shViewpoint(), settings.sh_degree);
+  const at::Tensor colors =
+      evaluateSh(g.sh, g.sh_rest, g.means, camera.shViewpoint(), settings.sh_degree);
   const at::Tensor values = settings.depth ? at::cat({colors, features, depths.unsqueeze(1)}, 1)
                             : features.size(1) > 0 ? at::cat({colors, features}, 1)
                                                    : colors;

@@ -95,6 +95,20 @@ __global__ void gradientVertical(const float* blurred, const float* a, const flo
   grad[i] = ssimGradient(s, a[i], b[i], *upstream / static_cast<float>(n));
 }
 
+// Tree-sums the block's two rows of per-thread values in a fixed order into sums[.][0]; called
+// by every thread of the block after writing its own entries.
+template <typename T>
+__device__ void sumPairsOverBlock(T (&sums)[2][kThreads], int t) {
+  __syncthreads();
+  for (int half = kThreads / 2; half > 0; half /= 2) {
+    if (t < half) {
+      sums[0][t] += sums[0][t + half];
+      sums[1][t] += sums[1][t + half];
+    }
+    __syncthreads();
+  }
+}
+
 // The RGB loss's forward (rgbLossForwardCuda): statsVertical's partials, and per block the sums
 // of the SSIM map and of |a - b| over its elements, reduced in a fixed order (no atomics).
 __global__ void lossVertical(const float* blurred, const float* a, const float* b, int W, int H,
@@ -112,14 +126,7 @@ __global__ void lossVertical(const float* blurred, const float* a, const float* 
   const int t = static_cast<int>(threadIdx.x);
   sums[0][t] = ssim_value;
   sums[1][t] = l1;
-  __syncthreads();
-  for (int half = kThreads / 2; half > 0; half /= 2) {
-    if (t < half) {
-      sums[0][t] += sums[0][t + half];
-      sums[1][t] += sums[1][t + half];
-    }
-    __syncthreads();
-  }
+  sumPairsOverBlock(sums, t);
   if (t == 0) {
     block_sums[2 * blockIdx.x] = sums[0][0];
     block_sums[2 * blockIdx.x + 1] = sums[1][0];
@@ -139,14 +146,7 @@ __global__ void lossFinish(const float* block_sums, int blocks, int64_t n, float
   }
   sums[0][t] = ssim_sum;
   sums[1][t] = l1_sum;
-  __syncthreads();
-  for (int half = kThreads / 2; half > 0; half /= 2) {
-    if (t < half) {
-      sums[0][t] += sums[0][t + half];
-      sums[1][t] += sums[1][t + half];
-    }
-    __syncthreads();
-  }
+  sumPairsOverBlock(sums, t);
   if (t == 0) {
     const double count = static_cast<double>(n);
     *loss = static_cast<float>((1.0 - lambda) * (sums[1][0] / count) +

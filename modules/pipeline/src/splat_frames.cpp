@@ -63,7 +63,8 @@ SplatFrames::SplatFrames(const std::string& path, const std::string& device) : s
   s.params.quats = t.rotations;
   s.params.log_scales = t.log_scales;
   s.params.opacity_logits = t.opacity_logit;
-  s.params.sh = at::cat({t.sh_dc, t.sh_rest}, 1);
+  s.params.sh = t.sh_dc;
+  s.params.sh_rest = t.sh_rest;
   for (const auto& p : s.cloud) {
     if (p.label != kUnlabelled) s.num_labels = std::max<int>(s.num_labels, p.label + 1);
   }

@@ -68,7 +68,10 @@ struct GaussianParams {
   at::Tensor quats;           ///< [N, 4] (w, x, y, z), need not be normalised
   at::Tensor log_scales;      ///< [N, 3]
   at::Tensor opacity_logits;  ///< [N]
-  at::Tensor sh;              ///< [N, K, 3], K >= (sh_degree + 1)^2
+  at::Tensor sh;              ///< [N, K, 3], K >= (sh_degree + 1)^2; with sh_rest: [N, 1, 3]
+  /// Optional: the SH coefficients after the first, [N, K - 1, 3], with `sh` holding only the
+  /// first (how the trainer stores them; both are read in place, no [N, K, 3] copy per render).
+  at::Tensor sh_rest;
   at::Tensor features;        ///< [N, C] semantic features, C = 0..64+ (may be undefined: C = 0)
   at::Tensor opacity_gate;    ///< [N] optional factor on the activated opacity (Hard Concrete gate)
 };
@@ -94,6 +97,10 @@ RenderResult render(const GaussianParams& gaussians, const RasterCamera& camera,
 /// \brief Colour of each Gaussian seen from `camera_centre`: SH of degree `degree` evaluated in
 /// the view direction, + 0.5, clamped at 0 (as in 3DGS). Differentiable. Returns [N, 3].
 at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& means,
+                      const std::array<double, 3>& camera_centre, int degree);
+/// \brief The same with the coefficients in two parts: the first [N, 1, 3] and the others
+/// [N, K - 1, 3] (GaussianParams::sh and sh_rest); each part gets its own gradient.
+at::Tensor evaluateSh(const at::Tensor& sh_dc, const at::Tensor& sh_rest, const at::Tensor& means,
                       const std::array<double, 3>& camera_centre, int degree);
 
 /// \brief Projection step alone (differentiable): returns {means2d [N,2], conics [N,3],
