@@ -202,11 +202,13 @@ TEST(Cli, TheLongScheduleSetsItsKeysAndKeepsGivenOnes) {
                              &out),
             0)
       << out;
-  EXPECT_NE(out.find("long schedule: lambda_l0_from 0 -> 12; recovery_iterations 0 -> 4;"),
+  EXPECT_NE(out.find("long schedule: densify_until -1 -> 6; lambda_l0_from 0 -> 6; "
+                     "recovery_iterations 0 -> 4;"),
             std::string::npos)
       << out;
   const std::string config = io::readWholeFile(run + "/config.json");
-  EXPECT_NE(config.find("\"lambda_l0_from\": 12"), std::string::npos) << config;
+  EXPECT_NE(config.find("\"densify_until\": 6"), std::string::npos) << config;
+  EXPECT_NE(config.find("\"lambda_l0_from\": 6"), std::string::npos) << config;
   EXPECT_NE(config.find("\"recovery_iterations\": 4"), std::string::npos) << config;
   EXPECT_NE(config.find("\"iterations\": 24"), std::string::npos) << config;
   EXPECT_EQ(

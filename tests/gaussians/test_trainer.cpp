@@ -782,22 +782,27 @@ TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKey
   std::vector<std::string> changed;
   const TrainConfig net1 = c.longSchedule({}, &changed);
   EXPECT_EQ(net1.iterations, 30000);
-  EXPECT_EQ(net1.lambda_l0_from, 0);  // no drop: nothing else changes
+  EXPECT_EQ(net1.densify_until, 7500);  // the first quarter
+  EXPECT_EQ(net1.lambda_l0_from, 0);    // no drop: no gate keys
   EXPECT_EQ(net1.recovery_iterations, 0);
-  EXPECT_EQ(changed.size(), 1u);
+  EXPECT_EQ(changed.size(), 2u);
   c.drop = "full";
   const TrainConfig full = c.longSchedule({});
-  EXPECT_EQ(full.lambda_l0_from, 15000);  // after the densification (half of the run)
+  EXPECT_EQ(full.densify_until, 7500);
+  EXPECT_EQ(full.lambda_l0_from, 7500);  // after the densification
   EXPECT_EQ(full.recovery_iterations, 5000);
   full.check();
   c.iterations = 12000;
   c.recovery_iterations = 100;
   const TrainConfig given = c.longSchedule({"iterations", "recovery_iterations"});
   EXPECT_EQ(given.iterations, 12000);
-  EXPECT_EQ(given.lambda_l0_from, 6000);
+  EXPECT_EQ(given.densify_until, 3000);
+  EXPECT_EQ(given.lambda_l0_from, 3000);
   EXPECT_EQ(given.recovery_iterations, 100);
-  c.densify_until = 4000;
-  EXPECT_EQ(c.longSchedule({"iterations"}).lambda_l0_from, 4000);
+  c.densify_until = 4000;  // a densification end the user set holds, and the gates follow it
+  const TrainConfig own = c.longSchedule({"iterations", "densify_until"});
+  EXPECT_EQ(own.densify_until, 4000);
+  EXPECT_EQ(own.lambda_l0_from, 4000);
 }
 
 TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRates) {

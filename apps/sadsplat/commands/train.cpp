@@ -43,9 +43,10 @@ class TrainCommand : public Command {
                 "times fewer steps and the learning rates x sqrt(B): as many views seen as one "
                 "view per step");
     c->add_option("--schedule", schedule_,
-                  "paper: the paper's 7000-iteration schedule (default); long: 30000 iterations "
-                  "and, with a drop, gates pushed shut only after the densification and the last "
-                  "sixth refined without gates (for the smallest model; keys you set are kept)")
+                  "paper: the paper's 7000-iteration schedule (default); long: 30000 iterations, "
+                  "densification in the first quarter and, with a drop, gates pushed shut only "
+                  "after it and the last sixth refined without gates (for the smallest model; "
+                  "keys you set are kept)")
         ->check(CLI::IsMember({"paper", "long"}));
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "
