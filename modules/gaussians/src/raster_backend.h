@@ -73,7 +73,6 @@ struct RasterGrads {
 /// narrow views of one [N, K, 3] tensor, are read where they lie: no [N, K, 3] copy per render.
 struct ShParts {
   at::Tensor dc, rest;
-  int64_t coefficients() const { return 1 + rest.size(1); }
 };
 
 struct ShGrads {

@@ -98,22 +98,32 @@ ProjectionGrads projectBackwardCpu(const at::Tensor& means, const at::Tensor& qu
   return g;
 }
 
+namespace {
+
+// Gaussian i's first `used` SH coefficients from the two parts (rows any stride apart) into one
+// row of 3 x used values, as raster::shColor reads them.
+template <typename T>
+void gatherShRow(const ShParts& sh, int64_t i, int64_t used, T* row) {
+  const T* dc = sh.dc.data_ptr<T>() + i * sh.dc.stride(0);
+  const T* rest = sh.rest.data_ptr<T>() + i * sh.rest.stride(0);
+  std::copy(dc, dc + 3, row);
+  std::copy(rest, rest + 3 * (used - 1), row + 3);
+}
+
+}  // namespace
+
 at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
                         const std::array<double, 3>& campos, int degree) {
-  const int64_t n = means.size(0), used = (degree + 1) * (degree + 1);
+  const int64_t n = means.size(0), used = shCoefficientCount(degree);
   at::Tensor colors = at::empty({n, 3}, means.options());
   AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shForwardCpu", [&] {
     const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
-    const scalar_t* dc = sh.dc.data_ptr<scalar_t>();
-    const scalar_t* rest = sh.rest.data_ptr<scalar_t>();
-    const int64_t dc_stride = sh.dc.stride(0), rest_stride = sh.rest.stride(0);
     const scalar_t* m = means.data_ptr<scalar_t>();
     scalar_t* c = colors.data_ptr<scalar_t>();
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
       scalar_t row[16 * 3];  // the coefficients the degree uses, in one row
       for (int64_t i = begin; i < end; ++i) {
-        std::copy(dc + i * dc_stride, dc + i * dc_stride + 3, row);
-        std::copy(rest + i * rest_stride, rest + i * rest_stride + 3 * (used - 1), row + 3);
+        gatherShRow(sh, i, used, row);
         shColor(row, degree, m + 3 * i, cam, c + 3 * i);
       }
     });
@@ -123,16 +133,13 @@ at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
 
 ShGrads shBackwardCpu(const ShParts& sh, const at::Tensor& means,
                       const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors) {
-  const int64_t n = means.size(0), used = (degree + 1) * (degree + 1);
+  const int64_t n = means.size(0), used = shCoefficientCount(degree);
   ShGrads g;
   g.dc = at::empty({n, 1, 3}, means.options());
   g.rest = at::zeros({n, sh.rest.size(1), 3}, means.options());
   g.means = at::zeros_like(means);
   AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shBackwardCpu", [&] {
     const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
-    const scalar_t* dc = sh.dc.data_ptr<scalar_t>();
-    const scalar_t* rest = sh.rest.data_ptr<scalar_t>();
-    const int64_t dc_stride = sh.dc.stride(0), rest_stride = sh.rest.stride(0);
     const int64_t rest_row = 3 * sh.rest.size(1);
     const scalar_t* m = means.data_ptr<scalar_t>();
     const scalar_t* gc = g_colors.data_ptr<scalar_t>();
@@ -142,8 +149,7 @@ ShGrads shBackwardCpu(const ShParts& sh, const at::Tensor& means,
     at::parallel_for(0, n, kGaussianGrain, [&](int64_t begin, int64_t end) {
       scalar_t row[16 * 3], g_row[16 * 3];
       for (int64_t i = begin; i < end; ++i) {
-        std::copy(dc + i * dc_stride, dc + i * dc_stride + 3, row);
-        std::copy(rest + i * rest_stride, rest + i * rest_stride + 3 * (used - 1), row + 3);
+        gatherShRow(sh, i, used, row);
         std::fill(g_row, g_row + 3 * used, scalar_t(0));
         shColorBackward(row, degree, m + 3 * i, cam, gc + 3 * i, g_row, gm + 3 * i);
         std::copy(g_row, g_row + 3, g_dc + 3 * i);

@@ -97,8 +97,8 @@ __global__ void projectBackwardKernel(
 
 // One thread per Gaussian, kShBlock Gaussians per block. A Gaussian's coefficients are a row of
 // 3 (degree + 1)^2 floats (192 bytes at degree 3) in two parts (dc, rest); read or written a
-// thread per row, a warp's access would touch 32 rows at once. The block's rows go through shared memory instead, copied with
-// consecutive threads on consecutive floats. Shared rows are kShStride (odd) floats apart, so the
+// thread per row, a warp's access would touch 32 rows at once. The block's rows go through
+// shared memory instead, copied with consecutive threads on consecutive floats. Shared rows are kShStride (odd) floats apart, so the
 // 32 threads of a warp, each on its own row, hit 32 different banks.
 constexpr int kShBlock = 64;
 constexpr int kShMaxRow = 16 * 3;  // degree 3
@@ -990,7 +990,7 @@ at::Tensor shForwardCuda(const ShParts& sh, const at::Tensor& means,
   if (n == 0) return colors;
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
   shForwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
-      n, (degree + 1) * (degree + 1), degree, cam, shRows(sh), means.data_ptr<float>(),
+      n, shCoefficientCount(degree), degree, cam, shRows(sh), means.data_ptr<float>(),
       colors.data_ptr<float>());
   checkLaunch("shForwardKernel");
   return colors;
@@ -1003,7 +1003,7 @@ ShGrads shBackwardCuda(const ShParts& sh, const at::Tensor& means,
   checkShPart(sh.rest, "sh");
   check(g_colors, "grad colors");
   const int64_t n = means.size(0), rest_coefficients = sh.rest.size(1);
-  const int used = (degree + 1) * (degree + 1);
+  const int used = shCoefficientCount(degree);
   ShGrads g;
   g.dc = at::empty({n, 1, 3}, means.options());
   // Coefficients above the degree get no gradient: cleared here, the kernel writes the others.

@@ -382,9 +382,9 @@ at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& sh_rest, const at:
     expectTensor(sh, "sh", n, {-1, 3}, means);
   }
   const int64_t coefficients = sh_rest.defined() ? 1 + sh_rest.size(1) : sh.size(1);
-  if (coefficients < (degree + 1) * (degree + 1)) {
+  if (coefficients < raster::shCoefficientCount(degree)) {
     throw Error("<render>", "sh",
-                "at least " + std::to_string((degree + 1) * (degree + 1)) +
+                "at least " + std::to_string(raster::shCoefficientCount(degree)) +
                     " coefficients for SH degree " + std::to_string(degree),
                 std::to_string(coefficients));
   }
