@@ -217,6 +217,35 @@ TEST(Cli, TheLongScheduleSetsItsKeysAndKeepsGivenOnes) {
       << out;
 }
 
+// A model that densification grows to max_gaussians is said once, with the cap and what to change;
+// a run that stays below it says nothing of the kind.
+TEST(Cli, TrainSaysOnceWhenTheModelReachesTheGaussianCap) {
+  test::TempDir dir;
+  const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+  // Every Gaussian densifies (threshold 0) every 5 iterations (the 20-iteration schedule densifies
+  // from iteration 2): 400 -> 800 at 5.
+  const std::string config = dir.file("grow.json");
+  test::writeFile(config,
+                  R"({"densify_grad_threshold": 0, "densify_interval": 5, "max_gaussians": 600})");
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " train " + cache + " --iterations 20 --config " + config +
+                                 " --out " + dir.file("capped"),
+                             &out),
+            0)
+      << out;
+  const std::string said = "[densify] iteration 5: the model reached max_gaussians (600)";
+  const std::size_t at = out.find(said);
+  ASSERT_NE(at, std::string::npos) << out;
+  EXPECT_EQ(out.find("[densify]", at + 1), std::string::npos) << out;
+  EXPECT_NE(out.find("raise densify_grad_threshold"), std::string::npos) << out;
+
+  ASSERT_EQ(test::runCommand(
+                kCli + " train " + cache + " --iterations 20 --out " + dir.file("uncapped"), &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("[densify]"), std::string::npos) << out;
+}
+
 // A run trained on a relative scene path is evaluated from another working directory (run.json
 // keeps the scene's absolute path), and eval's metrics count the floaters.
 // A scene without classes.json and label maps (photos + COLMAP only): plain 3DGS end to end.

@@ -45,8 +45,9 @@ class TrainCommand : public Command {
     c->add_option("--schedule", schedule_,
                   "paper: the paper's 7000-iteration schedule (default); long: 30000 iterations, "
                   "densification in the first quarter and, with a drop, gates pushed shut only "
-                  "after it and the last sixth refined without gates (for the smallest model; "
-                  "keys you set are kept)")
+                  "after it and the last sixth refined without gates (scenes whose densification "
+                  "levels off; on real surveys it grows larger models than the default; keys you "
+                  "set are kept)")
         ->check(CLI::IsMember({"paper", "long"}));
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "

@@ -276,6 +276,9 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     return flag.item<float>() > 0;
   };
   int rendered_again = 0;  // CUDA steps whose tile lists, sized from earlier counts, were short
+  // Said once: a model at the cap has stopped growing because of it, not because the densifier
+  // converged (a real survey reached 3 M Gaussians by iteration 6000 of the long schedule).
+  bool said_cap = o.resume && trainer.numGaussians() >= config.max_gaussians;
   while (trainer.iteration() < config.iterations) {
     if (stopRequested()) {
       checkpointNow();
@@ -312,6 +315,17 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     }
     gaussians::enterPhase(profile.get(), "log and progress");
     if (log) logStep(*log, stats, seconds(), it == config.iterations);
+    if (!said_cap && stats.num_gaussians >= config.max_gaussians) {
+      said_cap = true;
+      if (o.progress) {
+        *o.progress
+            << "\n[densify] iteration " << it << ": the model reached max_gaussians ("
+            << config.max_gaussians
+            << "); densification adds no more. A model that grows to the cap has not "
+               "converged: raise densify_grad_threshold or lower densify_until in --config, "
+               "or train with a drop\n";
+      }
+    }
     if (stats.dropped > 0 && o.progress) {
       const gaussians::DropDecision& d = stats.drop;
       *o.progress << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
