@@ -6,6 +6,9 @@
 #   bash scripts/gpu/background.sh start NAME CMD...   start CMD in its own session (it outlives
 #                                                      the call) with OUT=/tmp/sadsplat-bg/NAME,
 #                                                      then wait as below
+#   bash scripts/gpu/background.sh launch NAME CMD...  start CMD as above and return at once, so
+#                                                      that the call can run other work beside it
+#                                                      (collect it with wait, this call or the next)
 #   bash scripts/gpu/background.sh wait NAME           wait until CMD ends or UNTIL_S (575) seconds
 #                                                      after this call's start; copy what CMD put in
 #                                                      its OUT (*.txt, *.tgz, *.json) and its log to
@@ -20,15 +23,15 @@
 #   bash scripts/gpu/background.sh wait long
 set -uo pipefail
 source "$(dirname "$0")/lib.sh"
-mode="${1:?usage: background.sh start NAME CMD... | wait NAME}"
+mode="${1:?usage: background.sh start|launch NAME CMD... | wait NAME}"
 name="${2:?a name for the background work}"
 shift 2
 dir=/tmp/sadsplat-bg/$name
 
-if [ "$mode" = start ]; then
-  [ $# -gt 0 ] || { echo "background.sh start $name: no command given" >&2; exit 1; }
+if [ "$mode" = start ] || [ "$mode" = launch ]; then
+  [ $# -gt 0 ] || { echo "background.sh $mode $name: no command given" >&2; exit 1; }
   if [ -f "$dir/pid" ] && kill -0 "$(cat "$dir/pid")" 2>/dev/null; then
-    echo "background.sh start $name: already running (pid $(cat "$dir/pid"))" >&2
+    echo "background.sh $mode $name: already running (pid $(cat "$dir/pid"))" >&2
     exit 1
   fi
   rm -rf "$dir" && mkdir -p "$dir/out"
@@ -36,8 +39,9 @@ if [ "$mode" = start ]; then
     background "$@" > "$dir/log" 2>&1 < /dev/null &
   echo $! > "$dir/pid"
   echo "$name: started (pid $(cat "$dir/pid")), log $dir/log"
+  [ "$mode" = launch ] && exit 0
 elif [ "$mode" != wait ]; then
-  echo "background.sh: expected start or wait, got $mode" >&2
+  echo "background.sh: expected start, launch or wait, got $mode" >&2
   exit 1
 fi
 
