@@ -173,14 +173,14 @@ struct TrainConfig {
 
   /// \brief The long schedule (`sadsplat train --schedule long`, not the paper), for scenes whose
   /// densification levels off (on a real survey whose densifier grows to max_gaussians it gives
-  /// larger models than the paper schedule; docs/measurements/gpu_long_schedule): 30000 iterations,
-  /// densification in the first quarter (densify_until = iterations / 4; 3DGS densifies for half);
-  /// with a drop, the gates are pushed shut only after the densification (lambda_l0_from =
-  /// densify_until) and the last iterations / 6 refine the model without gates
-  /// (recovery_iterations): prune, then refine, as the pruning work that reaches >= 10x does. Each
-  /// key only where it is not in `given` (keys the user set; a given `iterations` sets the length
-  /// the others follow). \param[out] changed if not null, "key default -> value" for each key it
-  /// changed
+  /// larger models than the paper schedule; docs/measurements/gpu_long_schedule): 30000
+  /// iterations, densification in the first quarter (densify_until = iterations / 4; 3DGS
+  /// densifies for half); with a drop, the gates are pushed shut only after the densification
+  /// (lambda_l0_from = densify_until) and the last iterations / 6 refine the model without gates
+  /// (recovery_iterations): prune, then refine, as the pruning work that reaches >= 10x does.
+  /// Each key only where it is not in `given` (keys the user set; a given `iterations` sets the
+  /// length the others follow).
+  /// \param[out] changed if not null, "key default -> value" for each key it changed
   TrainConfig longSchedule(const std::vector<std::string>& given,
                            std::vector<std::string>* changed = nullptr) const;
 
