@@ -106,7 +106,7 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
   for (const auto& [name, c] : true_centres) mean += c / n;
   double radius = 0;
   for (const auto& [name, c] : true_centres) radius = std::max(radius, (c - mean).norm());
-  double worst_position = 0, worst_angle = 0;
+  double worst_position = 0;
   std::vector<double> angles;
   for (const io::ColmapImage& im : model.images) {
     // Where the camera must be in the scene's frame: its GPS in east-north-up around the
@@ -119,8 +119,8 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
     // Both frames are east-north-up (their origins ~100 m apart: their axes agree to 1e-5 rad).
     const Eigen::Matrix3d d = rotation(im.qvec) * true_rotations.at(im.name).transpose();
     angles.push_back(std::acos(std::clamp((d.trace() - 1) / 2, -1.0, 1.0)));
-    worst_angle = std::max(worst_angle, angles.back());
   }
+  const double worst_angle = *std::max_element(angles.begin(), angles.end());
   std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
   const double median_angle = angles[angles.size() / 2];
   std::printf(

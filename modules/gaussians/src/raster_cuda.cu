@@ -98,8 +98,9 @@ __global__ void projectBackwardKernel(
 // One thread per Gaussian, kShBlock Gaussians per block. A Gaussian's coefficients are a row of
 // 3 (degree + 1)^2 floats (192 bytes at degree 3) in two parts (dc, rest); read or written a
 // thread per row, a warp's access would touch 32 rows at once. The block's rows go through
-// shared memory instead, copied with consecutive threads on consecutive floats. Shared rows are kShStride (odd) floats apart, so the
-// 32 threads of a warp, each on its own row, hit 32 different banks.
+// shared memory instead, copied with consecutive threads on consecutive floats. Shared rows are
+// kShStride (odd) floats apart, so the 32 threads of a warp, each on its own row, hit 32
+// different banks.
 constexpr int kShBlock = 64;
 constexpr int kShMaxRow = 16 * 3;  // degree 3
 constexpr int kShStride = kShMaxRow + 1;
