@@ -114,7 +114,7 @@ void gatherShRow(const ShParts& sh, int64_t i, int64_t used, T* row) {
 
 at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
                         const std::array<double, 3>& campos, int degree) {
-  const int64_t n = means.size(0), used = shCoefficientCount(degree);
+  const int64_t n = means.size(0), used = shCoefficientsForDegree(degree);
   at::Tensor colors = at::empty({n, 3}, means.options());
   AT_DISPATCH_FLOATING_TYPES(means.scalar_type(), "shForwardCpu", [&] {
     const scalar_t cam[3] = {scalar_t(campos[0]), scalar_t(campos[1]), scalar_t(campos[2])};
@@ -133,7 +133,7 @@ at::Tensor shForwardCpu(const ShParts& sh, const at::Tensor& means,
 
 ShGrads shBackwardCpu(const ShParts& sh, const at::Tensor& means,
                       const std::array<double, 3>& campos, int degree, const at::Tensor& g_colors) {
-  const int64_t n = means.size(0), used = shCoefficientCount(degree);
+  const int64_t n = means.size(0), used = shCoefficientsForDegree(degree);
   ShGrads g;
   g.dc = at::empty({n, 1, 3}, means.options());
   g.rest = at::zeros({n, sh.rest.size(1), 3}, means.options());

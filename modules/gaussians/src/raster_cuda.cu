@@ -991,7 +991,7 @@ at::Tensor shForwardCuda(const ShParts& sh, const at::Tensor& means,
   if (n == 0) return colors;
   const float3 cam = make_float3(float(campos[0]), float(campos[1]), float(campos[2]));
   shForwardKernel<<<shBlocksFor(n), kShBlock, 0, static_cast<cudaStream_t>(stream_ptr)>>>(
-      n, shCoefficientCount(degree), degree, cam, shRows(sh), means.data_ptr<float>(),
+      n, shCoefficientsForDegree(degree), degree, cam, shRows(sh), means.data_ptr<float>(),
       colors.data_ptr<float>());
   checkLaunch("shForwardKernel");
   return colors;
@@ -1004,7 +1004,7 @@ ShGrads shBackwardCuda(const ShParts& sh, const at::Tensor& means,
   checkShPart(sh.rest, "sh");
   check(g_colors, "grad colors");
   const int64_t n = means.size(0), rest_coefficients = sh.rest.size(1);
-  const int used = shCoefficientCount(degree);
+  const int used = shCoefficientsForDegree(degree);
   ShGrads g;
   g.dc = at::empty({n, 1, 3}, means.options());
   // Coefficients above the degree get no gradient: cleared here, the kernel writes the others.

@@ -382,9 +382,9 @@ at::Tensor evaluateSh(const at::Tensor& sh, const at::Tensor& sh_rest, const at:
     expectTensor(sh, "sh", n, {-1, 3}, means);
   }
   const int64_t coefficients = sh_rest.defined() ? 1 + sh_rest.size(1) : sh.size(1);
-  if (coefficients < raster::shCoefficientCount(degree)) {
+  if (coefficients < shCoefficientsForDegree(degree)) {
     throw Error("<render>", "sh",
-                "at least " + std::to_string(raster::shCoefficientCount(degree)) +
+                "at least " + std::to_string(shCoefficientsForDegree(degree)) +
                     " coefficients for SH degree " + std::to_string(degree),
                 std::to_string(coefficients));
   }

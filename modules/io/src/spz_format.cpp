@@ -10,6 +10,7 @@
 
 #include "compression.h"
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/sh_degree.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/gaussian_checks.h"
 #include "sadsplat/io/splat_formats.h"
@@ -37,7 +38,9 @@ constexpr std::uint64_t kMaxZstdRatio = 1024;
 // the basis functions odd in y or z change sign, those even in both keep it.
 constexpr float kRdfRubShSign[15] = {-1, -1, 1, -1, 1, 1, -1, 1, -1, 1, -1, -1, 1, -1, 1};
 
-std::size_t shDim(int degree) { return static_cast<std::size_t>((degree + 1) * (degree + 1) - 1); }
+std::size_t shDim(int degree) {
+  return static_cast<std::size_t>(shCoefficientsForDegree(degree) - 1);
+}
 
 // The byte layout of one file's attribute arrays.
 struct Layout {

@@ -35,6 +35,8 @@
 #include <pcl/point_types.h>
 #include <pcl/register_point_struct.h>
 
+#include "sadsplat/common/sh_degree.h"
+
 namespace sadsplat {
 
 /// \brief Number of spherical-harmonics coefficients beyond degree 0, per channel, at degree 3.
@@ -71,9 +73,6 @@ struct EIGEN_ALIGN16 GaussianPoint {
 /// \brief Whether every field of `a` and `b` holds the same bits (padding ignored; NaNs with
 /// equal bits compare equal). This is the equality of lossless round trips.
 bool bitwiseEqual(const GaussianPoint& a, const GaussianPoint& b);
-
-/// \brief Number of SH coefficients per colour channel for a degree (1, 4, 9 or 16).
-constexpr int shCoefficientsForDegree(int degree) { return (degree + 1) * (degree + 1); }
 
 }  // namespace sadsplat
 

@@ -17,6 +17,8 @@
 #include <limits>
 #include <type_traits>
 
+#include "sadsplat/common/sh_degree.h"
+
 #if defined(__CUDACC__)
 #define SADSPLAT_HD __host__ __device__ __forceinline__
 #else
@@ -690,9 +692,6 @@ SADSPLAT_HD void shBasisBackward(const T d[3], int degree, const T g_b[16], T g_
             g_b[14] * c14 * (xx - yy);
 }
 
-/// How many SH coefficients a degree uses: (degree + 1)^2.
-SADSPLAT_HD int shCoefficientCount(int degree) { return (degree + 1) * (degree + 1); }
-
 /// Colour of one Gaussian (3DGS): SH of `degree` in the direction from the camera centre to the
 /// mean, + 0.5, clamped at 0. `sh` holds K >= (degree+1)^2 coefficients, [k][channel].
 template <typename T>
@@ -702,7 +701,7 @@ SADSPLAT_HD void shColor(const T* sh, int degree, const T mean[3], const T campo
   for (int i = 0; i < 3; ++i) d[i] /= norm;
   T b[16];
   shBasis(d, degree, b);
-  const int K = shCoefficientCount(degree);
+  const int K = shCoefficientsForDegree(degree);
   for (int c = 0; c < 3; ++c) {
     T v = T(0.5);
     for (int k = 0; k < K; ++k) v += b[k] * sh[3 * k + c];
@@ -719,7 +718,7 @@ SADSPLAT_HD void shColorBackward(const T* sh, int degree, const T mean[3], const
   for (int i = 0; i < 3; ++i) d[i] /= norm;
   T b[16];
   shBasis(d, degree, b);
-  const int K = shCoefficientCount(degree);
+  const int K = shCoefficientsForDegree(degree);
   T g[3];
   for (int c = 0; c < 3; ++c) {
     T v = T(0.5);
