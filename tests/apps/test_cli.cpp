@@ -11,6 +11,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/train_log.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -238,6 +239,15 @@ TEST(Cli, TrainSaysOnceWhenTheModelReachesTheGaussianCap) {
   ASSERT_NE(at, std::string::npos) << out;
   EXPECT_EQ(out.find("[densify]", at + 1), std::string::npos) << out;
   EXPECT_NE(out.find("raise densify_grad_threshold"), std::string::npos) << out;
+  // The log says it too, once, for readers of the run that did not see the terminal.
+  int cap_records = 0;
+  for (const io::TrainLogRecord& r : io::readTrainLog(dir.file("capped") + "/train_log.jsonl")) {
+    if (r.type != "max_gaussians_reached") continue;
+    ++cap_records;
+    EXPECT_EQ(r.iteration, 5);
+    EXPECT_GE(r.gaussians, 600);
+  }
+  EXPECT_EQ(cap_records, 1);
 
   ASSERT_EQ(test::runCommand(
                 kCli + " train " + cache + " --iterations 20 --out " + dir.file("uncapped"), &out),

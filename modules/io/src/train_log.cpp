@@ -52,7 +52,7 @@ void TrainLogWriter::append(const TrainLogRecord& r) {
     j["rgb_loss"] = r.rgb_loss;
     j["semantic_loss"] = r.semantic_loss;
     j["seconds"] = r.seconds;
-  } else {
+  } else if (r.type != "max_gaussians_reached") {
     j["removed"] = r.removed;
   }
   if (r.type == "recovery") j["closed_gate"] = r.closed_gate;

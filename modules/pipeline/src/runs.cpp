@@ -317,6 +317,13 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     if (log) logStep(*log, stats, seconds(), it == config.iterations);
     if (!said_cap && stats.num_gaussians >= config.max_gaussians) {
       said_cap = true;
+      if (log) {
+        io::TrainLogRecord r;
+        r.type = "max_gaussians_reached";
+        r.iteration = it;
+        r.gaussians = stats.num_gaussians;
+        log->append(r);
+      }
       if (o.progress) {
         *o.progress
             << "\n[densify] iteration " << it << ": the model reached max_gaussians ("

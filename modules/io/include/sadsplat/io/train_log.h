@@ -12,7 +12,9 @@
 ///   after the last iteration;
 /// - `{"type":"recovery","iteration","removed","gaussians","closed_gate"}`: the start of the
 ///   recovery phase (gates folded into the opacities): `closed_gate` Gaussians with a closed gate
-///   and `removed - closed_gate` least contributing ones removed.
+///   and `removed - closed_gate` least contributing ones removed;
+/// - `{"type":"max_gaussians_reached","iteration","gaussians"}`: the model reached the
+///   `max_gaussians` cap (densification adds no more), once per run.
 /// A resumed run first drops the records after the checkpoint's iteration (those steps are
 /// trained again), then appends: the log reads as one uninterrupted run.
 
@@ -25,7 +27,7 @@ namespace io {
 
 /// \brief One record of a train log.
 struct TrainLogRecord {
-  std::string type = "step";  ///< step, drop, closed_gates or recovery
+  std::string type = "step";  ///< step, drop, closed_gates, recovery, max_gaussians_reached
   int iteration = 0;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;  ///< step records
   double seconds = 0;                                ///< training time so far (step records)
