@@ -136,15 +136,15 @@ struct TrainConfig {
   double recovery_prune = 0.0;
   /// How the L0 pressure and the drop events are set (docs/GUIDE.md, "The drop rule"):
   /// "balanced" (default, not the paper): the L0 force on each gate of a Gaussian the losses
-  /// reached this step is l0_strength x the mean loss force on those gates (no L0 term in the loss, so
-  /// image size, Gaussian count, view count and loss level cancel); one drop event removes at
-  /// most drop_max_fraction of the Gaussians (those of highest P_drop); when the mean squared
-  /// error of four fixed training views (rendered as for evaluation) before a drop event exceeds
-  /// that before the previous event by more than drop_guard (and no opacity reset came between),
-  /// the L0 strength and the cap halve; a Gaussian that no confidence map sees
-  /// takes the mean confidence of those seen (0.5 when there are no maps).
-  /// "paper": L_L0 = lambda_l0 x mean P_nonzero in the loss, P_drop = P_base (1 - P_conf)
-  /// P_learned with P_conf = 0 where no map sees a Gaussian, no cap, no guard.
+  /// reached this step is l0_strength x the mean loss force on those gates (no L0 term in the loss,
+  /// so image size, Gaussian count, view count and loss level cancel); one drop event removes at
+  /// most drop_max_fraction of the Gaussians (those of highest P_drop); when the mean squared error
+  /// of four fixed training views (rendered as for evaluation) before a drop event exceeds that
+  /// before the previous event by more than drop_guard (and no opacity reset came between), the L0
+  /// strength and the cap halve; a Gaussian that no confidence map sees takes the mean confidence
+  /// of those seen (0.5 when there are no maps).
+  /// "paper": L_L0 = lambda_l0 x mean P_nonzero in the loss, P_drop = P_base (1 - P_conf) P_learned
+  /// with P_conf = 0 where no map sees a Gaussian, no cap, no guard.
   std::string drop_rule = "balanced";
   double l0_strength = 1.0;
   double drop_max_fraction = 0.15;
