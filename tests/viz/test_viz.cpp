@@ -276,6 +276,32 @@ TEST(Report, HoldsEveryPlotAndLinksThem) {
   EXPECT_NE(out.find("run directory"), std::string::npos) << out;
 }
 
+// A run whose log records the max_gaussians cap: the report says so, with the iteration; a run
+// without the record does not.
+TEST(Report, SaysWhenTheModelReachedTheGaussianCap) {
+  test::TempDir dir;
+  const std::string steps =
+      "{\"type\":\"step\",\"iteration\":10,\"loss\":0.5,\"rgb_loss\":0.5,"
+      "\"semantic_loss\":0,\"gaussians\":400,\"seconds\":1}\n"
+      "{\"type\":\"step\",\"iteration\":20,\"loss\":0.4,\"rgb_loss\":0.4,"
+      "\"semantic_loss\":0,\"gaussians\":800,\"seconds\":2}\n";
+  io::makeDirectory(dir.file("capped"));
+  io::makeDirectory(dir.file("plain"));
+  test::writeFile(dir.file("capped/train_log.jsonl"),
+                  steps +
+                      "{\"type\":\"max_gaussians_reached\",\"iteration\":15,"
+                      "\"gaussians\":800}\n");
+  test::writeFile(dir.file("plain/train_log.jsonl"), steps);
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " report " + dir.file("capped"), &out), 0) << out;
+  ASSERT_EQ(test::runCommand(kCli + " report " + dir.file("plain"), &out), 0) << out;
+  const std::string capped = test::readFile(dir.file("capped/report/report.md"));
+  EXPECT_NE(capped.find("reached max_gaussians at iteration 15 (800 Gaussians)"), std::string::npos)
+      << capped;
+  EXPECT_EQ(test::readFile(dir.file("plain/report/report.md")).find("max_gaussians"),
+            std::string::npos);
+}
+
 // Splat mode (the default): a short run seen through a scene camera is what `sadsplat render`
 // draws for that camera; classes are decoded per pixel; colourings and --mode points change the
 // picture.

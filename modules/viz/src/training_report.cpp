@@ -185,6 +185,13 @@ std::string writeTrainingReport(const ReportOptions& options) {
        << "` first for the metrics, the IoU per class and the panels.\n";
   }
   md << "\n## Loss\n\n![loss](loss.png)\n\n## Gaussians\n\n![Gaussians](gaussians.png)\n\n";
+  for (const auto& r : run.log) {
+    if (r.type != "max_gaussians_reached") continue;
+    md << "**The model reached max_gaussians at iteration " << r.iteration << " (" << r.gaussians
+       << " Gaussians); densification added no more.** A model that grows to the cap has not "
+          "converged: raise densify_grad_threshold or lower densify_until in --config, or train "
+          "with a drop.\n\n";
+  }
   std::size_t events = 0;
   for (const auto& r : run.log) {
     if (r.type == "drop") {
