@@ -325,12 +325,9 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
         log->append(r);
       }
       if (o.progress) {
-        *o.progress
-            << "\n[densify] iteration " << it << ": the model reached max_gaussians ("
-            << config.max_gaussians
-            << "); densification adds no more. A model that grows to the cap has not "
-               "converged: raise densify_grad_threshold or lower densify_until in --config, "
-               "or train with a drop\n";
+        *o.progress << "\n[densify] iteration " << it << ": the model reached max_gaussians ("
+                    << config.max_gaussians << "); densification adds no more. "
+                    << io::kMaxGaussiansAdvice << "\n";
       }
     }
     if (stats.dropped > 0 && o.progress) {

@@ -188,9 +188,7 @@ std::string writeTrainingReport(const ReportOptions& options) {
   for (const auto& r : run.log) {
     if (r.type != "max_gaussians_reached") continue;
     md << "**The model reached max_gaussians at iteration " << r.iteration << " (" << r.gaussians
-       << " Gaussians); densification added no more.** A model that grows to the cap has not "
-          "converged: raise densify_grad_threshold or lower densify_until in --config, or train "
-          "with a drop.\n\n";
+       << " Gaussians); densification added no more.** " << io::kMaxGaussiansAdvice << ".\n\n";
   }
   std::size_t events = 0;
   for (const auto& r : run.log) {

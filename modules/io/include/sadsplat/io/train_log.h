@@ -25,6 +25,12 @@
 namespace sadsplat {
 namespace io {
 
+/// \brief What to do about a `max_gaussians_reached` record: the training's progress line and
+/// `sadsplat report` both say it.
+inline constexpr const char* kMaxGaussiansAdvice =
+    "A model that grows to the cap has not converged: raise densify_grad_threshold or lower "
+    "densify_until in --config, or train with a drop";
+
 /// \brief One record of a train log.
 struct TrainLogRecord {
   std::string type = "step";  ///< step, drop, closed_gates, recovery, max_gaussians_reached
