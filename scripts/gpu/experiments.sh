@@ -36,8 +36,11 @@
 # table_TABLE.tgz (the new metrics.json files in that layout, train logs) and table_TABLE.txt:
 #   tar xzf table_TABLE.tgz -C docs/experiments/TABLE && sadsplat table docs/experiments/TABLE \
 #     --out docs/experiments/TABLE/README.md
+#   defaults   3 seed-0 scenes x none (Net-1) and full (Net-4: pseudo-labels, --drop full) under
+#              the current defaults x training seeds 0-2 (the README's default numbers)
 #   ablation   9 scenes (city/country/port x seeds 0-2) x none (Net-1), drop (Net-2), pl (Net-3),
-#              full (Net-4) x training seeds 0-2
+#              full (Net-4) x training seeds 0-2 (measured 2026-11-24/25: the paper's drop rule,
+#              today --drop-rule paper, densifying for half the iterations)
 #   pbase      3 seed-0 scenes x full with P_base 0 / 0.5 / 1 / 1.5 / 2 x training seeds 0-2
 #   l0schedule 3 seed-0 scenes x full with the L0 weight off until N (_fromN), rising over M
 #              (_rampM), weight X (_lambdaX)
@@ -199,11 +202,12 @@ table_run_one() {
 }
 
 mode_table() {
-  table="${1:?usage: experiments.sh table ablation|pbase|l0schedule|growth|late|recovery [JOBS] [DEADLINE_S]}"
+  table="${1:?usage: experiments.sh table defaults|ablation|pbase|l0schedule|growth|late|recovery [JOBS] [DEADLINE_S]}"
   local parallel="${2:-4}"; deadline_start "${3:-540}"
   device="${DEVICE:-cuda}"; size="${WIDTH:-800}x${HEIGHT:-450}"; iterations="${ITERATIONS:-7000}"
   local scenes configs
   case "$table" in
+    defaults) scenes=(city_0 country_0 port_0); configs=(none full) ;;
     ablation) scenes=(city_0 country_0 port_0 city_1 country_1 port_1 city_2 country_2 port_2)
               configs=(none full drop pl) ;;
     pbase)    scenes=(city_0 country_0 port_0); configs=(full_p1 full_p0 full_p2 full_p0.5 full_p1.5) ;;
@@ -214,7 +218,7 @@ mode_table() {
               configs=(none full full_from3500_rec1000_s3 full_from3500_rec1000_s4) ;;
     recovery) scenes=(city_0 country_0 port_0)
               configs=(none full full_rec1000 full_rec1000_rp0.3 full_rec1000_rp0.5) ;;
-    *) echo "unknown table $table (ablation, pbase, l0schedule, growth, late or recovery)"; return 2 ;;
+    *) echo "unknown table $table (defaults, ablation, pbase, l0schedule, growth, late or recovery)"; return 2 ;;
   esac
   [ -n "${SCENES:-}" ] && read -r -a scenes <<< "$SCENES"
   [ -n "${CONFIGS:-}" ] && read -r -a configs <<< "$CONFIGS"

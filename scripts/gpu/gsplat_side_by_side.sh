@@ -12,7 +12,8 @@
 #           CUDA SSIM, as gsplat's trainer; torchssim = SSIM composed of torch convolutions;
 #           nossim = SSIM weight 0, a lower bound). LIKE_FOR_LIKE=1
 #           adds sadsplat Net-1 with max_screen_radius 100000: no screen-size pruning, as
-#           gsplat's default strategy (the Gaussian counts then match).
+#           gsplat's default strategy, and densify_until 3500, the reference's refine_stop_iter
+#           (the Gaussian counts then match).
 # No run starts when fewer than its expected seconds are left before LIMIT. $OUT gets
 # side_by_side.txt (the tables) and side_by_side.tgz (logs, metrics JSON).
 set -uo pipefail
@@ -93,8 +94,9 @@ for scene in "${args[@]}"; do
   cache=$(scene_cache "$scene") || break
   [ "$(left)" -gt 75 ] && train_sadsplat "${scene}_net1" "$cache" --drop none
   if [ "${LIKE_FOR_LIKE:-0}" = 1 ] && [ "$(left)" -gt 90 ]; then
-    # Net-1 without the screen-size pruning, as gsplat's default strategy (refine_scale2d_stop_iter 0).
-    echo '{"max_screen_radius": 100000}' > "$work/no_screen_pruning.json"
+    # Net-1 without the screen-size pruning, as gsplat's default strategy (refine_scale2d_stop_iter 0),
+    # densifying for half the iterations as the reference does (refine_stop_iter).
+    echo '{"max_screen_radius": 100000, "densify_until": 3500}' > "$work/no_screen_pruning.json"
     train_sadsplat "${scene}_net1_nosr" "$cache" --drop none --config "$work/no_screen_pruning.json"
   fi
   if [ $gs_ok = 0 ] && [ $smoke_done = 0 ]; then

@@ -153,6 +153,7 @@ TEST(StepProfile, AProfiledTrainingTimesEveryPhaseAndGivesTheSameModel) {
   config.iterations = 12;
   config.feature_dim = 8;
   config.densify_from = 4;
+  config.densify_until = 6;  // one densification round, at iteration 5
   config.densify_interval = 5;
   config.checkpoint_interval = 0;
   gaussians::Trainer plain(scene, config), profiled(scene, config);

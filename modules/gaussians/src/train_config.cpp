@@ -145,7 +145,7 @@ const std::vector<TrainOption> kOptions = {
     {"lr_feature", &C::lr_feature, "learning rate of the semantic features", nullptr, 0, kInf},
     {"lr_decoder", &C::lr_decoder, "learning rate of the feature decoder", nullptr, 0, kInf},
     {"densify_from", &C::densify_from, "first densification iteration", nullptr, 0, kInf},
-    {"densify_until", &C::densify_until, "last densification iteration (-1: half the iterations)",
+    {"densify_until", &C::densify_until, "last densification iteration (-1: 2/7 of the iterations)",
      nullptr, -1, kInf},
     {"densify_interval", &C::densify_interval, "iterations between densifications", nullptr, 1,
      kInf},
@@ -361,7 +361,13 @@ TrainConfig TrainConfig::shortRunSchedule(const std::vector<std::string>& given,
   keys.set("opacity_reset_interval", c.opacity_reset_interval,
            std::max(iterations, opacity_reset_interval));
   keys.set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
+  if (c.densify_until < 0) keys.set("densify_until", c.densify_until, iterations / 2);
   return c;
+}
+
+int TrainConfig::densifyUntilResolved() const {
+  if (densify_until >= 0) return densify_until;
+  return static_cast<int>(std::int64_t{iterations} * 2 / 7);
 }
 
 TrainConfig TrainConfig::longSchedule(const std::vector<std::string>& given,
@@ -374,8 +380,7 @@ TrainConfig TrainConfig::longSchedule(const std::vector<std::string>& given,
   // gpu_long_schedule).
   keys.set("densify_until", c.densify_until, c.iterations / 4);
   if (c.drop != "none") {
-    const int densify_end = c.densify_until < 0 ? c.iterations / 2 : c.densify_until;
-    keys.set("lambda_l0_from", c.lambda_l0_from, densify_end);
+    keys.set("lambda_l0_from", c.lambda_l0_from, c.densifyUntilResolved());
     keys.set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
   }
   return c;

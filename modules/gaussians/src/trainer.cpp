@@ -49,7 +49,7 @@ void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
 
 // The keys whose -1 means "from the number of iterations", resolved.
 TrainConfig withScheduleResolved(TrainConfig c) {
-  if (c.densify_until < 0) c.densify_until = c.iterations / 2;
+  c.densify_until = c.densifyUntilResolved();
   if (c.scale_limit_from < 0) c.scale_limit_from = c.iterations - c.iterations / 7;
   return c;
 }
