@@ -300,6 +300,17 @@ TEST(Report, SaysWhenTheModelReachedTheGaussianCap) {
       << capped;
   EXPECT_EQ(test::readFile(dir.file("plain/report/report.md")).find("max_gaussians"),
             std::string::npos);
+  // The Gaussians chart marks it (a purple point and its legend entry); the plain run's has no
+  // purple.
+  const std::array<std::uint8_t, 3> kCapColour = {148, 103, 189};
+  const auto purple = [&](const std::string& png_path) {
+    const Png png = readPng(png_path);
+    std::size_t n = 0;
+    for (const auto& p : png.pixels) n += near(p, kCapColour, 20);
+    return n;
+  };
+  EXPECT_GT(purple(dir.file("capped/report/gaussians.png")), 20u);
+  EXPECT_EQ(purple(dir.file("plain/report/gaussians.png")), 0u);
 }
 
 // Splat mode (the default): a short run seen through a scene camera is what `sadsplat render`

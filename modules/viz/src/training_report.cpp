@@ -87,6 +87,7 @@ std::string writeTrainingReport(const ReportOptions& options) {
   ChartSeries rest = series("rest (L0, ...)", {148, 103, 189});
   ChartSeries count = series(run.name, {31, 119, 180});
   ChartSeries drops = series("drop events", {214, 39, 40}, true);
+  ChartSeries cap = series("max_gaussians reached", {148, 103, 189}, true);
   for (const auto& r : run.log) {
     if (r.type == "step") {
       total.x.push_back(r.iteration);
@@ -106,6 +107,10 @@ std::string writeTrainingReport(const ReportOptions& options) {
       drops.x.push_back(r.iteration);
       drops.y.push_back(static_cast<double>(r.gaussians));
     }
+    if (r.type == "max_gaussians_reached") {
+      cap.x.push_back(r.iteration);
+      cap.y.push_back(static_cast<double>(r.gaussians));
+    }
   }
   if (total.x.empty()) {
     throw Error((fs::path(run.dir) / "train_log.jsonl").string(), "records",
@@ -113,6 +118,7 @@ std::string writeTrainingReport(const ReportOptions& options) {
   }
   std::vector<ChartSeries> loss_series = {total, rgb, sem, rest};
   std::vector<ChartSeries> count_series = {count, drops};
+  if (!cap.x.empty()) count_series.push_back(cap);
   if (base) {
     ChartSeries base_total = series("total " + base->name, {255, 127, 14});
     ChartSeries base_count = series(base->name, {255, 127, 14});
@@ -128,9 +134,10 @@ std::string writeTrainingReport(const ReportOptions& options) {
   }
   writeLineChart(file("loss.png"), {"Training loss", "iteration", "loss", 900, 500, false},
                  loss_series);
-  writeLineChart(file("gaussians.png"),
-                 {"Gaussians (drop events marked)", "iteration", "Gaussians", 900, 500, false},
-                 count_series);
+  writeLineChart(
+      file("gaussians.png"),
+      {"Gaussians (drop events and the cap marked)", "iteration", "Gaussians", 900, 500, false},
+      count_series);
 
   // Per-class IoU.
   bool have_iou = false;
