@@ -809,6 +809,16 @@ TEST(TrainConfigSchedule, DensificationEndsAtTwoSeventhsAndAShortRunDensifiesFor
   EXPECT_EQ(s.shortRunSchedule({}).densify_until, 100);
 }
 
+// The trainer runs (and a run's config.json records) the resolved end, not -1.
+TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
+  TrainConfig c = small(70);
+  const Trainer plain(scene_, c);
+  EXPECT_EQ(plain.config().densify_until, 20);
+  c.densify_until = 35;
+  const Trainer given(scene_, c);
+  EXPECT_EQ(given.config().densify_until, 35);
+}
+
 TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {
   TrainConfig c;
   std::vector<std::string> changed;
