@@ -273,6 +273,9 @@ TEST(Cli, AnRgbOnlySceneTrainsEvaluatesAndSaysWhyThereIsNoMiou) {
   // The import scale and the short run's schedule are said.
   EXPECT_NE(out.find("at image scale 0.5"), std::string::npos) << out;
   EXPECT_NE(out.find("schedule of a run of 30 iterations"), std::string::npos) << out;
+  EXPECT_NE(out.find("schedule: 30 iterations; no densification; opacity reset none"),
+            std::string::npos)
+      << out;
   io::PlyFileInfo info;
   io::readGaussianPly(run + "/model.ply", &info);
   EXPECT_EQ(info.feature_dim, 0);

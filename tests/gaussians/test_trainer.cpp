@@ -817,6 +817,19 @@ TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
   c.densify_until = 35;
   const Trainer given(scene_, c);
   EXPECT_EQ(given.config().densify_until, 35);
+  // What `sadsplat train` says of it: the default 7000-iteration schedule has no opacity reset.
+  TrainConfig d;
+  d.checkpoint_interval = 0;
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "7000 iterations; densification after 500 until 2000 every 100; opacity reset none; "
+            "scale limit 0.1 x the extent from 6000");
+  d.densify_until = 3500;
+  d.scale_limit = 0;
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "7000 iterations; densification after 500 until 3500 every 100; opacity reset at 3000");
+  EXPECT_EQ(describeDefaultDensification(plain.config()),
+            "70 iterations; no densification; opacity reset none; scale limit 0.1 x the extent "
+            "from 60");
 }
 
 TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {

@@ -1,7 +1,10 @@
 #include "sadsplat/gaussians/densification.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
+#include <string>
 #include <tuple>
 
 #include "sadsplat/common/error.h"
@@ -225,6 +228,30 @@ class DefaultDensification : public DensificationStrategy {
 bool resetsOpacitiesAfter(const TrainConfig& c, int done) {
   return c.opacity_reset_interval > 0 && done <= c.densify_until &&
          done % c.opacity_reset_interval == 0;
+}
+
+std::string describeDefaultDensification(const TrainConfig& c) {
+  std::ostringstream s;
+  s << c.iterations << " iterations; ";
+  // Densification rounds come at the multiples of densify_interval in (densify_from, until].
+  const int first = (c.densify_from / c.densify_interval + 1) * c.densify_interval;
+  if (first > std::min(c.densify_until, c.iterations)) {
+    s << "no densification";
+  } else {
+    s << "densification after " << c.densify_from << " until " << c.densify_until << " every "
+      << c.densify_interval;
+  }
+  std::string resets;
+  for (int done = c.opacity_reset_interval; c.opacity_reset_interval > 0 && done < c.iterations;
+       done += c.opacity_reset_interval) {
+    if (resetsOpacitiesAfter(c, done))
+      resets += (resets.empty() ? "" : ", ") + std::to_string(done);
+  }
+  s << "; opacity reset " << (resets.empty() ? "none" : "at " + resets);
+  if (c.scale_limit > 0 && c.scale_limit_from < c.iterations) {
+    s << "; scale limit " << c.scale_limit << " x the extent from " << c.scale_limit_from;
+  }
+  return s.str();
 }
 
 DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent) {

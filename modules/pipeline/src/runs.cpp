@@ -18,6 +18,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/eval/evaluation.h"
+#include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
@@ -217,6 +218,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   trainer.setCollective(o.collective);
   if (o.resume) trainer.loadCheckpoint(checkpoint);
   if (writer) writeText(o.out + "/config.json", trainer.config().toJson());
+  if (o.progress && !o.resume) {
+    *o.progress << "schedule: " << gaussians::describeDefaultDensification(trainer.config())
+                << "\n";
+  }
   gaussians::StepProfile::Ptr profile;
   if (o.profile) {
     profile = std::make_shared<gaussians::StepProfile>(

@@ -67,5 +67,10 @@ DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, d
 /// opacity_reset_interval up to densify_until (resolved, not -1).
 bool resetsOpacitiesAfter(const TrainConfig& config, int done);
 
+/// \brief One line of what the default strategy does over the run of `config` (densify_until
+/// and scale_limit_from resolved, not -1), e.g. "7000 iterations; densification after 500
+/// until 2000 every 100; opacity reset none; scale limit 0.1 x the extent from 6000".
+std::string describeDefaultDensification(const TrainConfig& config);
+
 }  // namespace gaussians
 }  // namespace sadsplat
