@@ -827,6 +827,10 @@ TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
   d.scale_limit = 0;
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "7000 iterations; densification after 500 until 3500 every 100; opacity reset at 3000");
+  d.opacity_reset_interval = 100;  // many resets: a range, not a list
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "7000 iterations; densification after 500 until 3500 every 100; opacity reset every "
+            "100 from 100 to 3500");
   EXPECT_EQ(describeDefaultDensification(plain.config()),
             "70 iterations; no densification; opacity reset none; scale limit 0.1 x the extent "
             "from 60");

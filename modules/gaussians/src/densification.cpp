@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <sstream>
 #include <string>
@@ -234,20 +235,29 @@ std::string describeDefaultDensification(const TrainConfig& c) {
   std::ostringstream s;
   s << c.iterations << " iterations; ";
   // Densification rounds come at the multiples of densify_interval in (densify_from, until].
-  const int first = (c.densify_from / c.densify_interval + 1) * c.densify_interval;
+  const std::int64_t first =
+      (std::int64_t{c.densify_from} / c.densify_interval + 1) * c.densify_interval;
   if (first > std::min(c.densify_until, c.iterations)) {
     s << "no densification";
   } else {
     s << "densification after " << c.densify_from << " until " << c.densify_until << " every "
       << c.densify_interval;
   }
-  std::string resets;
-  for (int done = c.opacity_reset_interval; c.opacity_reset_interval > 0 && done < c.iterations;
-       done += c.opacity_reset_interval) {
-    if (resetsOpacitiesAfter(c, done))
-      resets += (resets.empty() ? "" : ", ") + std::to_string(done);
+  // Resets after the multiples of opacity_reset_interval up to densify_until and before the
+  // last iteration (resetsOpacitiesAfter); counted, not walked (64 bits: any interval, any length).
+  const std::int64_t interval = c.opacity_reset_interval;
+  const std::int64_t last_done =
+      std::min<std::int64_t>(std::int64_t{c.iterations} - 1, c.densify_until);
+  const std::int64_t resets = interval > 0 && last_done > 0 ? last_done / interval : 0;
+  s << "; opacity reset ";
+  if (resets == 0) {
+    s << "none";
+  } else if (resets <= 4) {
+    s << "at ";
+    for (std::int64_t r = 1; r <= resets; ++r) s << (r > 1 ? ", " : "") << r * interval;
+  } else {
+    s << "every " << interval << " from " << interval << " to " << resets * interval;
   }
-  s << "; opacity reset " << (resets.empty() ? "none" : "at " + resets);
   if (c.scale_limit > 0 && c.scale_limit_from < c.iterations) {
     s << "; scale limit " << c.scale_limit << " x the extent from " << c.scale_limit_from;
   }
