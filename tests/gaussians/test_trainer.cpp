@@ -831,6 +831,13 @@ TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "7000 iterations; densification after 500 until 3500 every 100; opacity reset every "
             "100 from 100 to 3500");
+  // A reset on the last iteration is said too (the strategy runs after the last step).
+  d.iterations = 9000;
+  d.densify_until = 9000;
+  d.opacity_reset_interval = 3000;
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "9000 iterations; densification after 500 until 9000 every 100; opacity reset at "
+            "3000, 6000, 9000");
   EXPECT_EQ(describeDefaultDensification(plain.config()),
             "70 iterations; no densification; opacity reset none; scale limit 0.1 x the extent "
             "from 60");

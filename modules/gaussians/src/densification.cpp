@@ -243,11 +243,11 @@ std::string describeDefaultDensification(const TrainConfig& c) {
     s << "densification after " << c.densify_from << " until " << c.densify_until << " every "
       << c.densify_interval;
   }
-  // Resets after the multiples of opacity_reset_interval up to densify_until and before the
-  // last iteration (resetsOpacitiesAfter); counted, not walked (64 bits: any interval, any length).
+  // Resets after the multiples of opacity_reset_interval up to densify_until
+  // (resetsOpacitiesAfter), the last iteration included: stepPostUpdate runs after it too.
+  // Counted, not walked (64 bits: any interval, any length).
   const std::int64_t interval = c.opacity_reset_interval;
-  const std::int64_t last_done =
-      std::min<std::int64_t>(std::int64_t{c.iterations} - 1, c.densify_until);
+  const std::int64_t last_done = std::min(c.iterations, c.densify_until);
   const std::int64_t resets = interval > 0 && last_done > 0 ? last_done / interval : 0;
   s << "; opacity reset ";
   if (resets == 0) {
