@@ -831,16 +831,45 @@ TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "7000 iterations; densification after 500 until 3500 every 100; opacity reset every "
             "100 from 100 to 3500");
-  // A reset on the last iteration is said too (the strategy runs after the last step).
+  // No reset in the last third of an interval: densifying until the end, a reset after the
+  // last iteration (or 900 before it) would leave every opacity at 0.01.
   d.iterations = 9000;
   d.densify_until = 9000;
   d.opacity_reset_interval = 3000;
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "9000 iterations; densification after 500 until 9000 every 100; opacity reset at "
+            "3000, 6000");
+  d.iterations = 9900;  // 6000 and 9000 allowed; 9000 is 900 before the end: not
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "9900 iterations; densification after 500 until 9000 every 100; opacity reset at "
+            "3000, 6000");
+  d.iterations = 10000;  // 1000 after 9000: allowed
+  EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
+            "10000 iterations; densification after 500 until 9000 every 100; opacity reset at "
             "3000, 6000, 9000");
   EXPECT_EQ(describeDefaultDensification(plain.config()),
             "70 iterations; no densification; opacity reset none; scale limit 0.1 x the extent "
             "from 60");
+}
+
+// Densifying until the end with a reset interval that divides the run: the reset after the
+// last iteration (and any in the last third of an interval) is skipped, one with room after it
+// happens. Before, the model came out with every opacity at 0.01.
+TEST_F(TrainerTest, NoOpacityResetWithoutRoomToRecoverBeforeTheEnd) {
+  TrainConfig c = small(60);
+  c.densify_until = 60;
+  c.opacity_reset_interval = 30;
+  Trainer trainer(scene_, c);
+  const auto max_opacity = [&] {
+    return at::sigmoid(trainer.parameters().opacity_logits.detach()).max().item<double>();
+  };
+  for (int i = 1; i <= 60; ++i) {
+    trainer.step();
+    if (i == 30) EXPECT_LE(max_opacity(), 0.0100001) << "the reset after iteration 30 happens";
+  }
+  EXPECT_GT(max_opacity(), 0.011) << "no reset after the last iteration";
+  EXPECT_FALSE(gaussians::resetsOpacitiesAfter(trainer.config(), 60));
+  EXPECT_TRUE(gaussians::resetsOpacitiesAfter(trainer.config(), 30));
 }
 
 TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {

@@ -64,7 +64,8 @@ class DensificationStrategy {
 DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent);
 
 /// \brief Whether the default strategy resets the opacities after iteration `done`: a multiple of
-/// opacity_reset_interval up to densify_until (resolved, not -1).
+/// opacity_reset_interval up to densify_until (resolved, not -1), and none in the last third of
+/// an interval before the end of the run (the opacities would have no time to recover).
 bool resetsOpacitiesAfter(const TrainConfig& config, int done);
 
 /// \brief One line of what the default strategy does over the run of `config` (densify_until
