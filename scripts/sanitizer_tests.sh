@@ -9,7 +9,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # No precompiled headers here: at -O0 with the sanitizers' instrumentation the sources spend little
 # of their time parsing, and making the headers cost what they saved (2 cores, 2026-11-28: 2107 s
-# of compiler time and 644 s of wall with them, 2057 s and 638 s without, two fresh clones).
+# of compiler time and 644 s of wall with them; 2057 s and 638 s without, a clone built earlier
+# that day on another machine start).
 # -O0 -g1 (line tables: stack traces keep file and line) compiles in half the time of -O1 -g
 # (2 cores, 2026-11-26: 9 min 37 s for the whole build; one LibTorch-heavy unity file 86 s at
 # -O1 -g, 41 s at -O0 -g1) and the tests take as long: the module whose loops they run,
