@@ -9,8 +9,8 @@
 # 30-70 s to make on 2 cores; a clean Release build there took 581 instead of 685 s (compiler
 # time 1817 instead of 2104 s, 2026-11-28). The sanitizer build gains nothing and leaves them.
 #   sadsplat_precompile_headers(PLAIN targets... TORCH targets... TORCH_OPENMP targets...)
-# TORCH: links LibTorch; TORCH_OPENMP: LibTorch and OpenMP (sadsplat_link_openmp). Executables and test suites are
-# told apart by their target type and a link to GoogleTest. CMake precompiles for C and C++ only
+# TORCH: links LibTorch; TORCH_OPENMP: LibTorch and OpenMP (sadsplat_link_openmp). Executables
+# and test suites are told apart by their target type and a link to GoogleTest. CMake precompiles for C and C++ only
 # (sadsplat has no C sources); a source compiled for another instruction set sets
 # SKIP_PRECOMPILE_HEADERS.
 option(SADSPLAT_PRECOMPILE_HEADERS "Precompile the third-party headers most sources parse" ON)
