@@ -10,9 +10,9 @@
 # time 1817 instead of 2104 s, 2026-11-28). The sanitizer build gains nothing and leaves them.
 #   sadsplat_precompile_headers(PLAIN targets... TORCH targets... TORCH_OPENMP targets...)
 # TORCH: links LibTorch; TORCH_OPENMP: LibTorch and OpenMP (sadsplat_link_openmp). Executables
-# and test suites are told apart by their target type and a link to GoogleTest. CMake precompiles for C and C++ only
-# (sadsplat has no C sources); a source compiled for another instruction set sets
-# SKIP_PRECOMPILE_HEADERS.
+# and test suites are told apart by their target type and a link to GoogleTest. CMake
+# precompiles for C and C++ only (sadsplat has no C sources); a source compiled for another
+# instruction set sets SKIP_PRECOMPILE_HEADERS.
 option(SADSPLAT_PRECOMPILE_HEADERS "Precompile the third-party headers most sources parse" ON)
 
 set(_sadsplat_pch_plain <pcl/point_types.h> <pcl/point_cloud.h> <nlohmann/json.hpp>)
@@ -26,7 +26,8 @@ function(_sadsplat_pch_host host torch omp exe test levels)
   endif()
   set(source ${CMAKE_BINARY_DIR}/pch/${host}.cpp)
   file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/pch)
-  file(WRITE ${source} "// Compiles the precompiled header of this kind of target (cmake/SadsplatPrecompiledHeaders.cmake).\n")
+  file(WRITE ${source}
+       "// The precompiled header of one kind of target: cmake/SadsplatPrecompiledHeaders.cmake\n")
   add_library(${host} OBJECT ${source})
   # What sadsplat_common passes on (PCL, the build's definitions), not sadsplat_common itself:
   # it reuses a host too.
