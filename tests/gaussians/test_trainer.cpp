@@ -839,7 +839,7 @@ TEST_F(TrainerTest, TheTrainerRunsTheResolvedDensificationEnd) {
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "9000 iterations; densification after 500 until 9000 every 100; opacity reset at "
             "3000, 6000");
-  d.iterations = 9900;  // 6000 and 9000 allowed; 9000 is 900 before the end: not
+  d.iterations = 9900;  // 9000 is 900 before the end: not allowed
   EXPECT_EQ(describeDefaultDensification(Trainer(scene_, d).config()),
             "9900 iterations; densification after 500 until 9000 every 100; opacity reset at "
             "3000, 6000");

@@ -224,10 +224,6 @@ class DefaultDensification : public DensificationStrategy {
   at::Tensor step_grad_, step_denom_;  // a step's sums, apart while they are all-reduced
 };
 
-}  // namespace
-
-namespace {
-
 // The last iteration after which a reset leaves the training room to win the opacities back: a
 // third of the reset interval (1000 of 3000; from logit(0.01) an opacity needs ~150 Adam steps at
 // 3DGS's learning rate to reach 0.9). Without it, densify_until = iterations with an interval
@@ -259,7 +255,7 @@ std::string describeDefaultDensification(const TrainConfig& c) {
   // Resets after the multiples of opacity_reset_interval up to lastResetAllowed
   // (resetsOpacitiesAfter). Counted, not walked (64 bits: any interval, any length).
   const std::int64_t interval = c.opacity_reset_interval;
-  const std::int64_t last_done = interval > 0 ? lastResetAllowed(c) : 0;
+  const std::int64_t last_done = lastResetAllowed(c);
   const std::int64_t resets = interval > 0 && last_done > 0 ? last_done / interval : 0;
   s << "; opacity reset ";
   if (resets == 0) {
