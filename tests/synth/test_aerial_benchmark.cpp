@@ -2,6 +2,8 @@
 // written files, and the scene import of what it writes.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -259,6 +261,47 @@ TEST(AerialBenchmark, CityXlIsFourTilesWithTheirOwnOrbitsAndSplits) {
     EXPECT_NEAR(gx, tx, 5.0) << i;
     EXPECT_NEAR(gy, ty, 5.0) << i;
   }
+}
+
+// The grid capture flies a drone-mapping mission: nadir photos (within the gimbal's ~1 degree)
+// at the stated altitude on parallel lines, 75 % forward overlap over flat ground, ~60 % side.
+TEST(AerialBenchmark, TheGridCaptureFliesNadirLinesWithTheStatedOverlap) {
+  synth::SynthOptions o = synth::SynthOptions::demo(synth::SceneKind::kCity, 3);
+  o.capture = synth::Capture::kGrid;
+  o.views = 36;
+  o.width = 160;
+  o.height = 90;
+  o.max_points = 500;
+  const synth::GridLayout g = synth::gridLayout(o);
+  EXPECT_EQ(g.lines, 4);
+  EXPECT_EQ(g.per_line, 9);
+  EXPECT_NEAR(g.forward_overlap, 0.75, 1e-9);
+  EXPECT_GT(g.side_overlap, 0.55);
+  EXPECT_LT(g.side_overlap, 0.70);
+  const synth::SynthScene scene = synth::generate(o);
+  ASSERT_EQ(scene.views.size(), 36u);
+  for (int i = 0; i < 36; ++i) {
+    const auto& c = scene.views[i].camera;
+    const Eigen::Quaterniond q(c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]);
+    const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+    const Eigen::Vector3d centre = -R.transpose() * Eigen::Vector3d(c.tvec[0], c.tvec[1], c.tvec[2]);
+    const Eigen::Vector3d viewing = R.transpose() * Eigen::Vector3d::UnitZ();
+    EXPECT_LT(std::acos(-viewing.z()) * 180 / M_PI, 1.0) << i;  // nadir
+    EXPECT_NEAR(centre.z(), g.altitude, 1.0) << i;
+    EXPECT_LE(std::abs(centre.x()), 0.9 * 100 + 0.5) << i;
+    EXPECT_LE(std::abs(centre.y()), 0.9 * 100 + 0.5) << i;
+    // Consecutive photos of a line: one spacing apart, the line's x shared.
+    if (i % g.per_line != 0) {
+      const auto& p = scene.views[i - 1].camera;
+      const Eigen::Matrix3d Rp =
+          Eigen::Quaterniond(p.qvec[0], p.qvec[1], p.qvec[2], p.qvec[3]).normalized().toRotationMatrix();
+      const Eigen::Vector3d prev = -Rp.transpose() * Eigen::Vector3d(p.tvec[0], p.tvec[1], p.tvec[2]);
+      EXPECT_NEAR(std::abs(centre.y() - prev.y()), g.along_spacing, 1.0) << i;
+      EXPECT_NEAR(centre.x(), prev.x(), 1.0) << i;
+    }
+  }
+  EXPECT_EQ(synth::captureFromName(synth::captureName(synth::Capture::kGrid)), synth::Capture::kGrid);
+  EXPECT_THROW(synth::captureFromName("spiral"), Error);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// `sadsplat synth`: a procedural aerial benchmark scene (directory and/or scene cache).
+// `sadsplat synth`: a procedural aerial benchmark scene (directory, scene cache, survey photos).
 #include <iostream>
 
 #include "commands.h"
@@ -7,6 +7,7 @@
 #include "sadsplat/synth/aerial_benchmark.h"
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/scene_writer.h"
+#include "sadsplat/synth/survey_photos.h"
 #endif
 
 namespace sadsplat {
@@ -23,6 +24,11 @@ class SynthCommand : public Command {
                   "demo (320x180), full (1600x900) or city-xl (a city of 4x the area, 280 views "
                   "of 1600x900)");
     c->add_option("--views", views_, "number of views (70)");
+    c->add_option("--capture", capture_,
+                  "orbit (oblique views around the scene, the paper's) or grid (a nadir "
+                  "drone-mapping mission, 75 % forward overlap)")
+        ->check(CLI::IsMember({"orbit", "grid"}))
+        ->capture_default_str();
     c->add_option("--width", width_, "image width (1600)");
     c->add_option("--height", height_, "image height (900)");
     c->add_option("--points", points_, "sparse points to keep");
@@ -30,18 +36,37 @@ class SynthCommand : public Command {
     c->add_option("--out", out_, "scene directory to write (PNG, needs OpenCV)");
     c->add_option("--cache", cache_, "scene cache file to write");
     c->add_flag("--preview", preview_, "also write OUT/preview.png");
+    c->add_option("--photos", photos_,
+                  "also write the views as survey photos: JPEGs with EXIF GPS and focal length "
+                  "(for `sadsplat sfm`)");
+    c->add_option("--gps-noise", gps_noise_,
+                  "with --photos: horizontal GPS noise (m, 1 sigma per axis), altitude offset, "
+                  "altitude wander amplitude, altitude noise (m); e.g. 2,30,25,3 for a camera's "
+                  "own receiver")
+        ->delimiter(',')
+        ->expected(1, 4);
+    c->add_option("--gcps", gcps_,
+                  "with --photos: about this many ground control points in gcp_list.txt");
     c->add_flag("--colmap-binary", colmap_binary_,
                 "with --out: write sparse/0 as a binary COLMAP model (cameras.bin, ...)");
     return c;
   }
 
   int run(const Invocation&) override {
-    if (out_.empty() && cache_.empty()) {
-      throw Error("<command line>", "synth", "--out DIR and/or --cache FILE", "neither");
+    if (out_.empty() && cache_.empty() && photos_.empty()) {
+      throw Error("<command line>", "synth", "--out DIR, --cache FILE and/or --photos DIR",
+                  "none");
     }
     const synth::SynthOptions o = options();
     std::cout << "generating " << kind_ << " seed " << seed_ << ": " << o.views << " views of "
-              << o.width << "x" << o.height << " ..." << std::flush;
+              << o.width << "x" << o.height << " (" << capture_ << ")";
+    if (o.capture == synth::Capture::kGrid) {
+      const synth::GridLayout g = synth::gridLayout(o);
+      std::cout << ": " << g.lines << " lines of " << g.per_line << " photos at " << g.altitude
+                << " m, overlap " << 100 * g.forward_overlap << " % forward, "
+                << 100 * g.side_overlap << " % side";
+    }
+    std::cout << " ..." << std::flush;
     const synth::SynthScene scene = synth::generate(o);
     std::cout << " " << scene.seconds << " s, " << scene.points.size() << " sparse points\n";
     if (!cache_.empty()) io::writeSceneCache(cache_, synth::toScene(scene));
@@ -53,6 +78,24 @@ class SynthCommand : public Command {
 #else
       throw Error(out_, "--out", "a sadsplat build with OpenCV to write PNG scene directories",
                   "a build without it (use --cache)");
+#endif
+    }
+    if (!photos_.empty()) {
+#if SADSPLAT_HAVE_OPENCV
+      synth::SurveyPhotoOptions p;
+      const double* n = gps_noise_.data();
+      if (gps_noise_.size() > 0) p.horizontal_noise = n[0];
+      if (gps_noise_.size() > 1) p.altitude_offset = n[1];
+      if (gps_noise_.size() > 2) p.altitude_wander = n[2];
+      if (gps_noise_.size() > 3) p.altitude_noise = n[3];
+      p.ground_control_points = gcps_;
+      const int written = synth::writeSurveyPhotos(scene, p, photos_);
+      std::cout << "photos: " << scene.views.size() << " JPEGs with GPS in " << photos_;
+      if (gcps_ > 0) std::cout << ", " << written << " ground control points in gcp_list.txt";
+      std::cout << "\n";
+#else
+      throw Error(photos_, "--photos", "a sadsplat build with OpenCV to write JPEG photos",
+                  "a build without it");
 #endif
     }
     const synth::SynthStats stats = synth::computeStats(scene);
@@ -82,6 +125,7 @@ class SynthCommand : public Command {
       throw Error("<command line>", "--preset", "demo, full or city-xl", preset_);
     }
     if (views_ > 0) o.views = views_;
+    o.capture = synth::captureFromName(capture_);
     if (width_ > 0) o.width = width_;
     if (height_ > 0) o.height = height_;
     if (points_ > 0) o.max_points = points_;
@@ -89,7 +133,9 @@ class SynthCommand : public Command {
     return o;
   }
 
-  std::string kind_ = "city", preset_, out_, cache_;
+  std::string kind_ = "city", preset_, out_, cache_, capture_ = "orbit", photos_;
+  std::vector<double> gps_noise_;
+  int gcps_ = 0;
   std::uint64_t seed_ = 0;
   int views_ = -1, width_ = -1, height_ = -1, points_ = -1;
   std::vector<int> labelled_;

@@ -64,6 +64,39 @@ Pose orbitPose(const World& world, const SynthOptions& o, int i) {
   return p;
 }
 
+// Photo i of a grid mission (gridLayout): line i / per_line, flown north on even lines and south
+// on odd ones; the camera looks straight down with a little gimbal jitter (<= 1 degree).
+Pose gridPose(const World& world, const SynthOptions& o, int i) {
+  const GridLayout g = gridLayout(o);
+  const std::uint64_t s = o.seed;
+  const int line = i / g.per_line, k = i % g.per_line;
+  const double half = 0.9 * world.extent();
+  const double x = -half + line * g.across_spacing + 1.0 * (hash01(s, 61, i) - 0.5);
+  const int along = (line % 2 == 0) ? k : g.per_line - 1 - k;
+  const double y = -half + along * g.along_spacing + 1.0 * (hash01(s, 62, i) - 0.5);
+  const double z = g.altitude + 2.0 * (hash01(s, 63, i) - 0.5);
+  const double heading = (line % 2 == 0 ? 0.0 : kPi) + 0.03 * (hash01(s, 64, i) - 0.5);
+  const double tilt = 0.017 * hash01(s, 65, i), tilt_dir = 2 * kPi * hash01(s, 66, i);
+  Pose p;
+  p.centre = {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)};
+  const Vec3 forward = normalize({static_cast<float>(std::sin(tilt) * std::cos(tilt_dir)),
+                                  static_cast<float>(std::sin(tilt) * std::sin(tilt_dir)),
+                                  static_cast<float>(-std::cos(tilt))});
+  // Flying north (heading 0) the image's top is north: right = east, down = south.
+  const Vec3 right0 = {static_cast<float>(std::cos(heading)), static_cast<float>(std::sin(heading)),
+                       0.f};
+  const Vec3 down = normalize(cross(forward, right0));
+  const Vec3 right = cross(down, forward);
+  p.rows[0] = right;
+  p.rows[1] = down;
+  p.rows[2] = forward;
+  return p;
+}
+
+Pose viewPose(const World& world, const SynthOptions& o, int i) {
+  return o.capture == Capture::kGrid ? gridPose(world, o, i) : orbitPose(world, o, i);
+}
+
 std::array<double, 4> rotationToQuaternion(const Pose& p) {
   const double R[3][3] = {{p.rows[0].x, p.rows[0].y, p.rows[0].z},
                           {p.rows[1].x, p.rows[1].y, p.rows[1].z},
@@ -338,6 +371,33 @@ void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthSc
 
 }  // namespace
 
+std::string captureName(Capture capture) {
+  return capture == Capture::kGrid ? "grid" : "orbit";
+}
+
+Capture captureFromName(const std::string& name) {
+  if (name == "orbit") return Capture::kOrbit;
+  if (name == "grid") return Capture::kGrid;
+  throw Error("<synth>", "--capture", "orbit or grid", name);
+}
+
+GridLayout gridLayout(const SynthOptions& o) {
+  GridLayout g;
+  const double tan_h = std::tan(o.horizontal_fov_deg * kPi / 360.0);
+  const double tan_v = tan_h * o.height / o.width;
+  // Spacing across / along = 2.5 over a square area: lines^2 * 2.5 ~ views.
+  g.lines = std::max(1, static_cast<int>(std::lround(std::sqrt(o.views / 2.5))));
+  g.per_line = std::max(2, (o.views + g.lines - 1) / g.lines);
+  const double span = 1.8 * World::extentOf(o.tiles);
+  g.along_spacing = span / (g.per_line - 1);
+  g.across_spacing = g.lines > 1 ? span / (g.lines - 1) : 0;
+  // 75 % forward overlap: the along-track footprint (the image's short side) is 4 spacings.
+  g.altitude = 4 * g.along_spacing / (2 * tan_v);
+  g.forward_overlap = 1 - g.along_spacing / (2 * g.altitude * tan_v);
+  g.side_overlap = g.lines > 1 ? 1 - g.across_spacing / (2 * g.altitude * tan_h) : 0;
+  return g;
+}
+
 SynthOptions SynthOptions::demo(SceneKind kind, std::uint64_t seed) {
   SynthOptions o;
   o.kind = kind;
@@ -433,7 +493,7 @@ SynthScene generate(const SynthOptions& o) {
   const double f = (o.width / 2.0) / std::tan(o.horizontal_fov_deg * kPi / 360.0);
   std::vector<Pose> poses;
   for (int i = 0; i < o.views; ++i) {
-    const Pose pose = orbitPose(world, o, i);
+    const Pose pose = viewPose(world, o, i);
     poses.push_back(pose);
     SynthView view;
     char name[32];

@@ -151,7 +151,7 @@ void World::buildCity() {
               {"grass", {152, 251, 152}, "grass or a lawn"},
               {"car", {0, 0, 142}, "a car"},
               {"paved", {190, 153, 153}, "paved ground, a sidewalk or a plaza"}};
-  extent_ = 100.f * tiles_;
+  extent_ = extentOf(tiles_);
   block_ = 40.f;
   road_half_ = 4.f;
   Rng rng(seed_ * 7919 + 1);

@@ -15,6 +15,17 @@
 namespace sadsplat {
 namespace synth {
 
+/// \brief How the views are flown.
+enum class Capture {
+  kOrbit,  ///< the paper's: oblique views on an orbit around the scene (pitch 28-56 degrees)
+  kGrid,   ///< a drone-mapping mission: nadir photos on parallel lines (75 % forward overlap)
+};
+
+/// \brief "orbit" or "grid".
+std::string captureName(Capture capture);
+/// \brief The capture a name gives. \throws sadsplat::Error for another name
+Capture captureFromName(const std::string& name);
+
 /// \brief What to generate. Defaults: the full-size benchmark of the paper's split.
 struct SynthOptions {
   SceneKind kind = SceneKind::kCity;
@@ -31,6 +42,12 @@ struct SynthOptions {
   /// The world is tiles x tiles ordinary scenes in area (city only); view i orbits tile
   /// i % tiles^2 at the ordinary scene's distance, so each tile gets views / tiles^2 views.
   int tiles = 1;
+  /// How the views are flown. kGrid: `views` photos on lines running north over 90 % of the
+  /// labelled area, serpentine, the camera straight down (within ~1 degree, as a gimbal holds it)
+  /// with the image's short side along the line; the lines are as many as make the spacing across
+  /// ~2.5x the spacing along (so that the side overlap is ~60 %), the altitude the one that gives
+  /// 75 % forward overlap over flat ground (gridAltitude()).
+  Capture capture = Capture::kOrbit;
 
   /// \brief The `--preset demo` size: 320x180, 40 views, 4000 points.
   static SynthOptions demo(SceneKind kind, std::uint64_t seed);
@@ -39,6 +56,19 @@ struct SynthOptions {
   /// training views, 7 test views), so 12 labelled and 28 test views in all.
   static SynthOptions cityXl(std::uint64_t seed);
 };
+
+/// \brief A grid capture's layout: lines, photos per line and the altitude above the ground.
+struct GridLayout {
+  int lines = 0;
+  int per_line = 0;
+  double altitude = 0;      ///< metres above z = 0
+  double along_spacing = 0;   ///< metres between photos on a line
+  double across_spacing = 0;  ///< metres between lines
+  double forward_overlap = 0;  ///< share of a photo's footprint the next one sees (flat ground)
+  double side_overlap = 0;     ///< the same between neighbouring lines
+};
+/// \brief The layout Capture::kGrid flies for `options` (its world's extent).
+GridLayout gridLayout(const SynthOptions& options);
 
 /// \brief One generated view.
 struct SynthView {

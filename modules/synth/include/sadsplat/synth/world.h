@@ -82,6 +82,8 @@ class World {
   SceneKind kind() const { return kind_; }
   /// \brief The labelled area is [-extent, extent]^2; outside it the ground is label 255.
   float extent() const { return extent_; }
+  /// \brief The extent of a world of `tiles` x `tiles` ordinary scenes (100 m per tile).
+  static float extentOf(int tiles) { return 100.f * tiles; }
   int tiles() const { return tiles_; }
   float maxHeight() const { return max_height_; }
   const std::vector<ClassInfo>& classes() const { return classes_; }
