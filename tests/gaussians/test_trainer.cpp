@@ -872,6 +872,56 @@ TEST_F(TrainerTest, NoOpacityResetWithoutRoomToRecoverBeforeTheEnd) {
   EXPECT_TRUE(gaussians::resetsOpacitiesAfter(trainer.config(), 30));
 }
 
+// A moving object (a magenta square, in another place in each of three training views) leaves a
+// ghost in the model where it was seen, unless masks (io::View::mask, from masks/*.png at import)
+// keep its pixels out of the losses: then the model shows there what a model trained without the
+// object shows.
+TEST_F(TrainerTest, MaskedPixelsOfAMovingObjectLeaveNoGhost) {
+  struct Square {
+    int view, x0, y0;
+  };
+  const std::vector<Square> squares = {{0, 18, 14}, {3, 30, 20}, {6, 24, 10}};
+  const int side = 10;
+  // How magenta the renders are over the squares, (R + B) / 2 - G averaged: trained on the clean
+  // photos, with the object unmasked, with the object masked.
+  double magenta[3] = {0, 0, 0};
+  for (int variant = 0; variant < 3; ++variant) {
+    io::Scene scene = scene_;
+    for (const Square& q : squares) {
+      io::View& v = scene.views[q.view];
+      ASSERT_TRUE(v.train) << v.name;
+      if (variant == 0) continue;
+      for (int y = q.y0; y < q.y0 + side; ++y) {
+        for (int x = q.x0; x < q.x0 + side; ++x) {
+          const std::size_t p = static_cast<std::size_t>(y) * v.camera.width + x;
+          v.rgb.pixels[3 * p] = 255, v.rgb.pixels[3 * p + 1] = 0, v.rgb.pixels[3 * p + 2] = 255;
+          if (variant == 2) v.mask.pixels[p] = 0;
+        }
+      }
+    }
+    TrainConfig c = small(300);
+    c.densify_from = 50;
+    c.densify_until = 250;
+    Trainer trainer(scene, c);
+    for (int i = 0; i < 300; ++i) trainer.step(false);
+    double sum = 0;
+    for (const Square& q : squares) {
+      const at::Tensor rgb = trainer.renderView(scene_.views[q.view])
+                                 .rgb.cpu()
+                                 .slice(0, q.y0, q.y0 + side)
+                                 .slice(1, q.x0, q.x0 + side);
+      sum += ((rgb.select(2, 0) + rgb.select(2, 2)) / 2 - rgb.select(2, 1)).mean().item<double>();
+    }
+    magenta[variant] = sum / squares.size();
+  }
+  std::printf("magenta over the object's squares: %.3f trained without the object, %.3f with it, "
+              "%.3f with it masked\n",
+              magenta[0], magenta[1], magenta[2]);
+  const double ghost = magenta[1] - magenta[0], masked_ghost = magenta[2] - magenta[0];
+  EXPECT_GT(ghost, 0.1);                            // the object's ghost, unmasked
+  EXPECT_LT(std::abs(masked_ghost), 0.25 * ghost);  // masked: about what the clean photos give
+}
+
 TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {
   TrainConfig c;
   std::vector<std::string> changed;

@@ -1,10 +1,17 @@
 // Scene directory import: roles, resizing, undistortion, label maps and every input error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/scene_import.h"
 #include "test_support/test_support.h"
+
+#if SADSPLAT_HAVE_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#endif
 
 namespace sadsplat {
 namespace {
@@ -92,6 +99,37 @@ TEST_F(SceneImport, UndistortsRadialCamerasAndMasksInvalidPixels) {
   EXPECT_EQ(v.rgb.at(32, 24, 1), plain.views[0].rgb.at(32, 24, 1));
   EXPECT_DOUBLE_EQ(v.camera.fx, 52.0);
 }
+
+#if SADSPLAT_HAVE_OPENCV
+// masks/<image>.png or masks/<stem>.png: 0 = leave the pixel out (of the losses), else keep.
+TEST_F(SceneImport, MasksKeepPixelsOutAndTakeTheirLabels) {
+  const std::string dir = copy();
+  io::makeDirectory(dir + "/masks");
+  cv::Mat mask(48, 64, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(20, 10, 12, 8)).setTo(0);
+  ASSERT_TRUE(cv::imwrite(dir + "/masks/view_000.png.png", mask));  // COLMAP's name
+  cv::Mat colour(48, 64, CV_8UC3, cv::Scalar(0, 0, 200));
+  colour(cv::Rect(0, 0, 5, 5)).setTo(cv::Scalar(0, 0, 0));
+  ASSERT_TRUE(cv::imwrite(dir + "/masks/view_001.png", colour));  // the stem's name, colour
+  const io::Scene scene = io::importScene(dir);
+  const io::View& v0 = scene.views[0];
+  EXPECT_EQ(v0.mask.at(25, 12), 0);
+  EXPECT_EQ(v0.labels.at(25, 12), io::kIgnoreLabel);
+  EXPECT_EQ(v0.mask.at(40, 30), 255);
+  EXPECT_NE(v0.labels.at(40, 30), io::kIgnoreLabel);
+  EXPECT_EQ(scene.views[1].mask.at(2, 2), 0);
+  EXPECT_EQ(scene.views[1].mask.at(30, 30), 255);
+  EXPECT_EQ(std::count(scene.views[2].mask.pixels.begin(), scene.views[2].mask.pixels.end(), 0),
+            0);
+  // Resized with the image.
+  io::ImportOptions half;
+  half.scale = 0.5;
+  EXPECT_EQ(io::importScene(dir, half).views[0].mask.at(12, 6), 0);
+  // A mask of another size is an error naming it.
+  ASSERT_TRUE(cv::imwrite(dir + "/masks/view_001.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))));
+  expectError(dir, "masks/view_001.png", "64x48");
+}
+#endif
 
 TEST_F(SceneImport, MapsColourLabelMapsThroughThePalette) {
   const std::string dir = copy();

@@ -143,6 +143,17 @@ TEST_F(TransformsJson, ImageSizesComeFromTheImagesWhenTheFileHasNone) {
   EXPECT_EQ(t.model.cameras[0].height, 600u);
 }
 
+// nerfstudio's per-frame mask_path: relative to the file, kept per image for the import.
+TEST_F(TransformsJson, MaskPathsAreKeptPerImage) {
+  const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
+  json a = frame("images/a.png", I), b = frame("images/b.png", I);
+  a["mask_path"] = "masks/a.png";
+  const json j = {{"fl_x", 100}, {"w", 200}, {"h", 100}, {"frames", json::array({a, b})}};
+  const io::TransformsJson t = io::readTransformsJson(write(j), noImageSize);
+  ASSERT_EQ(t.mask_paths.size(), 1u);
+  EXPECT_EQ(t.mask_paths.at("a.png"), tmp_.path() + "/masks/a.png");
+}
+
 TEST_F(TransformsJson, BadFilesAreOneLineErrors) {
   const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
   const json base = {{"fl_x", 100}, {"w", 200}, {"h", 100}};
@@ -178,6 +189,11 @@ TEST_F(TransformsJson, BadFilesAreOneLineErrors) {
   expectError(nan_focal, "fl_x");
   expectError(json{{"w", 200}, {"h", 100}, {"frames", json::array({frame("a.png", I)})}},
               "focal length");
+  json bad_mask = frame("a.png", I);
+  bad_mask["mask_path"] = 3;
+  expectError(with(json::array({bad_mask})), "mask_path");
+  bad_mask["mask_path"] = "/abs/mask.png";
+  expectError(with(json::array({bad_mask})), "mask_path");
   test::writeFile(tmp_.file("broken.json"), "{\"frames\": [");
   EXPECT_THROW(io::readTransformsJson(tmp_.file("broken.json"), noImageSize), Error);
 }

@@ -56,6 +56,7 @@ PosedImages readPosedImages(const std::string& dir, const ImageSizeOf& image_siz
     TransformsJson t = readTransformsJson(dir + "/transforms.json", image_size);
     posed.model = std::move(t.model);
     posed.image_dir = std::move(t.image_dir);
+    posed.mask_paths = std::move(t.mask_paths);
     posed.origin = dir + "/transforms.json";
     return posed;
   }
@@ -162,6 +163,47 @@ void undistortionMaps(const ColmapCamera& c, const cv::Mat& K, const cv::Mat& di
   } else {
     cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, size, CV_32FC1, *map1, *map2);
   }
+}
+
+// A view's mask: transforms.json's mask_path, else masks/<name>.png, else masks/<stem>.png.
+std::string userMaskPath(const std::string& dir, const PosedImages& posed,
+                         const std::string& name) {
+  const auto given = posed.mask_paths.find(name);
+  if (given != posed.mask_paths.end()) return given->second;
+  for (const std::string& candidate :
+       {dir + "/masks/" + name + ".png", dir + "/masks/" + stem(name) + ".png"}) {
+    if (pathExists(candidate)) return candidate;
+  }
+  return "";
+}
+
+// A mask as users draw them (nerfstudio, COLMAP, OpenDroneMap): 0 = leave out, else keep; any
+// channel count (a colour mask keeps a pixel where any channel is non-zero).
+cv::Mat readUserMask(const std::string& path, const cv::Size& size) {
+  requireRegularFile(path);
+  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
+  if (raw.empty()) throw Error(path, "image data", "a readable mask (PNG)", "cannot decode");
+  if (raw.depth() != CV_8U) {
+    throw Error(path, "pixel depth", "an 8-bit mask", "depth code " + std::to_string(raw.depth()));
+  }
+  if (raw.size() != size) {
+    throw Error(path, "size",
+                std::to_string(size.width) + "x" + std::to_string(size.height) + " (its image)",
+                std::to_string(raw.cols) + "x" + std::to_string(raw.rows));
+  }
+  cv::Mat keep(raw.size(), CV_8UC1, cv::Scalar(0));
+  // Grey (+ alpha): the grey; colour (+ alpha): any colour channel. Alpha is not the mask.
+  const int channels = raw.channels() >= 3 ? 3 : 1;
+  for (int y = 0; y < raw.rows; ++y) {
+    const std::uint8_t* px = raw.ptr<std::uint8_t>(y);
+    auto* out = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < raw.cols; ++x) {
+      bool any = false;
+      for (int c = 0; c < channels; ++c) any |= px[x * raw.channels() + c] != 0;
+      out[x] = any ? 255 : 0;
+    }
+  }
+  return keep;
 }
 
 cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
@@ -383,6 +425,12 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     }
 
     cv::Mat mask(bgr.size(), CV_8UC1, cv::Scalar(255));
+    const std::string mask_path = userMaskPath(dir, posed, im->name);
+    if (!mask_path.empty()) {
+      const cv::Mat keep = readUserMask(mask_path, bgr.size());
+      mask.setTo(0, keep == 0);
+      if (!labels.empty()) labels.setTo(kIgnoreLabel, keep == 0);
+    }
     cv::Mat K, dist;
     opencvIntrinsics(cam, &K, &dist, &view.camera);
     if (isDistorted(cam)) {

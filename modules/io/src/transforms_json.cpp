@@ -251,6 +251,15 @@ TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& im
     if (!names.insert(image.name).second) {
       throw Error(path, f.where() + " file_path", "each image once", image.name + " twice");
     }
+    if (frames[i].contains("mask_path")) {
+      const json& m = frames[i]["mask_path"];
+      const std::string mask = m.is_string() ? normalisedRelative(m.get<std::string>()) : "";
+      if (mask.empty() || mask[0] == '/') {
+        throw Error(path, f.where() + " mask_path", "a mask path relative to the file's folder",
+                    m.dump());
+      }
+      out.mask_paths[image.name] = dir + "/" + mask;
+    }
     poseOf(path, f.where(),
            frames[i].contains("transform_matrix") ? frames[i]["transform_matrix"] : json(), &image);
     out.model.images.push_back(std::move(image));

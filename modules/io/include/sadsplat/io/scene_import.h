@@ -3,6 +3,7 @@
 /// \brief Importing a scene directory (images/, labels/, sparse/0/, classes.json, split.json).
 /// Needs OpenCV (SADSPLAT_WITH_OPENCV); without it importScene throws a clear error.
 
+#include <map>
 #include <string>
 
 #include "sadsplat/io/colmap.h"
@@ -39,6 +40,8 @@ struct PosedImages {
   ColmapModel model;      ///< cameras, images (names relative to image_dir), points
   std::string image_dir;  ///< the folder the image names are relative to
   std::string origin;     ///< the COLMAP model folder or the transforms.json (for messages)
+  /// image name -> its mask file, from transforms.json's `mask_path` (nerfstudio)
+  std::map<std::string, std::string> mask_paths;
 };
 
 /// \brief The COLMAP model of `dir` (findColmapModel) with its images in `dir`/images, or, when
@@ -60,7 +63,11 @@ bool haveSceneImport();
 /// warped the same way with nearest-neighbour sampling. classes.json is optional: without it the
 /// scene has no classes (plain 3DGS) and may have no label maps. split.json is optional: without
 /// it ImportOptions::test_every decides the test views and every training view with a label map
-/// is labelled.
+/// is labelled. Masks keep pixels out of training (moving cars, people, the drone's legs): a
+/// frame's `mask_path` in transforms.json, else masks/<image name>.png or masks/<image stem>.png
+/// (COLMAP's and OpenDroneMap's layouts); 8-bit, the image's size, 0 = leave out, anything else
+/// = keep. Left-out pixels join the view's mask (outside the undistorted image) and lose their
+/// labels.
 /// \throws sadsplat::Error naming the file, the field and the expectation
 Scene importScene(const std::string& dir, const ImportOptions& options = {});
 

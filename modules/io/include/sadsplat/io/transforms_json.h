@@ -11,11 +11,13 @@
 /// `camera_angle_y` (full field of view in radians); `cx`, `cy` (default the image centre), `w`,
 /// `h`; `camera_model` "OPENCV" (default) with `k1 k2 p1 p2` and optionally `k3`, or
 /// "OPENCV_FISHEYE" with `k1..k4`. nerfstudio's `ply_file_path` names the sparse points.
-/// Pixel centres are at +0.5, as in COLMAP. Not read: masks (`mask_path`), depth, `aabb_scale`,
+/// Pixel centres are at +0.5, as in COLMAP. A frame's `mask_path` (nerfstudio) names its mask.
+/// Not read: depth, `aabb_scale`,
 /// `applied_transform` (the poses and the points are already in one frame).
 
 #include <array>
 #include <functional>
+#include <map>
 #include <string>
 
 #include "sadsplat/io/colmap.h"
@@ -31,6 +33,8 @@ struct TransformsJson {
   /// The folder the images' names are relative to: `<dir>/images` when every frame lies in it
   /// (nerfstudio's layout, so names match labels/<stem>.png as in COLMAP scenes), else `<dir>`.
   std::string image_dir;
+  /// image name -> its mask (`mask_path`, relative to the file's folder, made absolute)
+  std::map<std::string, std::string> mask_paths;
 };
 
 /// \brief Size (width, height) of the image at a path; asked only for frames without `w` / `h`.
