@@ -33,10 +33,10 @@ viz_tests="^(ViewScreenshot|SplatMode|Report|FrontierCharts)\."
 # instrumented code the other tests do not: the demo (synth, pseudo-labels, two trainings, eval:
 # the same paths as Cli.TrainEvalAndResumeOnTheFixture and Cli.PseudoLabelOptions*), kill -9 +
 # resume (resume is TrainerTest.ResumeFromACheckpointIsExact in process), a second two-rank
-# training, and the SfM (nearly all of it in COLMAP, which is not instrumented; the georeference
-# and EXIF code it calls have their own tests). They run in the Release pass; SADSPLAT_ASAN_ALL=1
+# training, and the two SfM runs (nearly all of it in COLMAP, which is not instrumented; the
+# georeference, ground control and EXIF code they call have their own tests). They run in the Release pass; SADSPLAT_ASAN_ALL=1
 # runs them here too.
-slow_tests="^(Cli\.DemoRunsTheMethodAndTheBaseline|Faults\.KillNineThenResumeIsBitIdentical|Distributed\.TwoRanksTrainLikeOneProcessWithTwoViewsPerStep|Sfm\.SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras)$"
+slow_tests="^(Cli\.DemoRunsTheMethodAndTheBaseline|Faults\.KillNineThenResumeIsBitIdentical|Distributed\.TwoRanksTrainLikeOneProcessWithTwoViewsPerStep|Sfm\.SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras|Sfm\.ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked)$"
 [ "${SADSPLAT_ASAN_ALL:-0}" = 1 ] && slow_tests="^$"
 ctest --test-dir build-asan --output-on-failure -j 2 -E "^Package\.|$viz_tests|$slow_tests" --timeout 900
 ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \

@@ -123,6 +123,13 @@ TEST(Georeference, ExifGpsWrittenBySadsplatIsReadBackByLibexif) {
   EXPECT_NEAR(read->latitude, where.latitude, 1e-9);
   EXPECT_NEAR(read->longitude, where.longitude, 1e-9);
   EXPECT_NEAR(read->altitude, where.altitude, 1e-3);
+  // With an Exif IFD for the focal length (before the GPS IFD) the GPS still reads back.
+  const auto with_focal = io::jpegWithExifGps(bare, where, 31);
+  test::writeFile(path, std::string(with_focal.begin(), with_focal.end()));
+  const auto again = io::readExifGps(path);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_NEAR(again->latitude, where.latitude, 1e-9);
+  EXPECT_NEAR(again->altitude, where.altitude, 1e-3);
   // A photo without EXIF has no position; a non-JPEG is refused by the writer.
   const std::string plain = tmp.file("plain.jpg");
   std::ofstream(plain, std::ios::binary).write("\xFF\xD8\xFF\xD9", 4);

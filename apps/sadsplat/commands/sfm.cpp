@@ -1,5 +1,6 @@
 // `sadsplat sfm PHOTOS --out SCENE`: a folder of photos into a scene directory (COLMAP's
-// reconstruction, undistorted images, the georeference from the photos' GPS).
+// reconstruction, undistorted images, the georeference from the photos' GPS or from ground
+// control points).
 #include <iostream>
 
 #include "commands.h"
@@ -29,10 +30,26 @@ class SfmCommand : public Command {
                 "calibrate each photo's camera alone (default: one camera for all)");
     c->add_option("--threads", o_.threads, "COLMAP's threads (-1: every core)")
         ->capture_default_str();
-    c->add_option("--gps-inlier", o_.gps_inlier_metres,
-                  "metres between a photo's GPS and its fitted camera centre for an inlier")
-        ->check(CLI::PositiveNumber)
+    c->add_option("--gps-accuracy", o_.gps_accuracy,
+                  "horizontal GPS accuracy, metres (1 sigma) the georeference starts from; 0: "
+                  "what the photos state (EXIF), else 5 m. Inliers then come from the measured "
+                  "noise")
+        ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
+    c->add_option("--gcp", o_.gcp,
+                  "ground control points, OpenDroneMap's gcp_list.txt (default: PHOTOS/"
+                  "gcp_list.txt when it exists); points named CHK*/check* are check points")
+        ->check(CLI::ExistingFile);
+    c->add_option("--match-neighbors", o_.match_neighbors,
+                  "spatial matcher: match each photo with its k nearest by GPS")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    c->add_option("--match-distance", o_.match_distance,
+                  "spatial matcher: only photos within this many metres (0: any)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    c->add_flag("!--keep-focal", o_.refine_focal,
+                "keep the focal length of the photos' EXIF (the mapper does not refine it)");
     c->add_option("--colmap", o_.colmap, "the COLMAP program")->capture_default_str();
     return c;
   }

@@ -1,6 +1,7 @@
 #include "sadsplat/geo/map_frame.h"
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "sadsplat/common/error.h"
@@ -130,6 +131,61 @@ Crs crsOfEpsg(int epsg) {
 #else
   (void)epsg;
   noGdal("map projection");
+#endif
+}
+
+std::vector<io::GeoPosition> crsToWgs84(const std::string& crs, const std::vector<Vec3>& xyz,
+                                        const std::string& file) {
+#if SADSPLAT_HAVE_GDAL
+  OGRSpatialReference from;
+  // OpenDroneMap's own form: "WGS84 UTM <zone><N|S>".
+  int zone = 0;
+  char hemisphere = 0;
+  std::string text = crs;
+  if (std::sscanf(crs.c_str(), "WGS84 UTM %d%c", &zone, &hemisphere) == 2 && zone >= 1 &&
+      zone <= 60 && (hemisphere == 'N' || hemisphere == 'S')) {
+    text = "EPSG:" + std::to_string((hemisphere == 'N' ? 32600 : 32700) + zone);
+  }
+  CPLErrorReset();
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  const OGRErr parsed = from.SetFromUserInput(text.c_str());
+  CPLPopErrorHandler();
+  if (parsed != OGRERR_NONE) {
+    throw Error(file, "CRS (first line)",
+                "EPSG:<code>, a PROJ string (+proj=utm +zone=..) or WGS84 UTM <zone><N|S>", crs);
+  }
+  from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  Transform t(OGRCreateCoordinateTransformation(&from, &wgs84));
+  CPLPopErrorHandler();
+  if (!t) {
+    throw Error(file, "CRS (first line)", "a CRS PROJ can transform to WGS84", crs);
+  }
+  std::vector<double> x(xyz.size()), y(xyz.size()), z(xyz.size());
+  for (std::size_t i = 0; i < xyz.size(); ++i) x[i] = xyz[i][0], y[i] = xyz[i][1], z[i] = xyz[i][2];
+  std::vector<int> ok(xyz.size(), 0);
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  const bool done = xyz.empty() || t->Transform(static_cast<int>(xyz.size()), x.data(), y.data(),
+                                                z.data(), ok.data());
+  CPLPopErrorHandler();
+  std::vector<io::GeoPosition> out(xyz.size());
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    if (!done || !ok[i] || !(std::abs(y[i]) <= 90) || !(std::abs(x[i]) <= 180)) {
+      throw Error(file, "coordinates", "positions in the CRS " + crs,
+                  std::to_string(xyz[i][0]) + " " + std::to_string(xyz[i][1]) +
+                      " (not transformable to WGS84)");
+    }
+    out[i] = {y[i], x[i], z[i]};
+  }
+  return out;
+#else
+  (void)crs;
+  (void)xyz;
+  (void)file;
+  noGdal("coordinate reference systems");
 #endif
 }
 

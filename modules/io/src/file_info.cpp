@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <cstdio>
 #include <iomanip>
 #include <limits>
 #include <map>
@@ -23,6 +24,22 @@ namespace sadsplat {
 namespace io {
 namespace {
 
+// File-borne text for the terminal: control bytes (an escape sequence in a hand-edited file)
+// shown as \xNN, never sent.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (c < 0x20 || c == 0x7F) {
+      char hex[8];
+      std::snprintf(hex, sizeof(hex), "\\x%02X", c);
+      out += hex;
+    } else {
+      out.push_back(static_cast<char>(c));
+    }
+  }
+  return out;
+}
+
 // One line: where the frame is on the Earth and how well the GPS fit it.
 void describeGeoreference(std::ostream& out, const Georeference& g) {
   std::ostringstream geo;
@@ -32,6 +49,23 @@ void describeGeoreference(std::ostream& out, const Georeference& g) {
       << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit"
       << (g.consensus ? "" : " (no consensus: the fit of all; positions can be off by the RMS)")
       << ", RMS " << g.rms_metres << " m\n";
+  if (!g.up_source.empty()) {
+    geo << "georeference: up from " << printable(g.up_source) << "; horizontal RMS "
+        << g.horizontal_rms_metres << " m, vertical " << g.vertical_rms_metres << " m";
+    if (g.ground_tilt_deg >= 0) geo << "; ground plane " << g.ground_tilt_deg << " deg from level";
+    if (g.check_points > 0) {
+      geo << "; " << g.check_points << " check points: RMSE horizontal "
+          << std::setprecision(3) << g.check_rmse_horizontal << " m, vertical "
+          << g.check_rmse_vertical << " m";
+    }
+    geo << "\n";
+  }
+  if (!g.trustworthy()) {
+    geo << "georeference: DOUBTFUL:";
+    for (const auto& d : g.doubts) geo << " " << printable(d) << ";";
+    if (!g.consensus) geo << " no consensus with the GPS;";
+    geo << " map positions, heights and areas can be wrong\n";
+  }
   out << geo.str();
 }
 

@@ -165,6 +165,19 @@ std::optional<GeoPosition> readExifGps(const std::string& path) {
     ExifEntry* alt_ref = entry(0x0005);
     if (alt_ref && alt_ref->size > 0 && alt_ref->data[0] == 1) p.altitude = -p.altitude;
   }
+  // The receiver's own accuracy: GPSHPositioningError (metres), else GPSDOP.
+  const auto positive_rational = [&](int tag) -> double {
+    ExifEntry* e = entry(tag);
+    if (e == nullptr || e->format != EXIF_FORMAT_RATIONAL || e->components < 1) return 0;
+    const ExifRational r = exif_get_rational(e->data, order);
+    const double v = r.denominator != 0 ? static_cast<double>(r.numerator) / r.denominator : 0;
+    return std::isfinite(v) && v > 0 ? v : 0;
+  };
+  if (const double error = positive_rational(0x001F); error > 0) {
+    p.horizontal_accuracy = error;
+  } else if (const double dop = positive_rational(0x000B); dop > 0) {
+    p.horizontal_accuracy = 3.0 * dop;
+  }
   if (!(std::abs(p.latitude) <= 90) || !(std::abs(p.longitude) <= 180)) {
     throw Error(path, "EXIF GPS position", "latitude within +-90, longitude within +-180 degrees",
                 std::to_string(p.latitude) + ", " + std::to_string(p.longitude));
@@ -177,11 +190,12 @@ std::optional<GeoPosition> readExifGps(const std::string& path) {
 }
 
 std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpeg,
-                                           const GeoPosition& gps) {
+                                           const GeoPosition& gps, int focal_length_35mm) {
   if (jpeg.size() < 2 || jpeg[0] != 0xFF || jpeg[1] != 0xD8) {
     throw Error("<jpeg>", "start", "a JPEG SOI marker (FF D8)", "other bytes");
   }
-  // TIFF, little endian: header, IFD0 (1 entry: GPS IFD pointer), GPS IFD (7 entries), values.
+  // TIFF, little endian: header, IFD0 (the Exif IFD pointer when there is a focal length, the
+  // GPS IFD pointer; tags ascending), the Exif IFD (1 entry), the GPS IFD (7 entries), values.
   std::vector<unsigned char> t;
   const auto u16 = [&](std::uint32_t v) {
     t.push_back(v & 0xFF);
@@ -190,16 +204,25 @@ std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpe
   const auto u32 = [&](std::uint32_t v) {
     for (int k = 0; k < 4; ++k) t.push_back((v >> (8 * k)) & 0xFF);
   };
-  const std::uint32_t ifd0 = 8, gps_ifd = ifd0 + 2 + 12 + 4, entries = 7;
+  const bool focal = focal_length_35mm > 0;
+  const std::uint32_t ifd0 = 8, ifd0_entries = focal ? 2 : 1, entries = 7;
+  const std::uint32_t exif_ifd = ifd0 + 2 + 12 * ifd0_entries + 4;
+  const std::uint32_t gps_ifd = focal ? exif_ifd + 2 + 12 + 4 : exif_ifd;
   const std::uint32_t values = gps_ifd + 2 + 12 * entries + 4;
   t.insert(t.end(), {'I', 'I', 42, 0});
   u32(ifd0);
-  u16(1);
-  u16(0x8825);  // GPSInfo
-  u16(4);       // LONG
-  u32(1);
-  u32(gps_ifd);
+  u16(ifd0_entries);
+  if (focal) {
+    u16(0x8769), u16(4), u32(1), u32(exif_ifd);  // ExifIFDPointer
+  }
+  u16(0x8825), u16(4), u32(1), u32(gps_ifd);  // GPSInfo
   u32(0);
+  if (focal) {
+    u16(1);
+    // FocalLengthIn35mmFilm, SHORT
+    u16(0xA405), u16(3), u32(1), u16(static_cast<std::uint32_t>(focal_length_35mm)), u16(0);
+    u32(0);
+  }
   const auto dms = [](double deg, std::uint32_t out[6]) {
     deg = std::abs(deg);
     const double d = std::floor(deg), m = std::floor((deg - d) * 60);
@@ -323,7 +346,24 @@ std::string georeferenceToJson(const Georeference& g) {
                             {"inliers", g.inliers},
                             {"consensus", g.consensus},
                             {"rms_metres", g.rms_metres}};
-  return j.dump(2) + "\n";
+  nlohmann::json out = j;
+  if (!g.up_source.empty()) {
+    out["up_source"] = g.up_source;
+    out["gps_accuracy_metres"] = g.gps_accuracy_metres;
+    out["gps_noise_metres"] = g.gps_noise_metres;
+    out["inlier_metres"] = g.inlier_metres;
+    out["horizontal_rms_metres"] = g.horizontal_rms_metres;
+    out["vertical_rms_metres"] = g.vertical_rms_metres;
+    out["scale_uncertainty"] = g.scale_uncertainty;
+    out["ground_tilt_deg"] = g.ground_tilt_deg;
+    out["views_tilt_deg"] = g.views_tilt_deg;
+    out["doubts"] = g.doubts;
+    out["control_points"] = g.control_points;
+    out["check_points"] = g.check_points;
+    out["check_rmse_horizontal"] = g.check_rmse_horizontal;
+    out["check_rmse_vertical"] = g.check_rmse_vertical;
+  }
+  return out.dump(2) + "\n";
 }
 
 Georeference georeferenceFromJson(const std::string& text, const std::string& origin) {
@@ -359,6 +399,35 @@ Georeference georeferenceFromJson(const std::string& text, const std::string& or
     g.inliers = static_cast<int>(j.value("inliers", 0));
     g.rms_metres = j.value("rms_metres", 0.0);
     g.consensus = j.value("consensus", true);  // older files carry no such field
+    if (j.contains("up_source")) {
+      if (!j.at("up_source").is_string()) {
+        throw Error(origin, "up_source", "a string", j.at("up_source").dump());
+      }
+      g.up_source = j.at("up_source").get<std::string>();
+      const auto optional = [&](const char* key, double fallback) {
+        return j.contains(key) ? number(j, key, key) : fallback;
+      };
+      g.gps_accuracy_metres = optional("gps_accuracy_metres", 0);
+      g.gps_noise_metres = optional("gps_noise_metres", 0);
+      g.inlier_metres = optional("inlier_metres", 0);
+      g.horizontal_rms_metres = optional("horizontal_rms_metres", 0);
+      g.vertical_rms_metres = optional("vertical_rms_metres", 0);
+      g.scale_uncertainty = optional("scale_uncertainty", 0);
+      g.ground_tilt_deg = optional("ground_tilt_deg", -1);
+      g.views_tilt_deg = optional("views_tilt_deg", -1);
+      g.control_points = static_cast<int>(optional("control_points", 0));
+      g.check_points = static_cast<int>(optional("check_points", 0));
+      g.check_rmse_horizontal = optional("check_rmse_horizontal", -1);
+      g.check_rmse_vertical = optional("check_rmse_vertical", -1);
+      if (j.contains("doubts")) {
+        const auto& d = j.at("doubts");
+        if (!d.is_array()) throw Error(origin, "doubts", "an array of strings", d.dump());
+        for (const auto& x : d) {
+          if (!x.is_string()) throw Error(origin, "doubts", "an array of strings", x.dump());
+          g.doubts.push_back(x.get<std::string>());
+        }
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw Error(origin, "JSON", "a georeference.json as sadsplat writes it", e.what());
   }

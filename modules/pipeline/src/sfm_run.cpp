@@ -18,10 +18,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/gps_georeference.h"
+#include "sadsplat/geo/ground_control.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/exif_orientation.h"
@@ -30,6 +33,7 @@
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #endif
 
 extern char** environ;
@@ -103,6 +107,125 @@ std::string lastLines(const std::string& path, int n) {
 Eigen::Matrix3d rotationOf(const std::array<double, 4>& q) {
   return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
 }
+
+std::array<double, 3> toArray(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+std::string fixed(double v, int digits = 2) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << std::fixed << v;
+  return s.str();
+}
+
+// The sanity check every run prints: where up came from, how well the GPS agrees, how level
+// the scene's own cues are after the fit, and the photos farthest from their GPS.
+std::string describeGpsFit(const geo::GpsFit& fit) {
+  const io::Georeference& g = fit.georeference;
+  std::string text = "sfm: georeference from GPS: up from " + g.up_source + "; " +
+                     std::to_string(g.inliers) + " of " + std::to_string(g.photos_with_gps) +
+                     " photos agree within " + fixed(g.inlier_metres) + " m (noise measured " +
+                     fixed(g.gps_noise_metres) + " m, stated or assumed " +
+                     fixed(g.gps_accuracy_metres) + " m), RMS horizontal " +
+                     fixed(g.horizontal_rms_metres) + " m, vertical " +
+                     fixed(g.vertical_rms_metres) + " m (altitude: the median offset only)";
+  if (g.up_source != "gps 3D fit") {
+    text += ", scale +-" + fixed(100 * g.scale_uncertainty) + " %";
+  }
+  text += "\nsfm: level check after the fit: ground plane " +
+          (g.ground_tilt_deg >= 0 ? fixed(g.ground_tilt_deg) + " deg" : std::string("none found")) +
+          ", nadir views " +
+          (g.views_tilt_deg >= 0 ? fixed(g.views_tilt_deg) + " deg" : std::string("not nadir")) +
+          " from vertical\n";
+  std::vector<std::pair<double, std::string>> off;
+  for (const auto& r : fit.residuals) {
+    if (!r.inlier) off.emplace_back(r.horizontal, r.photo);
+  }
+  std::sort(off.rbegin(), off.rend());
+  if (!off.empty()) {
+    text += "sfm: " + std::to_string(off.size()) + " photos' GPS disagree (horizontal):";
+    for (std::size_t k = 0; k < std::min<std::size_t>(off.size(), 5); ++k) {
+      text += " " + off[k].second + " (" + fixed(off[k].first, 1) + " m)";
+    }
+    text += off.size() > 5 ? " ...\n" : "\n";
+  }
+  return text;
+}
+
+std::string describeGcpFit(const geo::GcpFit& fit) {
+  const io::Georeference& g = fit.georeference;
+  std::string text = "sfm: georeference from " + std::to_string(g.control_points) +
+                     " ground control points: RMS horizontal " + fixed(g.horizontal_rms_metres, 3) +
+                     " m, vertical " + fixed(g.vertical_rms_metres, 3) + " m; ";
+  if (g.check_points > 0) {
+    text += std::to_string(g.check_points) + " check points: RMSE horizontal " +
+            fixed(g.check_rmse_horizontal, 3) + " m, vertical " + fixed(g.check_rmse_vertical, 3) +
+            " m\n";
+  } else {
+    text += "no check points (mark some CHK... or give >= 5 points): the accuracy is unchecked\n";
+  }
+  for (const auto& s : fit.skipped) text += "sfm: ground control point skipped: " + s + "\n";
+  return text;
+}
+
+// PHOTOS/masks/: each photo's mask as COLMAP (<photo>.png), OpenDroneMap (<stem>_mask.<ext>) or
+// nerfstudio-style (<stem>.png) name it.
+std::map<std::string, std::string> photoMasks(const std::string& photos_dir,
+                                              const std::vector<std::string>& photos) {
+  std::map<std::string, std::string> masks;
+  const std::string dir = photos_dir + "/masks";
+  if (!io::isDirectory(dir)) return masks;
+  for (const auto& p : photos) {
+    const std::string stem = p.substr(0, p.find_last_of('.'));
+    const std::string ext = p.substr(p.find_last_of('.'));
+    for (const std::string& candidate :
+         {dir + "/" + p + ".png", dir + "/" + stem + ".png", dir + "/" + stem + "_mask" + ext,
+          dir + "/" + stem + "_mask.png"}) {
+      if (io::pathExists(candidate)) {
+        masks[p] = candidate;
+        break;
+      }
+    }
+  }
+  return masks;
+}
+
+#if SADSPLAT_HAVE_OPENCV
+// A mask as COLMAP takes it: 8-bit, 0 = leave out, 255 = keep, the photo's size. No mask: all
+// kept.
+void writeBinaryMask(const std::string& mask, const std::string& photo, const std::string& out) {
+  const cv::Mat image = cv::imread(photo, cv::IMREAD_COLOR);
+  if (image.empty()) throw Error(photo, "image data", "a readable photo", "cannot decode");
+  cv::Mat keep(image.size(), CV_8UC1, cv::Scalar(255));
+  if (!mask.empty()) {
+    const cv::Mat raw = cv::imread(mask, cv::IMREAD_GRAYSCALE);
+    if (raw.empty()) throw Error(mask, "image data", "a readable mask", "cannot decode");
+    if (raw.size() != image.size()) {
+      throw Error(mask, "size",
+                  std::to_string(image.cols) + "x" + std::to_string(image.rows) + " (its photo)",
+                  std::to_string(raw.cols) + "x" + std::to_string(raw.rows));
+    }
+    keep.setTo(0, raw == 0);
+  }
+  if (!cv::imwrite(out, keep)) throw Error(out, "file", "a writable mask", "cannot write");
+}
+
+// COLMAP's undistorted mask (interpolated, maybe JPEG) back to 0 / 255.
+void binariseUndistortedMask(const std::string& in, const std::string& out) {
+  const cv::Mat raw = cv::imread(in, cv::IMREAD_GRAYSCALE);
+  if (raw.empty()) throw Error(in, "image data", "COLMAP's undistorted mask", "cannot decode");
+  cv::Mat keep;
+  cv::threshold(raw, keep, 127, 255, cv::THRESH_BINARY);
+  if (!cv::imwrite(out, keep)) throw Error(out, "file", "a writable mask", "cannot write");
+}
+#else
+[[noreturn]] void writeBinaryMask(const std::string&, const std::string& photo,
+                                  const std::string&) {
+  throw Error(photo, "masks", "a build with OpenCV to read photo masks", "a build without it");
+}
+[[noreturn]] void binariseUndistortedMask(const std::string& in, const std::string&) {
+  throw Error(in, "masks", "a build with OpenCV to read photo masks", "a build without it");
+}
+#endif
 
 // The model moved by x' = s R x + t: points move, cameras keep what they see.
 void transformModel(io::ColmapModel& model, const io::Similarity& sim) {
@@ -191,6 +314,13 @@ SfmSummary sfmRun(const SfmOptions& o) {
   if (!matchers.count(o.matcher)) {
     throw Error("<sfm options>", "matcher", "auto, exhaustive, sequential or spatial", o.matcher);
   }
+  if (o.match_neighbors < 1) {
+    throw Error("<sfm options>", "match neighbors", ">= 1", std::to_string(o.match_neighbors));
+  }
+  if (!(o.gps_accuracy >= 0) || !std::isfinite(o.gps_accuracy)) {
+    throw Error("<sfm options>", "gps accuracy", "metres >= 0 (0: from the photos)",
+                std::to_string(o.gps_accuracy));
+  }
   if (o.max_image_size < 100) {
     throw Error("<sfm options>", "max image size", ">= 100 pixels",
                 std::to_string(o.max_image_size));
@@ -213,6 +343,16 @@ SfmSummary sfmRun(const SfmOptions& o) {
   say("sfm: " + std::to_string(photos.size()) + " photos in " + o.photos + ", " +
       std::to_string(gps.size()) + " with GPS" +
       (io::haveExif() ? "" : " (this build reads no EXIF: no georeference)") + "\n");
+  // Ground control points are checked before COLMAP runs: a bad file costs no reconstruction.
+  const std::string gcp_path =
+      !o.gcp.empty() ? o.gcp
+                     : (io::pathExists(o.photos + "/gcp_list.txt") ? o.photos + "/gcp_list.txt" : "");
+  std::optional<geo::GcpList> gcps;
+  if (!gcp_path.empty()) {
+    gcps = geo::readGcpList(gcp_path, photos);
+    say("sfm: " + std::to_string(gcps->points.size()) + " ground control points in " + gcp_path +
+        " (" + gcps->crs + ")\n");
+  }
   // COLMAP reads pixels as stored: photos with an EXIF rotation get upright copies first, so
   // that images/, the cameras and annotations drawn on the photos as viewers show them agree.
   int rotated = 0;
@@ -234,10 +374,27 @@ SfmSummary sfmRun(const SfmOptions& o) {
                            {"matcher", matcher},
                            {"max_image_size", o.max_image_size}};
   nlohmann::json stages = nlohmann::json::array();
+  // Masks (PHOTOS/masks/): features outside them are not extracted, and the scene gets them
+  // undistorted as its images are (scene/masks/<photo>.png), so training leaves those pixels out.
+  const std::map<std::string, std::string> masks = photoMasks(o.photos, photos);
+  const std::string feature_masks = work + "/feature_masks";
+  if (!masks.empty()) {
+    say("sfm: " + std::to_string(masks.size()) + " photos have a mask in " + o.photos +
+        "/masks\n");
+    fs::remove_all(feature_masks);
+    io::makeDirectory(feature_masks);
+    for (const auto& p : photos) {
+      const auto it = masks.find(p);
+      writeBinaryMask(it == masks.end() ? "" : it->second, o.photos + "/" + p,
+                      feature_masks + "/" + p + ".png");
+    }
+  }
+  const int stage_count = masks.empty() ? 4 : 5;
   int stage_number = 0;
   const auto stage = [&](const std::string& name, const std::vector<std::string>& args) {
     ++stage_number;
-    say("[" + std::to_string(stage_number) + "/4] " + name + " ...");
+    say("[" + std::to_string(stage_number) + "/" + std::to_string(stage_count) + "] " + name +
+        " ...");
     const auto t0 = Clock::now();
     const std::string stage_log = work + "/" + name + ".log";
     const int rc = runLogged(args, stage_log);
@@ -252,11 +409,13 @@ SfmSummary sfmRun(const SfmOptions& o) {
                   std::to_string(rc) + ": " + lastLines(stage_log, 2));
     }
   };
-  stage("feature_extractor",
-        {o.colmap, "feature_extractor", "--database_path", db, "--image_path", image_path,
-         "--ImageReader.single_camera", o.single_camera ? "1" : "0",
-         "--SiftExtraction.max_image_size", size, "--SiftExtraction.num_threads", threads,
-         "--SiftExtraction.use_gpu", "0"});
+  std::vector<std::string> extract = {
+      o.colmap, "feature_extractor", "--database_path", db, "--image_path", image_path,
+      "--ImageReader.single_camera", o.single_camera ? "1" : "0",
+      "--SiftExtraction.max_image_size", size, "--SiftExtraction.num_threads", threads,
+      "--SiftExtraction.use_gpu", "0"};
+  if (!masks.empty()) extract.insert(extract.end(), {"--ImageReader.mask_path", feature_masks});
+  stage("feature_extractor", extract);
   std::vector<std::string> match = {o.colmap,
                                     matcher + "_matcher",
                                     "--database_path",
@@ -268,12 +427,25 @@ SfmSummary sfmRun(const SfmOptions& o) {
   if (matcher == "sequential") {
     match.insert(match.end(), {"--SequentialMatching.overlap", "10"});
   }
+  if (matcher == "spatial") {
+    // COLMAP's defaults (50 neighbours within 100 m) match nearly every pair of a survey.
+    match.insert(match.end(),
+                 {"--SpatialMatching.max_num_neighbors", std::to_string(o.match_neighbors),
+                  "--SpatialMatching.max_distance",
+                  o.match_distance > 0 ? std::to_string(o.match_distance) : "1e9"});
+    report["match_neighbors"] = o.match_neighbors;
+    report["match_distance"] = o.match_distance;
+  }
   stage(matcher + "_matcher", match);
   // Models of an earlier, failed run must not be taken for this run's.
   fs::remove_all(work + "/sparse");
   io::makeDirectory(work + "/sparse");
-  stage("mapper", {o.colmap, "mapper", "--database_path", db, "--image_path", image_path,
-                   "--output_path", work + "/sparse", "--Mapper.num_threads", threads});
+  std::vector<std::string> mapper = {o.colmap,       "mapper", "--database_path",    db,
+                                     "--image_path",  image_path, "--output_path",
+                                     work + "/sparse", "--Mapper.num_threads", threads};
+  if (!o.refine_focal) mapper.insert(mapper.end(), {"--Mapper.ba_refine_focal_length", "0"});
+  report["refine_focal"] = o.refine_focal;
+  stage("mapper", mapper);
   // The mapper may leave several models (sparse/0, 1, ...): the one with most photos.
   std::string best;
   std::size_t best_images = 0;
@@ -293,6 +465,26 @@ SfmSummary sfmRun(const SfmOptions& o) {
         {o.colmap, "image_undistorter", "--image_path", image_path, "--input_path", best,
          "--output_path", undistorted, "--max_image_size", size});
   io::ColmapModel model = io::readColmapModel(undistorted + "/sparse");
+  if (!masks.empty()) {
+    // COLMAP undistorts the masks as it did the photos: same cameras, same size. It reads by
+    // content and writes by extension, so each mask goes in under its photo's name.
+    const std::string mask_photos = work + "/mask_photos", mask_out = o.out + "/.undistort_masks";
+    fs::remove_all(mask_photos);
+    fs::remove_all(mask_out);
+    io::makeDirectory(mask_photos);
+    for (const auto& p : photos) {
+      fs::copy_file(feature_masks + "/" + p + ".png", mask_photos + "/" + p,
+                    fs::copy_options::overwrite_existing);
+    }
+    stage("image_undistorter (masks)",
+          {o.colmap, "image_undistorter", "--image_path", mask_photos, "--input_path", best,
+           "--output_path", mask_out, "--max_image_size", size});
+    io::makeDirectory(o.out + "/masks");
+    for (const auto& im : model.images) {
+      binariseUndistortedMask(mask_out + "/images/" + im.name, o.out + "/masks/" + im.name + ".png");
+    }
+    fs::remove_all(mask_out);
+  }
 
   SfmSummary summary;
   summary.photos = static_cast<int>(photos.size());
@@ -307,89 +499,120 @@ SfmSummary sfmRun(const SfmOptions& o) {
   for (const auto& p : model.points) error_sum += p.error;
   summary.mean_reprojection_error = model.points.empty() ? 0 : error_sum / model.points.size();
 
-  // The georeference: camera centres against the photos' GPS in east-north-up metres.
-  std::vector<std::array<double, 3>> centres, targets;
-  std::vector<const io::GeoPosition*> used;
-  std::vector<std::string> gps_names;
+  // The georeference: from ground control points when given, else from the photos' GPS.
+  std::vector<geo::GpsPhoto> gps_photos;
+  int with_gps = 0;
+  io::GeoPosition origin;
   for (const auto& im : model.images) {
+    geo::GpsPhoto photo;
+    photo.name = im.name;
+    const Eigen::Matrix3d R = rotationOf(im.qvec);
+    photo.centre = toArray(-R.transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]));
+    photo.viewing = toArray(R.transpose() * Eigen::Vector3d::UnitZ());
     const auto it = gps.find(im.name);
-    if (it == gps.end()) continue;
-    gps_names.push_back(im.name);
-    const Eigen::Vector3d c =
-        -rotationOf(im.qvec).transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]);
-    centres.push_back({c.x(), c.y(), c.z()});
-    used.push_back(&it->second);
+    if (it != gps.end()) {
+      photo.stated_accuracy = it->second.horizontal_accuracy;
+      origin.latitude += it->second.latitude, origin.longitude += it->second.longitude;
+      origin.altitude += it->second.altitude, ++with_gps;
+    }
+    gps_photos.push_back(photo);
+  }
+  if (with_gps > 0) {
+    origin.latitude /= with_gps, origin.longitude /= with_gps, origin.altitude /= with_gps;
+  } else if (gcps) {
+    for (const auto& p : gcps->points) {
+      origin.latitude += p.wgs84.latitude / gcps->points.size();
+      origin.longitude += p.wgs84.longitude / gcps->points.size();
+      origin.altitude += p.wgs84.altitude / gcps->points.size();
+    }
+  }
+  origin.horizontal_accuracy = 0;
+  for (auto& photo : gps_photos) {
+    const auto it = gps.find(photo.name);
+    if (it != gps.end()) photo.gps = io::toEnu(it->second, origin);
+  }
+  std::vector<std::array<double, 3>> points;
+  for (const auto& p : model.points) points.push_back(p.xyz);
+
+  std::optional<io::Georeference> georeference;
+  if (with_gps >= 3) {
+    try {
+      const geo::GpsFit fit =
+          geo::fitGpsGeoreference(gps_photos, points, origin, {o.gps_accuracy});
+      nlohmann::json residuals = nlohmann::json::array();
+      for (const auto& r : fit.residuals) {
+        residuals.push_back({{"photo", r.photo},
+                             {"metres", std::hypot(r.horizontal, r.vertical)},
+                             {"horizontal", r.horizontal},
+                             {"vertical", r.vertical},
+                             {"inlier", r.inlier}});
+      }
+      report["gps_residuals"] = residuals;
+      report["gps_georeference"] = nlohmann::json::parse(io::georeferenceToJson(fit.georeference));
+      georeference = fit.georeference;
+      say(describeGpsFit(fit));
+    } catch (const Error& e) {
+      say(std::string("sfm: no georeference from GPS: ") + e.what() + "\n");
+    }
+  } else if (!gcps) {
+    say("sfm: no georeference (" + std::to_string(with_gps) +
+        " registered photos with GPS; 3 needed): the model keeps COLMAP's frame\n");
+  }
+  std::optional<geo::GcpFit> gcp_fit;
+  if (gcps) {
+    // The photos' pixel marks are on the original photos: triangulate in COLMAP's own model
+    // (distorted cameras, the same frame as the undistorted one). A reconstruction that cannot
+    // place them keeps the GPS frame, said loudly, rather than losing the run.
+    try {
+      gcp_fit = geo::fitGcpGeoreference(io::readColmapModel(best), *gcps, origin);
+    } catch (const Error& e) {
+      say(std::string("WARNING: the ground control points could not be used: ") + e.what() +
+          "\n");
+      if (georeference) {
+        georeference->doubts.push_back(std::string("the ground control points could not be "
+                                                   "used (") + e.what() + ")");
+      }
+    }
+  }
+  if (gcp_fit) {
+    const geo::GcpFit& fit = *gcp_fit;
+    nlohmann::json residuals = nlohmann::json::array();
+    for (const auto& r : fit.residuals) {
+      residuals.push_back({{"name", r.name},
+                           {"check", r.check},
+                           {"horizontal", r.horizontal},
+                           {"vertical", r.vertical},
+                           {"reprojection_px", r.reprojection_px},
+                           {"marks", r.marks}});
+    }
+    report["gcp_residuals"] = residuals;
+    report["gcp_skipped"] = fit.skipped;
+    report["gcp_file"] = gcps->path;
+    io::Georeference g = fit.georeference;
+    if (georeference) {
+      // What the GPS fit said of the scene's own up stays as a check of the GCP frame.
+      g.photos_with_gps = georeference->photos_with_gps;
+      g.gps_accuracy_metres = georeference->gps_accuracy_metres;
+      g.gps_noise_metres = georeference->gps_noise_metres;
+    }
+    georeference = g;
+    say(describeGcpFit(fit));
   }
   nlohmann::json georef_json = nullptr;
-  if (used.size() >= 3) {
-    io::GeoPosition origin;
-    for (const auto* g : used) {
-      origin.latitude += g->latitude / used.size();
-      origin.longitude += g->longitude / used.size();
-      origin.altitude += g->altitude / used.size();
+  if (georeference) {
+    transformModel(model, georeference->sfm_to_local);
+    io::writeFileAtomically(o.out + "/georeference.json",
+                            [&](std::ostream& out) { out << io::georeferenceToJson(*georeference); });
+    georef_json = nlohmann::json::parse(io::georeferenceToJson(*georeference));
+    summary.georeferenced = true;
+    summary.georeference_doubtful = !georeference->trustworthy();
+    if (summary.georeference_doubtful) {
+      std::string text = "WARNING: the georeference is doubtful:";
+      for (const auto& d : georeference->doubts) text += " " + d + ";";
+      if (!georeference->consensus) text += " the GPS does not agree with the reconstruction;";
+      say(text + " positions, heights and areas in the map products (ortho, DSM, LAS) can be "
+                 "wrong. Check sfm_report.json; ground control points (gcp_list.txt) fix it.\n");
     }
-    for (const auto* g : used) targets.push_back(io::toEnu(*g, origin));
-    std::vector<bool> inliers;
-    try {
-      io::Georeference geo;
-      geo.sfm_to_local =
-          io::fitSimilarity(centres, targets, o.gps_inlier_metres, &inliers, &geo.consensus);
-      geo.origin = origin;
-      geo.epsg_utm = io::utmEpsg(origin);
-      geo.photos_with_gps = static_cast<int>(used.size());
-      // Residuals per photo; the RMS is over the photos the fit used (the agreeing ones, or all).
-      double sq = 0;
-      int fitted = 0;
-      nlohmann::json residuals = nlohmann::json::array();
-      std::vector<std::pair<double, std::string>> off;  // photos outside the inlier distance
-      for (std::size_t i = 0; i < centres.size(); ++i) {
-        const auto x = geo.sfm_to_local.apply(centres[i]);
-        double d2 = 0;
-        for (int k = 0; k < 3; ++k) d2 += (x[k] - targets[i][k]) * (x[k] - targets[i][k]);
-        residuals.push_back({{"photo", gps_names[i]},
-                             {"metres", std::sqrt(d2)},
-                             {"inlier", static_cast<bool>(inliers[i])}});
-        if (inliers[i]) {
-          ++geo.inliers;
-        } else {
-          off.emplace_back(std::sqrt(d2), gps_names[i]);
-        }
-        if (inliers[i] || !geo.consensus) sq += d2, ++fitted;
-      }
-      geo.rms_metres = std::sqrt(sq / std::max(1, fitted));
-      report["gps_residuals"] = residuals;
-      std::sort(off.rbegin(), off.rend());
-      std::ostringstream warn;
-      warn.precision(3);
-      if (!geo.consensus) {
-        warn << "warning: no 3 photos' GPS agree with the reconstruction within "
-             << o.gps_inlier_metres << " m; georeferenced by the least-squares fit of all "
-             << used.size() << " (RMS " << geo.rms_metres << " m), so positions in the outputs "
-             << "can be off by that much. The reconstruction or the GPS is wrong: check the "
-                "photos' overlap (sfm_report.json lists each photo's distance to its GPS), or "
-                "raise --gps-inlier if the GPS is this noisy.\n";
-      }
-      if (!off.empty()) {
-        warn << "warning: " << off.size() << " of " << used.size()
-             << " photos' camera centres lie more than " << o.gps_inlier_metres
-             << " m from their GPS:";
-        for (std::size_t k = 0; k < std::min<std::size_t>(off.size(), 5); ++k) {
-          warn << " " << off[k].second << " (" << off[k].first << " m)";
-        }
-        warn << (off.size() > 5 ? " ...\n" : "\n");
-      }
-      say(warn.str());
-      transformModel(model, geo.sfm_to_local);
-      io::writeFileAtomically(o.out + "/georeference.json",
-                              [&](std::ostream& out) { out << io::georeferenceToJson(geo); });
-      georef_json = nlohmann::json::parse(io::georeferenceToJson(geo));
-      summary.georeferenced = true;
-    } catch (const Error& e) {
-      say(std::string("sfm: no georeference: ") + e.what() + "\n");
-    }
-  } else {
-    say("sfm: no georeference (" + std::to_string(used.size()) +
-        " registered photos with GPS; 3 needed): the model keeps COLMAP's frame\n");
   }
   io::makeDirectory(o.out + "/sparse");
   io::writeColmapText(o.out + "/sparse/0", model);
@@ -412,12 +635,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
        << summary.points << " points, mean reprojection error " << summary.mean_reprojection_error
        << " px";
   if (summary.georeferenced) {
-    const auto g = io::georeferenceFromJson(io::readWholeFile(o.out + "/georeference.json"),
-                                            o.out + "/georeference.json");
-    done << "; georeferenced (" << g.inliers << " of " << g.photos_with_gps
-         << " GPS positions within " << o.gps_inlier_metres << " m"
-         << (g.consensus ? "" : ", no consensus: fit of all") << ", RMS " << g.rms_metres
-         << " m, UTM EPSG:" << g.epsg_utm << ")";
+    done << (summary.georeference_doubtful ? "; georeference DOUBTFUL (" : "; georeferenced (")
+         << georeference->up_source << ", UTM EPSG:" << georeference->epsg_utm << ")";
   }
   done << "; " << summary.seconds << " s\n";
   if (!summary.unregistered.empty()) {

@@ -77,6 +77,15 @@ Crs crsOfEpsg(int epsg);
 std::vector<std::array<double, 3>> enuToUtm(const io::Georeference& georeference,
                                             const std::vector<std::array<double, 3>>& enu);
 
+/// \brief WGS84 positions of points given in the CRS `crs`: anything GDAL's SetFromUserInput
+/// takes ("EPSG:32632", a PROJ string "+proj=utm +zone=32 +datum=WGS84 +units=m", WKT) or
+/// OpenDroneMap's "WGS84 UTM 32N"; x, y in the CRS's traditional GIS order (easting / longitude
+/// first), z passed through as the height. `file` names the source in errors.
+/// \throws sadsplat::Error naming `file` for a CRS PROJ does not know, or without GDAL
+std::vector<io::GeoPosition> crsToWgs84(const std::string& crs,
+                                        const std::vector<std::array<double, 3>>& xyz,
+                                        const std::string& file);
+
 /// \brief OGC WKT of the local-metres CRS (a LOCAL_CS, metres).
 std::string localCrsWkt();
 

@@ -2,11 +2,14 @@
 /// \file sfm_run.h
 /// \brief `sadsplat sfm`: a folder of photos into a scene directory that sadsplat reads as is,
 /// through COLMAP's command line (Debian's `colmap`): feature extraction, matching, mapping,
-/// undistortion; then the georeference from the photos' GPS (EXIF) when they carry it.
+/// undistortion; then the georeference from the photos' GPS (EXIF) when they carry it
+/// (geo::fitGpsGeoreference), or from ground control points (gcp_list.txt,
+/// geo::fitGcpGeoreference) when given.
 ///
 /// The scene directory: images/ (undistorted), sparse/0/ (COLMAP text, PINHOLE cameras; in
 /// east-north-up metres when georeferenced), georeference.json (when georeferenced),
-/// sfm_report.json (stages, times, registered and unregistered photos), colmap/ (COLMAP's
+/// sfm_report.json (stages, times, registered and unregistered photos, every photo's GPS residual
+/// and every ground control point's), colmap/ (COLMAP's
 /// database, its own model and the logs of every stage).
 
 #include <ostream>
@@ -26,7 +29,20 @@ struct SfmOptions {
   int max_image_size = 2000;
   bool single_camera = true;      ///< one camera for every photo (one drone, one lens)
   int threads = -1;               ///< -1: every core
-  double gps_inlier_metres = 5;   ///< GPS within this of the fitted camera centre is an inlier
+  /// Horizontal GPS accuracy (1 sigma, metres) the georeference starts from; 0: what the photos
+  /// state in EXIF, else geo::kDefaultGpsAccuracy. The inlier distance then comes from the
+  /// measured noise (geo::fitGpsGeoreference).
+  double gps_accuracy = 0;
+  /// OpenDroneMap's gcp_list.txt; empty: `photos`/gcp_list.txt when it exists, else none.
+  std::string gcp;
+  /// The spatial matcher: each photo against its k nearest photos by GPS (OpenDroneMap matches
+  /// against ~8); within `match_distance` metres (0: any distance).
+  int match_neighbors = 12;
+  double match_distance = 0;
+  /// Whether the mapper refines the focal length from its prior (EXIF, or 1.2x the longest side
+  /// without one). false keeps the prior: a nadir flight over flat ground fixes the focal length
+  /// only weakly, and a wrong one scales every height.
+  bool refine_focal = true;
   std::string colmap = "colmap";  ///< the program
   std::ostream* progress = nullptr;
 };
@@ -39,6 +55,8 @@ struct SfmSummary {
   std::size_t points = 0;
   double mean_reprojection_error = 0;  ///< pixels, mean over the points
   bool georeferenced = false;
+  /// a frame was written, but something speaks against it (georeference.json's `doubts`)
+  bool georeference_doubtful = false;
   double seconds = 0;
 };
 
