@@ -427,7 +427,7 @@ class ThirdsGates : public gaussians::DropStrategy {
 TEST_P(TrainerOnDevice, RecoveryFoldsTheGatesIntoTheOpacitiesAndTrainsWithoutThem) {
   TrainConfig c = small(20);
   c.recovery_iterations = 5;
-  c.lr_opacity = 0;  // the opacities change only by the folding
+  c.lr_opacity = 0;       // the opacities change only by the folding
   c.drop_rule = "paper";  // the L0 term is in the loss
   Trainer trainer(scene_, c);
   auto gates = std::make_shared<ThirdsGates>();
@@ -914,9 +914,10 @@ TEST_F(TrainerTest, MaskedPixelsOfAMovingObjectLeaveNoGhost) {
     }
     magenta[variant] = sum / squares.size();
   }
-  std::printf("magenta over the object's squares: %.3f trained without the object, %.3f with it, "
-              "%.3f with it masked\n",
-              magenta[0], magenta[1], magenta[2]);
+  std::printf(
+      "magenta over the object's squares: %.3f trained without the object, %.3f with it, "
+      "%.3f with it masked\n",
+      magenta[0], magenta[1], magenta[2]);
   const double ghost = magenta[1] - magenta[0], masked_ghost = magenta[2] - magenta[0];
   EXPECT_GT(ghost, 0.1);                            // the object's ghost, unmasked
   EXPECT_LT(std::abs(masked_ghost), 0.25 * ghost);  // masked: about what the clean photos give

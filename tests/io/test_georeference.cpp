@@ -117,7 +117,8 @@ TEST(Georeference, ExifGpsWrittenBySadsplatIsReadBackByLibexif) {
   const auto bytes = io::jpegWithExifGps(bare, where);
   const std::string path = tmp.file("photo.jpg");
   std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
   const auto read = io::readExifGps(path);
   ASSERT_TRUE(read.has_value());
   EXPECT_NEAR(read->latitude, where.latitude, 1e-9);
@@ -163,6 +164,22 @@ TEST(Georeference, JsonAndSceneCacheRoundTrips) {
     EXPECT_NE(std::string(e.what()).find("origin"), std::string::npos) << e.what();
   }
   EXPECT_THROW(io::georeferenceFromJson("{\"origin\": 3}", "geo.json"), Error);
+  // The EPSG code must be the origin's UTM zone (Duluth: 15 N = 32615) or a neighbour.
+  const auto withEpsg = [](const std::string& epsg, const std::string& altitude = "198.6") {
+    return "{\"origin\": {\"latitude\": 46.843, \"longitude\": -91.994, \"altitude\": " + altitude +
+           "}, \"epsg_utm\": " + epsg + "}";
+  };
+  EXPECT_EQ(io::georeferenceFromJson(withEpsg("32615"), "geo.json").epsg_utm, 32615);
+  EXPECT_EQ(io::georeferenceFromJson(withEpsg("32616"), "geo.json").epsg_utm, 32616);
+  for (const std::string bad : {"4326", "32715", "32620", "32615.5", "1e300"}) {
+    try {
+      io::georeferenceFromJson(withEpsg(bad), "geo.json");
+      ADD_FAILURE() << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("EPSG:32615"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(io::georeferenceFromJson(withEpsg("32615", "1e308"), "geo.json"), Error);
   // The scene cache keeps it (a chunk older readers skip); a scene without one stays without.
   test::TempDir tmp;
   io::Scene scene;

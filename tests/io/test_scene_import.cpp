@@ -119,8 +119,7 @@ TEST_F(SceneImport, MasksKeepPixelsOutAndTakeTheirLabels) {
   EXPECT_NE(v0.labels.at(40, 30), io::kIgnoreLabel);
   EXPECT_EQ(scene.views[1].mask.at(2, 2), 0);
   EXPECT_EQ(scene.views[1].mask.at(30, 30), 255);
-  EXPECT_EQ(std::count(scene.views[2].mask.pixels.begin(), scene.views[2].mask.pixels.end(), 0),
-            0);
+  EXPECT_EQ(std::count(scene.views[2].mask.pixels.begin(), scene.views[2].mask.pixels.end(), 0), 0);
   // Resized with the image.
   io::ImportOptions half;
   half.scale = 0.5;

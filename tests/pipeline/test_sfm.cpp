@@ -122,8 +122,8 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
     const Eigen::Vector3d t = true_centres.at(im.name);
     const auto expected = io::toEnu(io::fromEnu({t.x(), t.y(), t.z()}, place), g.origin);
     const Eigen::Vector3d c = centre(im.qvec, im.tvec);
-    worst_position = std::max(
-        worst_position, (c - Eigen::Vector3d(expected[0], expected[1], expected[2])).norm());
+    worst_position = std::max(worst_position,
+                              (c - Eigen::Vector3d(expected[0], expected[1], expected[2])).norm());
     // Both frames are east-north-up (their origins ~100 m apart: their axes agree to 1e-5 rad).
     const Eigen::Matrix3d d = rotation(im.qvec) * true_rotations.at(im.name).transpose();
     angles.push_back(std::acos(std::clamp((d.trace() - 1) / 2, -1.0, 1.0)));
@@ -303,10 +303,11 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
     by_gps.push_back(gps.sfm_to_local.apply(colmap_frame.back()));
   }
   const FrameError e = frameError(truth, by_gps);
-  std::printf("GPS frame: up from %s, tilt %.3f deg, heading %.3f deg, scale %+.3f %%; noise %.2f m, "
-              "horizontal RMS %.2f m, vertical RMS %.2f m, scale +-%.2f %%\n",
-              gps.up_source.c_str(), e.tilt, e.heading, 100 * e.scale, gps.gps_noise_metres,
-              gps.horizontal_rms_metres, gps.vertical_rms_metres, 100 * gps.scale_uncertainty);
+  std::printf(
+      "GPS frame: up from %s, tilt %.3f deg, heading %.3f deg, scale %+.3f %%; noise %.2f m, "
+      "horizontal RMS %.2f m, vertical RMS %.2f m, scale +-%.2f %%\n",
+      gps.up_source.c_str(), e.tilt, e.heading, 100 * e.scale, gps.gps_noise_metres,
+      gps.horizontal_rms_metres, gps.vertical_rms_metres, 100 * gps.scale_uncertainty);
   EXPECT_EQ(gps.up_source, "nadir views");
   EXPECT_LT(e.tilt, 1.0);
   EXPECT_LT(std::abs(e.scale), 0.01);
@@ -340,11 +341,12 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
   std::printf("focal length: recovered %.1f px (undistorted camera), true %.1f px\n",
               model.cameras.at(0).params.at(0), scene.views[0].camera.fx);
   const FrameError eg = frameError(truth, by_gcp);
-  std::printf("GCP frame: tilt %.3f deg, heading %.3f deg, scale %+.3f %%; controls RMS %.3f / "
-              "%.3f m; check RMSE horizontal %.3f m, vertical %.3f m (GSD %.3f m)\n",
-              eg.tilt, eg.heading, 100 * eg.scale, final_frame.horizontal_rms_metres,
-              final_frame.vertical_rms_metres, final_frame.check_rmse_horizontal,
-              final_frame.check_rmse_vertical, gsd);
+  std::printf(
+      "GCP frame: tilt %.3f deg, heading %.3f deg, scale %+.3f %%; controls RMS %.3f / "
+      "%.3f m; check RMSE horizontal %.3f m, vertical %.3f m (GSD %.3f m)\n",
+      eg.tilt, eg.heading, 100 * eg.scale, final_frame.horizontal_rms_metres,
+      final_frame.vertical_rms_metres, final_frame.check_rmse_horizontal,
+      final_frame.check_rmse_vertical, gsd);
   // The marks' stated accuracy: half a pixel (the noise they were made with). On the ground that
   // is half the GSD horizontally, and vertically that times the flight's height-to-base ratio
   // (a stereo intersection's height error; 138 m over 22.5 m photo spacing: 6.2). The check
@@ -401,11 +403,13 @@ TEST(Sfm, BadInputsAreOneLineErrors) {
 // SHORT), written by hand from the specification.
 std::vector<unsigned char> jpegWithOrientation(const std::vector<unsigned char>& jpeg, int value) {
   const std::vector<unsigned char> app1 = {
-      0xFF, 0xE1, 0, 34, 'E', 'x', 'i', 'f', 0, 0,                 // APP1, length 34, "Exif\0\0"
-      'I',  'I',  42, 0, 8, 0, 0, 0,                               // TIFF little endian, IFD0 at 8
-      1,    0,                                                     // one entry
-      0x12, 0x01, 3, 0, 1, 0, 0, 0, static_cast<unsigned char>(value), 0, 0, 0,  // Orientation
-      0,    0,    0, 0};                                           // no next IFD
+      0xFF, 0xE1, 0,  34, 'E', 'x', 'i', 'f', 0,
+      0,                                     // APP1, length 34, "Exif\0\0"
+      'I',  'I',  42, 0,  8,   0,   0,   0,  // TIFF little endian, IFD0 at 8
+      1,    0,                               // one entry
+      0x12, 0x01, 3,  0,  1,   0,   0,   0,   static_cast<unsigned char>(value),
+      0,    0,    0,                                               // Orientation
+      0,    0,    0,  0};                                          // no next IFD
   std::vector<unsigned char> out(jpeg.begin(), jpeg.begin() + 2);  // SOI
   out.insert(out.end(), app1.begin(), app1.end());
   out.insert(out.end(), jpeg.begin() + 2, jpeg.end());
@@ -441,7 +445,8 @@ TEST(Sfm, PhotosWithAnExifRotationGetUprightCopies) {
   EXPECT_EQ(rotated, 1);
   EXPECT_EQ(upright, tmp.file("work") + "/upright");
   EXPECT_EQ(test::readFile(upright + "/a.jpg"), test::readFile(photos + "/a.jpg"));
-  const cv::Mat b = cv::imread(upright + "/b.jpg", cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+  const cv::Mat b =
+      cv::imread(upright + "/b.jpg", cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
   ASSERT_EQ(b.cols, 20);
   ASSERT_EQ(b.rows, 40);
   EXPECT_EQ(io::readExifOrientation(upright + "/b.jpg"), 1);

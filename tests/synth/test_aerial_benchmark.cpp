@@ -284,7 +284,8 @@ TEST(AerialBenchmark, TheGridCaptureFliesNadirLinesWithTheStatedOverlap) {
     const auto& c = scene.views[i].camera;
     const Eigen::Quaterniond q(c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]);
     const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
-    const Eigen::Vector3d centre = -R.transpose() * Eigen::Vector3d(c.tvec[0], c.tvec[1], c.tvec[2]);
+    const Eigen::Vector3d centre =
+        -R.transpose() * Eigen::Vector3d(c.tvec[0], c.tvec[1], c.tvec[2]);
     const Eigen::Vector3d viewing = R.transpose() * Eigen::Vector3d::UnitZ();
     EXPECT_LT(std::acos(-viewing.z()) * 180 / M_PI, 1.0) << i;  // nadir
     EXPECT_NEAR(centre.z(), g.altitude, 1.0) << i;
@@ -293,14 +294,17 @@ TEST(AerialBenchmark, TheGridCaptureFliesNadirLinesWithTheStatedOverlap) {
     // Consecutive photos of a line: one spacing apart, the line's x shared.
     if (i % g.per_line != 0) {
       const auto& p = scene.views[i - 1].camera;
-      const Eigen::Matrix3d Rp =
-          Eigen::Quaterniond(p.qvec[0], p.qvec[1], p.qvec[2], p.qvec[3]).normalized().toRotationMatrix();
-      const Eigen::Vector3d prev = -Rp.transpose() * Eigen::Vector3d(p.tvec[0], p.tvec[1], p.tvec[2]);
+      const Eigen::Matrix3d Rp = Eigen::Quaterniond(p.qvec[0], p.qvec[1], p.qvec[2], p.qvec[3])
+                                     .normalized()
+                                     .toRotationMatrix();
+      const Eigen::Vector3d prev =
+          -Rp.transpose() * Eigen::Vector3d(p.tvec[0], p.tvec[1], p.tvec[2]);
       EXPECT_NEAR(std::abs(centre.y() - prev.y()), g.along_spacing, 1.0) << i;
       EXPECT_NEAR(centre.x(), prev.x(), 1.0) << i;
     }
   }
-  EXPECT_EQ(synth::captureFromName(synth::captureName(synth::Capture::kGrid)), synth::Capture::kGrid);
+  EXPECT_EQ(synth::captureFromName(synth::captureName(synth::Capture::kGrid)),
+            synth::Capture::kGrid);
   EXPECT_THROW(synth::captureFromName("spiral"), Error);
 }
 

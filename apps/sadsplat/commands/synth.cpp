@@ -54,8 +54,7 @@ class SynthCommand : public Command {
 
   int run(const Invocation&) override {
     if (out_.empty() && cache_.empty() && photos_.empty()) {
-      throw Error("<command line>", "synth", "--out DIR, --cache FILE and/or --photos DIR",
-                  "none");
+      throw Error("<command line>", "synth", "--out DIR, --cache FILE and/or --photos DIR", "none");
     }
     const synth::SynthOptions o = options();
     std::cout << "generating " << kind_ << " seed " << seed_ << ": " << o.views << " views of "
@@ -103,7 +102,11 @@ class SynthCommand : public Command {
     for (std::size_t c = 0; c < scene.classes.size(); ++c) {
       std::cout << " " << scene.classes[c].name << " " << 100.0 * stats.class_share[c] << "%";
     }
-    std::cout << "\nwrote " << (out_.empty() ? cache_ : out_) << "\n";
+    std::cout << "\nwrote";
+    for (const std::string* path : {&out_, &cache_, &photos_}) {
+      if (!path->empty()) std::cout << " " << *path;
+    }
+    std::cout << "\n";
     return 0;
   }
 

@@ -1,8 +1,8 @@
 #include "sadsplat/io/file_info.h"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <limits>
@@ -54,9 +54,8 @@ void describeGeoreference(std::ostream& out, const Georeference& g) {
         << g.horizontal_rms_metres << " m, vertical " << g.vertical_rms_metres << " m";
     if (g.ground_tilt_deg >= 0) geo << "; ground plane " << g.ground_tilt_deg << " deg from level";
     if (g.check_points > 0) {
-      geo << "; " << g.check_points << " check points: RMSE horizontal "
-          << std::setprecision(3) << g.check_rmse_horizontal << " m, vertical "
-          << g.check_rmse_vertical << " m";
+      geo << "; " << g.check_points << " check points: RMSE horizontal " << std::setprecision(3)
+          << g.check_rmse_horizontal << " m, vertical " << g.check_rmse_vertical << " m";
     }
     geo << "\n";
   }
@@ -131,21 +130,20 @@ void describeLas(std::ostream& out, const std::string& path) {
   if (!h.wkt.empty()) {  // the name: the first quoted string of the WKT
     const std::size_t a = h.wkt.find('"'), b = h.wkt.find('"', a + 1);
     crs = a != std::string::npos && b != std::string::npos ? h.wkt.substr(a + 1, b - a - 1)
-                                                          : "(WKT without a name)";
+                                                           : "(WKT without a name)";
   }
   out << path << ": LAS 1." << h.version_minor << ", point format " << h.point_format << "\n"
       << "points: " << points.size() << "\n"
       << "CRS: " << crs << "\n"
       << std::fixed << std::setprecision(3) << "bounding box: [" << h.min[0] << ", " << h.min[1]
-      << ", " << h.min[2] << "] .. [" << h.max[0] << ", " << h.max[1] << ", " << h.max[2]
-      << "]\n";
+      << ", " << h.min[2] << "] .. [" << h.max[0] << ", " << h.max[1] << ", " << h.max[2] << "]\n";
   std::map<int, std::size_t> histogram;
   for (const LasPoint& p : points) ++histogram[p.classification];
   out << "points per ASPRS class:";
   for (const auto& [code, count] : histogram) {
     const auto it = asprsClassNames().find(code);
-    out << " " << code << " (" << (it != asprsClassNames().end() ? it->second : "user") << "):"
-        << count;
+    out << " " << code << " (" << (it != asprsClassNames().end() ? it->second : "user")
+        << "):" << count;
   }
   out << "\n";
 }
@@ -327,8 +325,8 @@ std::string describeCameras(const std::string& path) {
   out << "name,width,height,fx,fy,cx,cy,qw,qx,qy,qz,tx,ty,tz,role\n";
   for (const View& v : scene.views) {
     const PinholeCamera& c = v.camera;
-    out << v.name << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << ","
-        << c.cx << "," << c.cy;
+    out << v.name << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << "," << c.cx
+        << "," << c.cy;
     for (double q : c.qvec) out << "," << q;
     for (double t : c.tvec) out << "," << t;
     out << "," << (v.test ? "test" : v.train ? "train" : "none") << "\n";

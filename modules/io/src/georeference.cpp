@@ -22,9 +22,9 @@ namespace io {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kA = 6378137.0;                // WGS84 semi-major axis
-constexpr double kF = 1.0 / 298.257223563;      // WGS84 flattening
-constexpr double kE2 = kF * (2 - kF);           // first eccentricity squared
+constexpr double kA = 6378137.0;            // WGS84 semi-major axis
+constexpr double kF = 1.0 / 298.257223563;  // WGS84 flattening
+constexpr double kE2 = kF * (2 - kF);       // first eccentricity squared
 
 double radians(double deg) { return deg * kPi / 180.0; }
 double degrees(double rad) { return rad * 180.0 / kPi; }
@@ -54,7 +54,7 @@ GeoPosition fromEcef(const Eigen::Vector3d& x) {
 Eigen::Matrix3d enuBasis(const GeoPosition& origin) {
   const double lat = radians(origin.latitude), lon = radians(origin.longitude);
   Eigen::Matrix3d m;
-  m << -std::sin(lon), std::cos(lon), 0,  //
+  m << -std::sin(lon), std::cos(lon), 0,                                              //
       -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),  //
       std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat);
   return m;
@@ -234,8 +234,8 @@ std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpe
   std::uint32_t lat[6], lon[6];
   dms(gps.latitude, lat);
   dms(gps.longitude, lon);
-  const std::uint32_t alt[2] = {static_cast<std::uint32_t>(std::llround(std::abs(gps.altitude) * 1000)),
-                                1000};
+  const std::uint32_t alt[2] = {
+      static_cast<std::uint32_t>(std::llround(std::abs(gps.altitude) * 1000)), 1000};
   u16(entries);
   const auto ascii = [&](std::uint16_t tag, char c) {
     u16(tag), u16(2), u32(2);
@@ -246,7 +246,8 @@ std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpe
   u16(0x0002), u16(5), u32(3), u32(values);
   ascii(0x0003, gps.longitude < 0 ? 'W' : 'E');
   u16(0x0004), u16(5), u32(3), u32(values + 24);
-  u16(0x0005), u16(1), u32(1), t.insert(t.end(), {static_cast<unsigned char>(gps.altitude < 0), 0, 0, 0});
+  u16(0x0005), u16(1), u32(1),
+      t.insert(t.end(), {static_cast<unsigned char>(gps.altitude < 0), 0, 0, 0});
   u16(0x0006), u16(5), u32(1), u32(values + 48);
   u32(0);
   for (auto v : lat) u32(v);
@@ -382,13 +383,27 @@ Georeference georeferenceFromJson(const std::string& text, const std::string& or
       throw Error(origin, "origin", "an object with latitude, longitude, altitude", "missing");
     }
     const auto& o = j.at("origin");
-    g.origin = {number(o, "latitude", "origin.latitude"), number(o, "longitude", "origin.longitude"),
+    g.origin = {number(o, "latitude", "origin.latitude"),
+                number(o, "longitude", "origin.longitude"),
                 number(o, "altitude", "origin.altitude")};
     if (std::abs(g.origin.latitude) > 90 || std::abs(g.origin.longitude) > 180) {
-      throw Error(origin, "origin", "latitude within +-90, longitude within +-180",
-                  o.dump());
+      throw Error(origin, "origin", "latitude within +-90, longitude within +-180", o.dump());
     }
-    g.epsg_utm = static_cast<int>(number(j, "epsg_utm", "epsg_utm"));
+    const double epsg = number(j, "epsg_utm", "epsg_utm");
+    // The UTM zone of the origin (sadsplat writes that one) or a neighbouring zone of the same
+    // hemisphere: another code would put the maps on a distorted or a wrong grid.
+    const int own = utmEpsg(g.origin);
+    if (!(std::abs(epsg - own) <= 1) || std::floor(epsg) != epsg ||
+        std::floor(epsg / 100) != own / 100) {
+      throw Error(origin, "epsg_utm",
+                  "the WGS84 / UTM zone of the origin, EPSG:" + std::to_string(own) +
+                      " (or a neighbouring zone)",
+                  j.at("epsg_utm").dump());
+    }
+    g.epsg_utm = static_cast<int>(epsg);
+    if (!(std::abs(g.origin.altitude) <= 100000)) {
+      throw Error(origin, "origin.altitude", "metres within +-100 km", o.at("altitude").dump());
+    }
     if (j.contains("sfm_to_local")) {
       const auto& s = j.at("sfm_to_local");
       g.sfm_to_local.scale = number(s, "scale", "sfm_to_local.scale");

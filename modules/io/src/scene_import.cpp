@@ -6,9 +6,9 @@
 #include <set>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/io/colmap.h"
 #include "sadsplat/io/annotations.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/colmap.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/transforms_json.h"
 
@@ -278,7 +278,7 @@ cv::Mat rasterise(const AnnotatedImage& a, const cv::Size& size,
       labels.setTo(cv::Scalar(id), scaled);
       continue;
     }
-    std::vector<std::vector<cv::Point>> rings;
+    std::vector<std::vector<cv::Point> > rings;
     for (const auto& polygon : shape.polygons) {
       std::vector<cv::Point> ring;
       for (const auto& p : polygon) {
@@ -485,8 +485,8 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   }
 
   if (pathExists(dir + "/georeference.json")) {
-    scene.georeference = georeferenceFromJson(readWholeFile(dir + "/georeference.json"),
-                                              dir + "/georeference.json");
+    scene.georeference =
+        georeferenceFromJson(readWholeFile(dir + "/georeference.json"), dir + "/georeference.json");
   }
   scene.points.reserve(model.points.size());
   for (const auto& p : model.points) {

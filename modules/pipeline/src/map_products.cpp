@@ -179,6 +179,20 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
   j["similarity_fit_residual_m"] = grid.frame.fit_residual;
+  if (run.scene.georeference && !run.scene.georeference->up_source.empty()) {
+    // The frame's accuracy statement, as sfm measured it (georeference.json).
+    const io::Georeference& g = *run.scene.georeference;
+    nlohmann::json a = {{"source", g.up_source},
+                        {"horizontal_rms_m", g.horizontal_rms_metres},
+                        {"vertical_rms_m", g.vertical_rms_metres},
+                        {"doubts", g.doubts}};
+    if (g.check_points > 0) {
+      a["check_points"] = g.check_points;
+      a["check_rmse_horizontal_m"] = g.check_rmse_horizontal;
+      a["check_rmse_vertical_m"] = g.check_rmse_vertical;
+    }
+    j["georeference_accuracy"] = a;
+  }
   j["height_datum"] = grid.frame.georeferenced
                           ? "the photos' GPS altitude reference (origin altitude + local up)"
                           : "the scene frame's up axis";

@@ -345,8 +345,9 @@ SfmSummary sfmRun(const SfmOptions& o) {
       (io::haveExif() ? "" : " (this build reads no EXIF: no georeference)") + "\n");
   // Ground control points are checked before COLMAP runs: a bad file costs no reconstruction.
   const std::string gcp_path =
-      !o.gcp.empty() ? o.gcp
-                     : (io::pathExists(o.photos + "/gcp_list.txt") ? o.photos + "/gcp_list.txt" : "");
+      !o.gcp.empty()
+          ? o.gcp
+          : (io::pathExists(o.photos + "/gcp_list.txt") ? o.photos + "/gcp_list.txt" : "");
   std::optional<geo::GcpList> gcps;
   if (!gcp_path.empty()) {
     gcps = geo::readGcpList(gcp_path, photos);
@@ -379,8 +380,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
   const std::map<std::string, std::string> masks = photoMasks(o.photos, photos);
   const std::string feature_masks = work + "/feature_masks";
   if (!masks.empty()) {
-    say("sfm: " + std::to_string(masks.size()) + " photos have a mask in " + o.photos +
-        "/masks\n");
+    say("sfm: " + std::to_string(masks.size()) + " photos have a mask in " + o.photos + "/masks\n");
     fs::remove_all(feature_masks);
     io::makeDirectory(feature_masks);
     for (const auto& p : photos) {
@@ -409,11 +409,20 @@ SfmSummary sfmRun(const SfmOptions& o) {
                   std::to_string(rc) + ": " + lastLines(stage_log, 2));
     }
   };
-  std::vector<std::string> extract = {
-      o.colmap, "feature_extractor", "--database_path", db, "--image_path", image_path,
-      "--ImageReader.single_camera", o.single_camera ? "1" : "0",
-      "--SiftExtraction.max_image_size", size, "--SiftExtraction.num_threads", threads,
-      "--SiftExtraction.use_gpu", "0"};
+  std::vector<std::string> extract = {o.colmap,
+                                      "feature_extractor",
+                                      "--database_path",
+                                      db,
+                                      "--image_path",
+                                      image_path,
+                                      "--ImageReader.single_camera",
+                                      o.single_camera ? "1" : "0",
+                                      "--SiftExtraction.max_image_size",
+                                      size,
+                                      "--SiftExtraction.num_threads",
+                                      threads,
+                                      "--SiftExtraction.use_gpu",
+                                      "0"};
   if (!masks.empty()) extract.insert(extract.end(), {"--ImageReader.mask_path", feature_masks});
   stage("feature_extractor", extract);
   std::vector<std::string> match = {o.colmap,
@@ -429,10 +438,9 @@ SfmSummary sfmRun(const SfmOptions& o) {
   }
   if (matcher == "spatial") {
     // COLMAP's defaults (50 neighbours within 100 m) match nearly every pair of a survey.
-    match.insert(match.end(),
-                 {"--SpatialMatching.max_num_neighbors", std::to_string(o.match_neighbors),
-                  "--SpatialMatching.max_distance",
-                  o.match_distance > 0 ? std::to_string(o.match_distance) : "1e9"});
+    match.insert(match.end(), {"--SpatialMatching.max_num_neighbors",
+                               std::to_string(o.match_neighbors), "--SpatialMatching.max_distance",
+                               o.match_distance > 0 ? std::to_string(o.match_distance) : "1e9"});
     report["match_neighbors"] = o.match_neighbors;
     report["match_distance"] = o.match_distance;
   }
@@ -440,9 +448,9 @@ SfmSummary sfmRun(const SfmOptions& o) {
   // Models of an earlier, failed run must not be taken for this run's.
   fs::remove_all(work + "/sparse");
   io::makeDirectory(work + "/sparse");
-  std::vector<std::string> mapper = {o.colmap,       "mapper", "--database_path",    db,
-                                     "--image_path",  image_path, "--output_path",
-                                     work + "/sparse", "--Mapper.num_threads", threads};
+  std::vector<std::string> mapper = {
+      o.colmap,        "mapper",         "--database_path",      db,     "--image_path", image_path,
+      "--output_path", work + "/sparse", "--Mapper.num_threads", threads};
   if (!o.refine_focal) mapper.insert(mapper.end(), {"--Mapper.ba_refine_focal_length", "0"});
   report["refine_focal"] = o.refine_focal;
   stage("mapper", mapper);
@@ -481,7 +489,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
            "--output_path", mask_out, "--max_image_size", size});
     io::makeDirectory(o.out + "/masks");
     for (const auto& im : model.images) {
-      binariseUndistortedMask(mask_out + "/images/" + im.name, o.out + "/masks/" + im.name + ".png");
+      binariseUndistortedMask(mask_out + "/images/" + im.name,
+                              o.out + "/masks/" + im.name + ".png");
     }
     fs::remove_all(mask_out);
   }
@@ -537,8 +546,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
   std::optional<io::Georeference> georeference;
   if (with_gps >= 3) {
     try {
-      const geo::GpsFit fit =
-          geo::fitGpsGeoreference(gps_photos, points, origin, {o.gps_accuracy});
+      const geo::GpsFit fit = geo::fitGpsGeoreference(gps_photos, points, origin, {o.gps_accuracy});
       nlohmann::json residuals = nlohmann::json::array();
       for (const auto& r : fit.residuals) {
         residuals.push_back({{"photo", r.photo},
@@ -566,11 +574,11 @@ SfmSummary sfmRun(const SfmOptions& o) {
     try {
       gcp_fit = geo::fitGcpGeoreference(io::readColmapModel(best), *gcps, origin);
     } catch (const Error& e) {
-      say(std::string("WARNING: the ground control points could not be used: ") + e.what() +
-          "\n");
+      say(std::string("WARNING: the ground control points could not be used: ") + e.what() + "\n");
       if (georeference) {
         georeference->doubts.push_back(std::string("the ground control points could not be "
-                                                   "used (") + e.what() + ")");
+                                                   "used (") +
+                                       e.what() + ")");
       }
     }
   }
@@ -601,8 +609,9 @@ SfmSummary sfmRun(const SfmOptions& o) {
   nlohmann::json georef_json = nullptr;
   if (georeference) {
     transformModel(model, georeference->sfm_to_local);
-    io::writeFileAtomically(o.out + "/georeference.json",
-                            [&](std::ostream& out) { out << io::georeferenceToJson(*georeference); });
+    io::writeFileAtomically(o.out + "/georeference.json", [&](std::ostream& out) {
+      out << io::georeferenceToJson(*georeference);
+    });
     georef_json = nlohmann::json::parse(io::georeferenceToJson(*georeference));
     summary.georeferenced = true;
     summary.georeference_doubtful = !georeference->trustworthy();
@@ -610,8 +619,9 @@ SfmSummary sfmRun(const SfmOptions& o) {
       std::string text = "WARNING: the georeference is doubtful:";
       for (const auto& d : georeference->doubts) text += " " + d + ";";
       if (!georeference->consensus) text += " the GPS does not agree with the reconstruction;";
-      say(text + " positions, heights and areas in the map products (ortho, DSM, LAS) can be "
-                 "wrong. Check sfm_report.json; ground control points (gcp_list.txt) fix it.\n");
+      say(text +
+          " positions, heights and areas in the map products (ortho, DSM, LAS) can be "
+          "wrong. Check sfm_report.json; ground control points (gcp_list.txt) fix it.\n");
     }
   }
   io::makeDirectory(o.out + "/sparse");

@@ -371,9 +371,7 @@ void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthSc
 
 }  // namespace
 
-std::string captureName(Capture capture) {
-  return capture == Capture::kGrid ? "grid" : "orbit";
-}
+std::string captureName(Capture capture) { return capture == Capture::kGrid ? "grid" : "orbit"; }
 
 Capture captureFromName(const std::string& name) {
   if (name == "orbit") return Capture::kOrbit;
