@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
@@ -129,6 +130,41 @@ TEST_F(SceneImport, MasksKeepPixelsOutAndTakeTheirLabels) {
   expectError(dir, "masks/view_001.png", "64x48");
 }
 #endif
+
+// An optional file that is there but cannot be read (a dangling or looping symbolic link) is an
+// error naming it, not a scene without it; a looping link in an annotation folder likewise.
+TEST_F(SceneImport, LinksThatCannotBeFollowedAreErrorsNotAbsentFiles) {
+  {
+    const std::string dir = test::copyTree(kTinyScene, tmp_.file("dangling"));
+    std::filesystem::remove(dir + "/classes.json");
+    std::filesystem::create_symlink(dir + "/nowhere.json", dir + "/classes.json");
+    expectError(dir, "classes.json", "symbolic link");
+  }
+  {
+    const std::string dir = test::copyTree(kTinyScene, tmp_.file("looping"));
+    std::filesystem::create_symlink("georeference.json", dir + "/georeference.json");  // a loop
+    expectError(dir, "georeference.json", "symbolic link");
+  }
+  {
+    const std::string dir = test::copyTree(kTinyScene, tmp_.file("annotated"));
+    io::makeDirectory(dir + "/annotations");
+    std::filesystem::create_symlink("loop.json", dir + "/annotations/loop.json");
+    io::ImportOptions options;
+    options.annotations = dir + "/annotations";
+    expectError(dir, "loop.json", "symbolic link", options);
+  }
+  // io::filesIn lists only the wanted names and skips links among the others.
+  const std::string dir = tmp_.file("listing");
+  io::makeDirectory(dir);
+  test::writeFile(dir + "/b.jpg", "x");
+  test::writeFile(dir + "/a.jpg", "x");
+  std::filesystem::create_symlink(dir + "/missing", dir + "/notes.txt");
+  const auto jpgs = io::filesIn(dir, [](const std::string& n) { return io::endsWith(n, ".jpg"); });
+  EXPECT_EQ(jpgs, (std::vector<std::string>{"a.jpg", "b.jpg"}));
+  EXPECT_FALSE(io::optionalFileExists(dir + "/none.json"));
+  EXPECT_TRUE(io::optionalFileExists(dir + "/a.jpg"));
+  EXPECT_THROW(io::optionalFileExists(dir + "/notes.txt"), Error);
+}
 
 TEST_F(SceneImport, MapsColourLabelMapsThroughThePalette) {
   const std::string dir = copy();

@@ -269,6 +269,13 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
     }
   }
   test::writeFile(photos + "/gcp_list.txt", gcp_list.str());
+  // A mask on two photos (OpenDroneMap's <stem>_mask name and COLMAP's <photo>.png): a block the
+  // scene must leave out of training, undistorted as the photos are.
+  io::makeDirectory(photos + "/masks");
+  cv::Mat mask(options.height, options.width, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(100, 80, 60, 40)).setTo(0);
+  ASSERT_TRUE(cv::imwrite(photos + "/masks/view_005_mask.png", mask));
+  ASSERT_TRUE(cv::imwrite(photos + "/masks/view_020.jpg.png", mask));
 
   pipeline::SfmOptions o;
   o.photos = photos;
@@ -358,6 +365,16 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
   EXPECT_LT(final_frame.check_rmse_horizontal, 2 * mark);
   EXPECT_LT(final_frame.check_rmse_vertical, 2 * mark * height_to_base);
   ASSERT_EQ(report.at("gcp_residuals").size(), 12u);
+  // The masks, undistorted into the scene: the block left out (near where it was: the camera's
+  // distortion moves pixels by a few), the rest kept; photos without one get none.
+  for (const std::string name : {"view_005.jpg", "view_020.jpg"}) {
+    const cv::Mat m = cv::imread(o.out + "/masks/" + name + ".png", cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(m.empty()) << name;
+    EXPECT_EQ(m.at<std::uint8_t>(100, 130), 0) << name;
+    EXPECT_EQ(m.at<std::uint8_t>(300, 500), 255) << name;
+    EXPECT_NEAR(cv::countNonZero(m == 0), 60 * 40, 0.3 * 60 * 40) << name;
+  }
+  EXPECT_FALSE(io::pathExists(o.out + "/masks/view_000.jpg.png"));
 }
 
 TEST(Sfm, BadInputsAreOneLineErrors) {

@@ -110,9 +110,9 @@ LasExportOptions lasOptionsBeside(const std::string& model_path,
   }
   LasExportOptions o;
   o.classification_map = classification_map;
-  if (io::isRegularFile(dir + "/classes.json"))
+  if (io::optionalFileExists(dir + "/classes.json"))
     o.classes = io::readClassesJson(dir + "/classes.json");
-  if (io::isRegularFile(dir + "/georeference.json")) {
+  if (io::optionalFileExists(dir + "/georeference.json")) {
     o.georeference = io::georeferenceFromJson(io::readWholeFile(dir + "/georeference.json"),
                                               dir + "/georeference.json");
   }

@@ -251,13 +251,9 @@ std::vector<std::uint8_t> decodeCocoRle(const std::vector<std::uint32_t>& counts
 std::vector<AnnotatedImage> readAnnotations(const std::string& path, int* skipped) {
   if (skipped) *skipped = 0;
   if (isDirectory(path)) {
-    std::vector<std::string> files;
-    for (const auto& e : std::filesystem::directory_iterator(path)) {
-      if (e.is_regular_file() && lowerExtension(e.path().string()) == ".json") {
-        files.push_back(e.path().string());
-      }
-    }
-    std::sort(files.begin(), files.end());
+    std::vector<std::string> files =
+        filesIn(path, [](const std::string& name) { return lowerExtension(name) == ".json"; });
+    for (auto& f : files) f = path + "/" + f;
     if (files.empty()) throw Error(path, "annotations", "LabelMe .json files", "none");
     std::vector<AnnotatedImage> images;
     for (const auto& f : files) {

@@ -242,7 +242,7 @@ std::string describeFile(const std::string& path) {
     if (pathExists(path + "/run.json") && pathExists(path + "/model.ply")) {
       // A run directory: its model, and the frame it is in.
       out << path << ": run directory (model.ply below)\n";
-      if (pathExists(path + "/georeference.json")) {
+      if (optionalFileExists(path + "/georeference.json")) {
         describeGeoreference(out, georeferenceFromJson(readWholeFile(path + "/georeference.json"),
                                                        path + "/georeference.json"));
       } else {

@@ -172,7 +172,7 @@ std::string userMaskPath(const std::string& dir, const PosedImages& posed,
   if (given != posed.mask_paths.end()) return given->second;
   for (const std::string& candidate :
        {dir + "/masks/" + name + ".png", dir + "/masks/" + stem(name) + ".png"}) {
-    if (pathExists(candidate)) return candidate;
+    if (optionalFileExists(candidate)) return candidate;
   }
   return "";
 }
@@ -305,7 +305,9 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   Scene scene;
   scene.source = dir;
   // Without classes.json the scene trains as plain 3DGS (no semantic head).
-  if (pathExists(dir + "/classes.json")) scene.classes = readClassesJson(dir + "/classes.json");
+  if (optionalFileExists(dir + "/classes.json")) {
+    scene.classes = readClassesJson(dir + "/classes.json");
+  }
   const PosedImages posed = readPosedImages(dir, [](const std::string& image_path) {
     requireRegularFile(image_path);
     const cv::Mat image = cv::imread(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
@@ -317,7 +319,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   for (const auto& c : model.cameras) cameras[c.id] = &c;
 
   SplitInfo split;
-  const bool have_split = pathExists(dir + "/split.json");
+  const bool have_split = optionalFileExists(dir + "/split.json");
   if (have_split) {
     split = readSplitJson(dir + "/split.json");
   } else {
@@ -402,12 +404,12 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     const std::string label_path = dir + "/labels/" + stem(im->name) + ".png";
     const auto annotation = annotated.find(im->name);
     if (annotation != annotated.end()) {
-      if (pathExists(label_path)) {
+      if (optionalFileExists(label_path)) {
         throw Error(options.annotations, "image " + annotation->second.file_name,
                     "one source of labels per view", "an annotation and " + label_path);
       }
       labels = rasterise(annotation->second, bgr.size(), class_ids, options.annotations);
-    } else if (pathExists(label_path)) {
+    } else if (optionalFileExists(label_path)) {
       labels = readLabelMap(label_path, scene.classes);
       if (labels.size() != bgr.size()) {
         throw Error(label_path, "size",
@@ -484,7 +486,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     scene.views.push_back(std::move(view));
   }
 
-  if (pathExists(dir + "/georeference.json")) {
+  if (optionalFileExists(dir + "/georeference.json")) {
     scene.georeference =
         georeferenceFromJson(readWholeFile(dir + "/georeference.json"), dir + "/georeference.json");
   }

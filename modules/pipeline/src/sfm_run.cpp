@@ -180,7 +180,7 @@ std::map<std::string, std::string> photoMasks(const std::string& photos_dir,
     for (const std::string& candidate :
          {dir + "/" + p + ".png", dir + "/" + stem + ".png", dir + "/" + stem + "_mask" + ext,
           dir + "/" + stem + "_mask.png"}) {
-      if (io::pathExists(candidate)) {
+      if (io::optionalFileExists(candidate)) {
         masks[p] = candidate;
         break;
       }
@@ -299,13 +299,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
     throw Error(o.photos, "photos", "a folder of photos",
                 io::pathExists(o.photos) ? "not a folder" : "missing");
   }
-  std::vector<std::string> photos;
-  for (const auto& e : fs::directory_iterator(o.photos)) {
-    if (e.is_regular_file() && isPhoto(e.path().filename().string())) {
-      photos.push_back(e.path().filename().string());
-    }
-  }
-  std::sort(photos.begin(), photos.end());
+  const std::vector<std::string> photos = io::filesIn(o.photos, isPhoto);
   if (photos.size() < 2) {
     throw Error(o.photos, "photos", "at least 2 photos (.jpg, .jpeg, .png, .tif)",
                 std::to_string(photos.size()));
@@ -489,6 +483,7 @@ SfmSummary sfmRun(const SfmOptions& o) {
            "--output_path", mask_out, "--max_image_size", size});
     io::makeDirectory(o.out + "/masks");
     for (const auto& im : model.images) {
+      if (!masks.count(im.name)) continue;  // a photo without a mask keeps every pixel
       binariseUndistortedMask(mask_out + "/images/" + im.name,
                               o.out + "/masks/" + im.name + ".png");
     }
