@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -226,6 +227,114 @@ void binariseUndistortedMask(const std::string& in, const std::string& out) {
   throw Error(in, "masks", "a build with OpenCV to read photo masks", "a build without it");
 }
 #endif
+
+// The georeference of the undistorted `model` (the mapper's own model, `distorted_model`, shares
+// its frame): from ground control points when given, else from the photos' GPS; what each fit
+// found goes into the report and onto the terminal.
+std::optional<io::Georeference> georeferenceModel(
+    const io::ColmapModel& model, const std::string& distorted_model,
+    const std::map<std::string, io::GeoPosition>& gps, const std::optional<geo::GcpList>& gcps,
+    double gps_accuracy, nlohmann::json& report,
+    const std::function<void(const std::string&)>& say) {
+  std::vector<geo::GpsPhoto> gps_photos;
+  int with_gps = 0;
+  io::GeoPosition origin;
+  for (const auto& im : model.images) {
+    geo::GpsPhoto photo;
+    photo.name = im.name;
+    const Eigen::Matrix3d R = rotationOf(im.qvec);
+    photo.centre = toArray(-R.transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]));
+    photo.viewing = toArray(R.transpose() * Eigen::Vector3d::UnitZ());
+    const auto it = gps.find(im.name);
+    if (it != gps.end()) {
+      photo.stated_accuracy = it->second.horizontal_accuracy;
+      origin.latitude += it->second.latitude, origin.longitude += it->second.longitude;
+      origin.altitude += it->second.altitude, ++with_gps;
+    }
+    gps_photos.push_back(photo);
+  }
+  if (with_gps > 0) {
+    origin.latitude /= with_gps, origin.longitude /= with_gps, origin.altitude /= with_gps;
+  } else if (gcps) {
+    for (const auto& p : gcps->points) {
+      origin.latitude += p.wgs84.latitude / gcps->points.size();
+      origin.longitude += p.wgs84.longitude / gcps->points.size();
+      origin.altitude += p.wgs84.altitude / gcps->points.size();
+    }
+  }
+  origin.horizontal_accuracy = 0;
+  for (auto& photo : gps_photos) {
+    const auto it = gps.find(photo.name);
+    if (it != gps.end()) photo.gps = io::toEnu(it->second, origin);
+  }
+  std::vector<std::array<double, 3>> points;
+  for (const auto& p : model.points) points.push_back(p.xyz);
+
+  std::optional<io::Georeference> georeference;
+  if (with_gps >= 3) {
+    try {
+      const geo::GpsFit fit = geo::fitGpsGeoreference(gps_photos, points, origin, {gps_accuracy});
+      nlohmann::json residuals = nlohmann::json::array();
+      for (const auto& r : fit.residuals) {
+        residuals.push_back({{"photo", r.photo},
+                             {"metres", std::hypot(r.horizontal, r.vertical)},
+                             {"horizontal", r.horizontal},
+                             {"vertical", r.vertical},
+                             {"inlier", r.inlier}});
+      }
+      report["gps_residuals"] = residuals;
+      report["gps_georeference"] = nlohmann::json::parse(io::georeferenceToJson(fit.georeference));
+      georeference = fit.georeference;
+      say(describeGpsFit(fit));
+    } catch (const Error& e) {
+      say(std::string("sfm: no georeference from GPS: ") + e.what() + "\n");
+    }
+  } else if (!gcps) {
+    say("sfm: no georeference (" + std::to_string(with_gps) +
+        " registered photos with GPS; 3 needed): the model keeps COLMAP's frame\n");
+  }
+  std::optional<geo::GcpFit> gcp_fit;
+  if (gcps) {
+    // The photos' pixel marks are on the original photos: triangulate in COLMAP's own model
+    // (distorted cameras, the same frame as the undistorted one). A reconstruction that cannot
+    // place them keeps the GPS frame, said loudly, rather than losing the run.
+    try {
+      gcp_fit = geo::fitGcpGeoreference(io::readColmapModel(distorted_model), *gcps, origin);
+    } catch (const Error& e) {
+      say(std::string("WARNING: the ground control points could not be used: ") + e.what() + "\n");
+      if (georeference) {
+        georeference->doubts.push_back(std::string("the ground control points could not be "
+                                                   "used (") +
+                                       e.what() + ")");
+      }
+    }
+  }
+  if (gcp_fit) {
+    const geo::GcpFit& fit = *gcp_fit;
+    nlohmann::json residuals = nlohmann::json::array();
+    for (const auto& r : fit.residuals) {
+      residuals.push_back({{"name", r.name},
+                           {"check", r.check},
+                           {"horizontal", r.horizontal},
+                           {"vertical", r.vertical},
+                           {"reprojection_px", r.reprojection_px},
+                           {"marks", r.marks}});
+    }
+    report["gcp_residuals"] = residuals;
+    report["gcp_skipped"] = fit.skipped;
+    report["gcp_file"] = gcps->path;
+    io::Georeference g = fit.georeference;
+    if (georeference) {
+      // What the GPS fit said of the scene's own up stays as a check of the GCP frame.
+      g.photos_with_gps = georeference->photos_with_gps;
+      g.gps_accuracy_metres = georeference->gps_accuracy_metres;
+      g.gps_noise_metres = georeference->gps_noise_metres;
+    }
+    georeference = g;
+    say(describeGcpFit(fit));
+  }
+  return georeference;
+}
 
 // The model moved by x' = s R x + t: points move, cameras keep what they see.
 void transformModel(io::ColmapModel& model, const io::Similarity& sim) {
@@ -503,104 +612,8 @@ SfmSummary sfmRun(const SfmOptions& o) {
   for (const auto& p : model.points) error_sum += p.error;
   summary.mean_reprojection_error = model.points.empty() ? 0 : error_sum / model.points.size();
 
-  // The georeference: from ground control points when given, else from the photos' GPS.
-  std::vector<geo::GpsPhoto> gps_photos;
-  int with_gps = 0;
-  io::GeoPosition origin;
-  for (const auto& im : model.images) {
-    geo::GpsPhoto photo;
-    photo.name = im.name;
-    const Eigen::Matrix3d R = rotationOf(im.qvec);
-    photo.centre = toArray(-R.transpose() * Eigen::Vector3d(im.tvec[0], im.tvec[1], im.tvec[2]));
-    photo.viewing = toArray(R.transpose() * Eigen::Vector3d::UnitZ());
-    const auto it = gps.find(im.name);
-    if (it != gps.end()) {
-      photo.stated_accuracy = it->second.horizontal_accuracy;
-      origin.latitude += it->second.latitude, origin.longitude += it->second.longitude;
-      origin.altitude += it->second.altitude, ++with_gps;
-    }
-    gps_photos.push_back(photo);
-  }
-  if (with_gps > 0) {
-    origin.latitude /= with_gps, origin.longitude /= with_gps, origin.altitude /= with_gps;
-  } else if (gcps) {
-    for (const auto& p : gcps->points) {
-      origin.latitude += p.wgs84.latitude / gcps->points.size();
-      origin.longitude += p.wgs84.longitude / gcps->points.size();
-      origin.altitude += p.wgs84.altitude / gcps->points.size();
-    }
-  }
-  origin.horizontal_accuracy = 0;
-  for (auto& photo : gps_photos) {
-    const auto it = gps.find(photo.name);
-    if (it != gps.end()) photo.gps = io::toEnu(it->second, origin);
-  }
-  std::vector<std::array<double, 3>> points;
-  for (const auto& p : model.points) points.push_back(p.xyz);
-
-  std::optional<io::Georeference> georeference;
-  if (with_gps >= 3) {
-    try {
-      const geo::GpsFit fit = geo::fitGpsGeoreference(gps_photos, points, origin, {o.gps_accuracy});
-      nlohmann::json residuals = nlohmann::json::array();
-      for (const auto& r : fit.residuals) {
-        residuals.push_back({{"photo", r.photo},
-                             {"metres", std::hypot(r.horizontal, r.vertical)},
-                             {"horizontal", r.horizontal},
-                             {"vertical", r.vertical},
-                             {"inlier", r.inlier}});
-      }
-      report["gps_residuals"] = residuals;
-      report["gps_georeference"] = nlohmann::json::parse(io::georeferenceToJson(fit.georeference));
-      georeference = fit.georeference;
-      say(describeGpsFit(fit));
-    } catch (const Error& e) {
-      say(std::string("sfm: no georeference from GPS: ") + e.what() + "\n");
-    }
-  } else if (!gcps) {
-    say("sfm: no georeference (" + std::to_string(with_gps) +
-        " registered photos with GPS; 3 needed): the model keeps COLMAP's frame\n");
-  }
-  std::optional<geo::GcpFit> gcp_fit;
-  if (gcps) {
-    // The photos' pixel marks are on the original photos: triangulate in COLMAP's own model
-    // (distorted cameras, the same frame as the undistorted one). A reconstruction that cannot
-    // place them keeps the GPS frame, said loudly, rather than losing the run.
-    try {
-      gcp_fit = geo::fitGcpGeoreference(io::readColmapModel(best), *gcps, origin);
-    } catch (const Error& e) {
-      say(std::string("WARNING: the ground control points could not be used: ") + e.what() + "\n");
-      if (georeference) {
-        georeference->doubts.push_back(std::string("the ground control points could not be "
-                                                   "used (") +
-                                       e.what() + ")");
-      }
-    }
-  }
-  if (gcp_fit) {
-    const geo::GcpFit& fit = *gcp_fit;
-    nlohmann::json residuals = nlohmann::json::array();
-    for (const auto& r : fit.residuals) {
-      residuals.push_back({{"name", r.name},
-                           {"check", r.check},
-                           {"horizontal", r.horizontal},
-                           {"vertical", r.vertical},
-                           {"reprojection_px", r.reprojection_px},
-                           {"marks", r.marks}});
-    }
-    report["gcp_residuals"] = residuals;
-    report["gcp_skipped"] = fit.skipped;
-    report["gcp_file"] = gcps->path;
-    io::Georeference g = fit.georeference;
-    if (georeference) {
-      // What the GPS fit said of the scene's own up stays as a check of the GCP frame.
-      g.photos_with_gps = georeference->photos_with_gps;
-      g.gps_accuracy_metres = georeference->gps_accuracy_metres;
-      g.gps_noise_metres = georeference->gps_noise_metres;
-    }
-    georeference = g;
-    say(describeGcpFit(fit));
-  }
+  std::optional<io::Georeference> georeference =
+      georeferenceModel(model, best, gps, gcps, o.gps_accuracy, report, say);
   nlohmann::json georef_json = nullptr;
   if (georeference) {
     transformModel(model, georeference->sfm_to_local);
