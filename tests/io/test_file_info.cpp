@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/file_info.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/georeference.h"
 #include "sadsplat/io/splat_formats.h"
 #include "test_support/test_support.h"
 
@@ -53,6 +55,41 @@ TEST(FileInfo, SpzShowsVersionDegreeAndFlags) {
   EXPECT_NE(text.find("SH degree: 2"), std::string::npos) << text;
   EXPECT_NE(text.find("antialiased: yes"), std::string::npos) << text;
   EXPECT_NE(text.find("gaussians: 5"), std::string::npos) << text;
+}
+
+// A run's frame as info states it: fitted to control points with the check points' RMSE, or a
+// doubtful GPS frame said loudly, its file-borne text escaped.
+TEST(FileInfo, TheGeoreferenceSaysItsSourceChecksAndDoubts) {
+  test::TempDir dir;
+  const std::string run = dir.file("run");
+  io::makeDirectory(run);
+  test::writeFile(run + "/run.json", "{}");
+  std::filesystem::copy_file(
+      std::string(SADSPLAT_TEST_DATA_DIR) + "/interop/splat_transform_compressed_decoded.ply",
+      run + "/model.ply");
+  io::Georeference g;
+  g.origin = {47.3769, 8.5417, 420};
+  g.epsg_utm = 32632;
+  g.up_source = "ground control points";
+  g.control_points = 10;
+  g.check_points = 2;
+  g.check_rmse_horizontal = 0.109;
+  g.check_rmse_vertical = 0.659;
+  test::writeFile(run + "/georeference.json", io::georeferenceToJson(g));
+  std::string text = io::describeFile(run);
+  EXPECT_NE(text.find("fitted to 10 ground control points"), std::string::npos) << text;
+  EXPECT_NE(text.find("2 check points: RMSE horizontal 0.109 m, vertical 0.659 m"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("DOUBTFUL"), std::string::npos) << text;
+  g.control_points = g.check_points = 0;
+  g.up_source = "nadir views";
+  g.doubts = {"only 3 of 40 photos' GPS agree \x1b[2J"};
+  test::writeFile(run + "/georeference.json", io::georeferenceToJson(g));
+  text = io::describeFile(run);
+  EXPECT_NE(text.find("DOUBTFUL: only 3 of 40"), std::string::npos) << text;
+  EXPECT_EQ(text.find('\x1b'), std::string::npos) << text;
+  EXPECT_NE(text.find("\\x1B[2J"), std::string::npos) << text;
 }
 
 // The decoded reference PLY of splat-transform keeps 255 alphas as +inf: info counts the clamps.

@@ -45,10 +45,14 @@ void describeGeoreference(std::ostream& out, const Georeference& g) {
   std::ostringstream geo;
   geo << std::fixed << std::setprecision(7) << "georeference: origin " << g.origin.latitude << ", "
       << g.origin.longitude << std::setprecision(2) << ", " << g.origin.altitude
-      << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; "
-      << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit"
-      << (g.consensus ? "" : " (no consensus: the fit of all; positions can be off by the RMS)")
-      << ", RMS " << g.rms_metres << " m\n";
+      << " m (WGS84); frame east-north-up metres, z up; UTM EPSG:" << g.epsg_utm << "; ";
+  if (g.control_points > 0) {
+    geo << "fitted to " << g.control_points << " ground control points";
+  } else {
+    geo << g.inliers << " of " << g.photos_with_gps << " photos' GPS within the fit"
+        << (g.consensus ? "" : " (no consensus: the fit of all; positions can be off by the RMS)");
+  }
+  geo << ", RMS " << g.rms_metres << " m\n";
   if (!g.up_source.empty()) {
     geo << "georeference: up from " << printable(g.up_source) << "; horizontal RMS "
         << g.horizontal_rms_metres << " m, vertical " << g.vertical_rms_metres << " m";
