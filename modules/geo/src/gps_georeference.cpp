@@ -55,7 +55,7 @@ bool fitPlaneSimilarity(const std::vector<Complex>& w, const std::vector<Complex
   return std::abs(*a) > 0 && std::isfinite(std::abs(*a));
 }
 
-std::string degreesText(double d) {
+std::string twoDecimals(double d) {
   std::ostringstream s;
   s.precision(2);
   s << std::fixed << d;
@@ -224,7 +224,7 @@ GpsFit fitGpsGeoreference(const std::vector<GpsPhoto>& photos,
     std::iota(all.begin(), all.end(), 0);
     if (best.size() < 3) {
       doubts.push_back("no 3 photos' GPS agree with the reconstruction within " +
-                       degreesText(first_threshold) + " m: the fit of all");
+                       twoDecimals(first_threshold) + " m: the fit of all");
       best = all;
     }
     if (!fitPlaneSimilarity(w, t, best, &a, &b)) {
@@ -273,11 +273,11 @@ GpsFit fitGpsGeoreference(const std::vector<GpsPhoto>& photos,
     g.scale_uncertainty = scale_uncertainty;
     if (scale_uncertainty > 0.02) {
       doubts.push_back("the flight is small against the GPS noise: its scale is uncertain by " +
-                       degreesText(100 * scale_uncertainty) + " %");
+                       twoDecimals(100 * scale_uncertainty) + " %");
     }
     if (accuracy_stated && noise > 2 * accuracy) {
-      doubts.push_back("the GPS is noisier (" + degreesText(noise) + " m) than its stated " +
-                       degreesText(accuracy) + " m");
+      doubts.push_back("the GPS is noisier (" + twoDecimals(noise) + " m) than its stated " +
+                       twoDecimals(accuracy) + " m");
     }
   } else {
     g.up_source = "gps 3D fit";
@@ -324,7 +324,7 @@ GpsFit fitGpsGeoreference(const std::vector<GpsPhoto>& photos,
   if (ground.found) g.ground_tilt_deg = angleDegrees(arr(rotation * vec(ground.up)), z);
   if (views.found && ground.found && angleDegrees(views.up, ground.up) > 5) {
     doubts.push_back("the nadir views and the ground plane disagree by " +
-                     degreesText(angleDegrees(views.up, ground.up)) +
+                     twoDecimals(angleDegrees(views.up, ground.up)) +
                      " degrees (sloping ground, or a camera that was not level)");
   }
   return fit;
