@@ -33,11 +33,20 @@ inline void writeInput(const std::string& path, const std::uint8_t* data, std::s
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
+// The message of the last sadsplat::Error a target's reader gave ("" after a success): the
+// corpus test checks the regression inputs' messages against fuzz/regressions/expected.tsv.
+inline std::string& lastError() {
+  static std::string message;
+  return message;
+}
+
 // Runs `read`; a sadsplat::Error is fine, any other exception aborts with its message.
 inline void expectOnlySadsplatErrors(const std::function<void()>& read) {
+  lastError().clear();
   try {
     read();
-  } catch (const Error&) {
+  } catch (const Error& e) {
+    lastError() = e.what();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "internal error (not a sadsplat::Error): %s\n", e.what());
     std::abort();

@@ -12,7 +12,10 @@
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/colmap.h"
+#include "sadsplat/io/file_info.h"
 #include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/georeference.h"
+#include "sadsplat/io/las.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/scene.h"
 #include "sadsplat/io/scene_cache.h"
@@ -143,7 +146,71 @@ inline void fuzz_checkpoint(const std::uint8_t* data, std::size_t size) {
   fuzz::expectOnlySadsplatErrors([&] { gaussians::readTensorArchive(path); });
 }
 
+// Fuzz target: a LAS file, as read by `convert` / `info` (readLas, and the streaming summary).
+inline void fuzz_las(const std::uint8_t* data, std::size_t size) {
+  const std::string path = fuzz::inputFile("input.las");
+  fuzz::writeInput(path, data, size);
+  fuzz::expectOnlySadsplatErrors([&] { io::readLas(path); });
+  fuzz::expectOnlySadsplatErrors([&] { io::describeFile(path); });
+}
+
+// Fuzz target: georeference.json (a scene's or a run's frame on the Earth).
+inline void fuzz_georeference(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  fuzz::expectOnlySadsplatErrors([&] { io::georeferenceFromJson(text, "georeference.json"); });
+}
+
 #if SADSPLAT_HAVE_OPENCV
+// The fixture scene (data/tiny_scene) copied once into `name`, for the targets that replace one
+// of its files and import it.
+inline std::string fixtureSceneCopy(const std::string& name) {
+  const std::string dir = fuzz::inputFile(name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::copy(std::string(SADSPLAT_SOURCE_DIR) + "/data/tiny_scene", dir,
+                        std::filesystem::copy_options::recursive);
+  return dir;
+}
+
+// Fuzz target: transforms.json (nerfstudio / instant-ngp poses) in place of the fixture scene's
+// COLMAP model, imported as `sadsplat import` does (so the cameras it gives are checked too).
+inline void fuzz_transforms_json(const std::uint8_t* data, std::size_t size) {
+  static const std::string scene = [] {
+    const std::string dir = fixtureSceneCopy("transforms_scene");
+    std::filesystem::remove_all(dir + "/sparse");
+    std::filesystem::remove(dir + "/split.json");
+    return dir;
+  }();
+  fuzz::writeInput(scene + "/transforms.json", data, size);
+  io::ImportOptions options;
+  options.test_every = 0;
+  fuzz::expectOnlySadsplatErrors([&] { io::importScene(scene, options); });
+}
+
+// Fuzz target: LabelMe / COCO annotations (`import --annotations FILE`) on the fixture scene
+// without its label maps (image names view_000.png .. view_007.png, 64x48).
+inline void fuzz_annotations(const std::uint8_t* data, std::size_t size) {
+  static const std::string scene = [] {
+    const std::string dir = fixtureSceneCopy("annotated_scene");
+    std::filesystem::remove_all(dir + "/labels");
+    std::filesystem::remove(dir + "/split.json");
+    return dir;
+  }();
+  const std::string path = fuzz::inputFile("annotations.json");
+  fuzz::writeInput(path, data, size);
+  io::ImportOptions options;
+  options.test_every = 0;
+  options.annotations = path;
+  fuzz::expectOnlySadsplatErrors([&] { io::importScene(scene, options); });
+}
+
+// Fuzz target: a photo of the fixture scene (any format OpenCV reads, under the name
+// view_000.png), imported: the header's size is checked before anything is decoded.
+inline void fuzz_photo(const std::uint8_t* data, std::size_t size) {
+  static const std::string scene = fixtureSceneCopy("photo_scene");
+  fuzz::writeInput(scene + "/images/view_000.png", data, size);
+  fuzz::expectOnlySadsplatErrors([&] { io::importScene(scene, io::ImportOptions()); });
+}
+
 // A valid PNG built from fuzz bytes, so that the label checks (size, channels, bit depth, class
 // ids and colours) see what a mutated PNG file rarely gets past (libpng's CRC and zlib checks):
 // byte 0 picks the channels (1, 3, 4) and the depth (8 or 16 bit); bit 0 of byte 1 says whether

@@ -10,6 +10,8 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/image_file.h"
+#include "json_field.h"
 
 namespace sadsplat {
 namespace io {
@@ -24,73 +26,47 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? p : p.substr(slash + 1);
 }
 
-json parseFile(const std::string& path) {
-  try {
-    return json::parse(readWholeFile(path));
-  } catch (const json::exception& e) {
-    throw Error(path, "JSON syntax", "valid JSON", e.what());
+// An annotated image's size: whole pixels, within the image budget (a COCO RLE mask is decoded at
+// this size).
+void checkImageSize(const JsonField& entry, int width, int height) {
+  if (static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > kMaxImagePixels) {
+    throw Error(entry.file(), entry.field() + " size",
+                "an image of at most " + std::to_string(kMaxImagePixels) + " pixels",
+                std::to_string(width) + "x" + std::to_string(height));
   }
 }
 
-double number(const json& v, const std::string& path, const std::string& field) {
-  if (!v.is_number()) throw Error(path, field, "a number", v.dump().substr(0, 40));
-  const double x = v.get<double>();
-  if (!std::isfinite(x)) throw Error(path, field, "a finite number", v.dump());
-  return x;
+// Coordinates beyond this many pixels are no annotation of a photo (and would wrap an int).
+constexpr double kMaxCoordinate = 1e7;
+
+std::array<double, 2> point(const JsonField& x, const JsonField& y) {
+  return {x.number(-kMaxCoordinate, kMaxCoordinate), y.number(-kMaxCoordinate, kMaxCoordinate)};
 }
 
-int positiveInt(const json& obj, const char* key, const std::string& path,
-                const std::string& field) {
-  if (!obj.contains(key)) throw Error(path, field, "a positive integer", "missing");
-  const double v = number(obj.at(key), path, field);
-  if (!(v >= 1 && v <= 1e6) || v != std::floor(v)) {
-    throw Error(path, field, "a positive integer up to 1000000", obj.at(key).dump());
-  }
-  return static_cast<int>(v);
-}
-
-std::string text(const json& obj, const char* key, const std::string& path,
-                 const std::string& field) {
-  if (!obj.contains(key) || !obj.at(key).is_string()) {
-    throw Error(path, field, "a string", obj.contains(key) ? obj.at(key).dump().substr(0, 40) : "missing");
-  }
-  return obj.at(key).get<std::string>();
-}
-
-AnnotatedImage readLabelMe(const json& j, const std::string& path, int* skipped) {
+AnnotatedImage readLabelMe(const JsonField& j, int* skipped) {
   AnnotatedImage image;
-  image.file_name = baseName(text(j, "imagePath", path, "imagePath"));
-  image.width = positiveInt(j, "imageWidth", path, "imageWidth");
-  image.height = positiveInt(j, "imageHeight", path, "imageHeight");
-  if (!j.at("shapes").is_array()) throw Error(path, "shapes", "an array", j.at("shapes").type_name());
-  int index = 0;
-  for (const json& s : j.at("shapes")) {
-    const std::string field = "shapes[" + std::to_string(index++) + "]";
-    if (!s.is_object()) throw Error(path, field, "an object", s.type_name());
-    const std::string type = s.value("shape_type", std::string("polygon"));
+  image.file_name = baseName(j["imagePath"].text());
+  image.width = static_cast<int>(j["imageWidth"].integer(1, 1000000));
+  image.height = static_cast<int>(j["imageHeight"].integer(1, 1000000));
+  checkImageSize(j, image.width, image.height);
+  for (const JsonField& s : j["shapes"].elements()) {
+    if (!s.isObject()) s.fail("an object (a LabelMe shape)");
+    // LabelMe writes "polygon" when shape_type is absent or null.
+    const JsonField type_field = s.optional("shape_type");
+    const std::string type = type_field.isNull() ? "polygon" : type_field.text();
     AnnotatedShape shape;
-    shape.label = text(s, "label", path, field + ".label");
-    if (!s.contains("points") || !s.at("points").is_array()) {
-      throw Error(path, field + ".points", "an array of [x, y]", "missing");
-    }
+    shape.label = s["label"].text();
     std::vector<std::array<double, 2>> ring;
-    int p = 0;
-    for (const json& xy : s.at("points")) {
-      const std::string pf = field + ".points[" + std::to_string(p++) + "]";
-      if (!xy.is_array() || xy.size() != 2) throw Error(path, pf, "[x, y]", xy.dump().substr(0, 40));
-      ring.push_back({number(xy[0], path, pf), number(xy[1], path, pf)});
+    for (const JsonField& xy : s["points"].elements()) {
+      if (xy.size() != 2) xy.fail("[x, y]");
+      ring.push_back(point(xy.at(0), xy.at(1)));
     }
     if (type == "rectangle") {
-      if (ring.size() != 2) {
-        throw Error(path, field + ".points", "2 corners of a rectangle", std::to_string(ring.size()));
-      }
+      if (ring.size() != 2) s["points"].fail("2 corners of a rectangle");
       const auto a = ring[0], b = ring[1];
       ring = {a, {b[0], a[1]}, b, {a[0], b[1]}};
     } else if (type == "polygon") {
-      if (ring.size() < 3) {
-        throw Error(path, field + ".points", "at least 3 points of a polygon",
-                    std::to_string(ring.size()));
-      }
+      if (ring.size() < 3) s["points"].fail("at least 3 points of a polygon");
     } else {
       if (skipped) ++*skipped;  // point, line, linestrip, circle: no area to label
       continue;
@@ -101,90 +77,70 @@ AnnotatedImage readLabelMe(const json& j, const std::string& path, int* skipped)
   return image;
 }
 
-std::vector<AnnotatedImage> readCoco(const json& j, const std::string& path) {
-  for (const char* key : {"images", "annotations", "categories"}) {
-    if (!j.at(key).is_array()) throw Error(path, key, "an array", j.at(key).type_name());
-  }
+std::vector<AnnotatedImage> readCoco(const JsonField& j) {
   std::map<long long, std::string> categories;
-  for (const json& c : j.at("categories")) {
-    categories[static_cast<long long>(number(c.at("id"), path, "categories[].id"))] =
-        text(c, "name", path, "categories[].name");
+  constexpr long long kMaxId = (1LL << 53);
+  for (const JsonField& c : j["categories"].elements()) {
+    const long long id = c["id"].integer(-kMaxId, kMaxId);
+    if (!categories.emplace(id, c["name"].text()).second) c["id"].fail("an id no other category has");
   }
   std::map<long long, std::size_t> image_index;
   std::vector<AnnotatedImage> images;
-  for (const json& im : j.at("images")) {
+  for (const JsonField& im : j["images"].elements()) {
     AnnotatedImage a;
-    a.file_name = baseName(text(im, "file_name", path, "images[].file_name"));
-    a.width = positiveInt(im, "width", path, "images[" + a.file_name + "].width");
-    a.height = positiveInt(im, "height", path, "images[" + a.file_name + "].height");
-    image_index[static_cast<long long>(number(im.at("id"), path, "images[].id"))] = images.size();
+    a.file_name = baseName(im["file_name"].text());
+    a.width = static_cast<int>(im["width"].integer(1, 1000000));
+    a.height = static_cast<int>(im["height"].integer(1, 1000000));
+    checkImageSize(im, a.width, a.height);
+    // Two images with one id would draw one photo's annotations on the other.
+    if (!image_index.emplace(im["id"].integer(-kMaxId, kMaxId), images.size()).second) {
+      im["id"].fail("an id no other image has");
+    }
     images.push_back(std::move(a));
   }
-  int index = 0;
-  for (const json& an : j.at("annotations")) {
-    const std::string field = "annotations[" + std::to_string(index++) + "]";
-    const long long image_id =
-        static_cast<long long>(number(an.at("image_id"), path, field + ".image_id"));
-    const long long category_id =
-        static_cast<long long>(number(an.at("category_id"), path, field + ".category_id"));
-    const auto im = image_index.find(image_id);
-    if (im == image_index.end()) {
-      throw Error(path, field + ".image_id", "the id of an entry of images", std::to_string(image_id));
-    }
-    const auto cat = categories.find(category_id);
-    if (cat == categories.end()) {
-      throw Error(path, field + ".category_id", "the id of an entry of categories",
-                  std::to_string(category_id));
-    }
+  for (const JsonField& an : j["annotations"].elements()) {
+    if (!an.isObject()) an.fail("an object (a COCO annotation)");
+    const JsonField image_id = an["image_id"], category_id = an["category_id"];
+    const auto im = image_index.find(image_id.integer(-kMaxId, kMaxId));
+    if (im == image_index.end()) image_id.fail("the id of an entry of images");
+    const auto cat = categories.find(category_id.integer(-kMaxId, kMaxId));
+    if (cat == categories.end()) category_id.fail("the id of an entry of categories");
     AnnotatedImage& image = images[im->second];
     AnnotatedShape shape;
     shape.label = cat->second;
-    if (!an.contains("segmentation")) throw Error(path, field + ".segmentation", "polygons or an RLE", "missing");
-    const json& seg = an.at("segmentation");
-    if (seg.is_array()) {
-      for (const json& poly : seg) {
-        if (!poly.is_array() || poly.size() < 6 || poly.size() % 2 != 0) {
-          throw Error(path, field + ".segmentation", "polygons [x1, y1, x2, y2, ...] of >= 3 points",
-                      poly.dump().substr(0, 40));
+    const JsonField seg = an["segmentation"];
+    if (seg.isArray()) {
+      for (const JsonField& poly : seg.elements()) {
+        if (poly.size() < 6 || poly.size() % 2 != 0) {
+          poly.fail("a polygon [x1, y1, x2, y2, ...] of >= 3 points");
         }
         std::vector<std::array<double, 2>> ring;
-        for (std::size_t k = 0; k < poly.size(); k += 2) {
-          ring.push_back({number(poly[k], path, field + ".segmentation"),
-                          number(poly[k + 1], path, field + ".segmentation")});
-        }
+        for (std::size_t k = 0; k < poly.size(); k += 2) ring.push_back(point(poly.at(k), poly.at(k + 1)));
         shape.polygons.push_back(std::move(ring));
       }
-    } else if (seg.is_object()) {
-      const json& size = seg.at("size");
-      if (!size.is_array() || size.size() != 2) {
-        throw Error(path, field + ".segmentation.size", "[height, width]", size.dump());
-      }
-      const int h = static_cast<int>(number(size[0], path, field + ".segmentation.size"));
-      const int w = static_cast<int>(number(size[1], path, field + ".segmentation.size"));
+    } else if (seg.isObject()) {
+      const JsonField size = seg["size"];
+      if (size.size() != 2) size.fail("[height, width]");
+      const long long h = size.at(0).integer(1, 1000000), w = size.at(1).integer(1, 1000000);
       if (h != image.height || w != image.width) {
-        throw Error(path, field + ".segmentation.size",
-                    "the image's [" + std::to_string(image.height) + ", " +
-                        std::to_string(image.width) + "]",
-                    size.dump());
+        size.fail("the image's [" + std::to_string(image.height) + ", " +
+                  std::to_string(image.width) + "]");
       }
       std::vector<std::uint32_t> counts;
-      const json& c = seg.at("counts");
-      if (c.is_string()) {
-        counts = cocoRleCounts(c.get<std::string>(), path + " (" + field + ")");
-      } else if (c.is_array()) {
-        for (const json& v : c) {
-          const double x = number(v, path, field + ".segmentation.counts");
-          if (x < 0 || x != std::floor(x)) {
-            throw Error(path, field + ".segmentation.counts", "non-negative integers", v.dump());
-          }
-          counts.push_back(static_cast<std::uint32_t>(x));
-        }
+      const JsonField c = seg["counts"];
+      const std::string origin = seg.file() + " (" + seg.field() + ")";
+      if (c.isString()) {
+        counts = cocoRleCounts(c.text(), origin);
+      } else if (c.isArray()) {
+        // A run is at most the image's pixel count (a count of 2^32 must not wrap to 0).
+        const long long pixels = h * w;
+        for (const JsonField& v : c.elements()) counts.push_back(static_cast<std::uint32_t>(v.integer(0, pixels)));
       } else {
-        throw Error(path, field + ".segmentation.counts", "a list or a string", c.type_name());
+        c.fail("a list of runs or a COCO RLE string");
       }
-      shape.mask = decodeCocoRle(counts, h, w, path + " (" + field + ")");
+      shape.mask = decodeCocoRle(counts, static_cast<int>(h), static_cast<int>(w), origin);
     } else {
-      throw Error(path, field + ".segmentation", "polygons or an RLE", seg.type_name());
+      seg.fail("polygons or an RLE");
     }
     image.shapes.push_back(std::move(shape));
   }
@@ -217,7 +173,9 @@ std::vector<std::uint32_t> cocoRleCounts(const std::string& s, const std::string
       if (!more && (c & 0x10)) x -= 1LL << (5 * k);
     }
     if (counts.size() > 2) x += counts[counts.size() - 2];
-    if (x < 0) throw Error(origin, "segmentation.counts", "non-negative runs", std::to_string(x));
+    if (x < 0 || x > 0xffffffffLL) {
+      throw Error(origin, "segmentation.counts", "runs in [0, 2^32)", std::to_string(x));
+    }
     counts.push_back(x);
   }
   return std::vector<std::uint32_t>(counts.begin(), counts.end());
@@ -257,21 +215,20 @@ std::vector<AnnotatedImage> readAnnotations(const std::string& path, int* skippe
     if (files.empty()) throw Error(path, "annotations", "LabelMe .json files", "none");
     std::vector<AnnotatedImage> images;
     for (const auto& f : files) {
-      const json j = parseFile(f);
+      const json j = readJsonFile(f);
       // Other JSON files in the folder (a classes.json) are not annotations.
       if (!j.is_object() || !j.contains("shapes")) continue;
-      images.push_back(readLabelMe(j, f, skipped));
+      images.push_back(readLabelMe(JsonField(j, f), skipped));
     }
     if (images.empty()) {
       throw Error(path, "annotations", "LabelMe .json files (objects with \"shapes\")", "none");
     }
     return images;
   }
-  requireRegularFile(path);
-  const json j = parseFile(path);
-  if (j.is_object() && j.contains("shapes")) return {readLabelMe(j, path, skipped)};
+  const json j = readJsonFile(path);
+  if (j.is_object() && j.contains("shapes")) return {readLabelMe(JsonField(j, path), skipped)};
   if (j.is_object() && j.contains("images") && j.contains("annotations") && j.contains("categories")) {
-    return readCoco(j, path);
+    return readCoco(JsonField(j, path));
   }
   throw Error(path, "annotations",
               "LabelMe (an object with \"shapes\") or COCO (\"images\", \"annotations\", \"categories\")",

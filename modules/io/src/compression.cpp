@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
 
 #if SADSPLAT_HAVE_ZSTD
 #include <zstd.h>
@@ -115,6 +116,18 @@ std::vector<std::uint8_t> gunzip(
 std::vector<std::uint8_t> inflateRaw(const std::string& path, const std::string& field,
                                      const std::uint8_t* data, std::size_t size,
                                      std::size_t expected) {
+  // Deflate expands at most 1032:1 (a 258-byte match per ~2 bits): a header asking for more than
+  // that of the bytes behind it is refused before anything is allocated.
+  if (expected / 1032 > size + 1) {
+    throw Error(path, field,
+                "a compressed block of at least " + std::to_string(expected / 1032) +
+                    " bytes for " + std::to_string(expected) + " bytes (deflate's ratio is at "
+                    "most 1032:1)",
+                std::to_string(size) + " bytes");
+  }
+  if (size > std::numeric_limits<uInt>::max()) {
+    throw Error(path, field, "a compressed block below 4 GiB", std::to_string(size) + " bytes");
+  }
   z_stream s{};
   if (inflateInit2(&s, -MAX_WBITS) != Z_OK) {
     throw Error(path, field, "zlib to initialise", "an initialisation failure");

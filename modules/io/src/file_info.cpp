@@ -128,8 +128,9 @@ void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& 
 }
 
 void describeLas(std::ostream& out, const std::string& path) {
-  LasHeader h;
-  const std::vector<LasPoint> points = readLas(path, &h);
+  std::map<int, std::size_t> histogram;
+  const LasHeader h =
+      forEachLasPoint(path, [&](const LasPoint& p) { ++histogram[p.classification]; });
   std::string crs = "none";
   if (!h.wkt.empty()) {  // the name: the first quoted string of the WKT
     const std::size_t a = h.wkt.find('"'), b = h.wkt.find('"', a + 1);
@@ -137,12 +138,10 @@ void describeLas(std::ostream& out, const std::string& path) {
                                                            : "(WKT without a name)";
   }
   out << path << ": LAS 1." << h.version_minor << ", point format " << h.point_format << "\n"
-      << "points: " << points.size() << "\n"
-      << "CRS: " << crs << "\n"
+      << "points: " << h.point_count << "\n"
+      << "CRS: " << printable(crs) << "\n"
       << std::fixed << std::setprecision(3) << "bounding box: [" << h.min[0] << ", " << h.min[1]
       << ", " << h.min[2] << "] .. [" << h.max[0] << ", " << h.max[1] << ", " << h.max[2] << "]\n";
-  std::map<int, std::size_t> histogram;
-  for (const LasPoint& p : points) ++histogram[p.classification];
   out << "points per ASPRS class:";
   for (const auto& [code, count] : histogram) {
     const auto it = asprsClassNames().find(code);
@@ -220,14 +219,14 @@ void describeScene(std::ostream& out, const Scene& scene) {
   if (pseudo_views > 0) {
     std::ostringstream share;
     share << std::fixed << std::setprecision(1) << 100.0 * kept / pixels;
-    out << "pseudo-labels: " << pseudo_views << " views (" << backend << "), " << kept_targets
+    out << "pseudo-labels: " << pseudo_views << " views (" << printable(backend) << "), " << kept_targets
         << " of " << targets << " targets kept, " << share.str() << " % of their pixels labelled\n";
   }
   out << "classes: " << scene.classes.size() << "\n";
   for (std::size_t i = 0; i < scene.classes.size(); ++i) {
     const auto& c = scene.classes[i];
-    out << "  " << i << " " << c.name << " rgb(" << int(c.color[0]) << "," << int(c.color[1]) << ","
-        << int(c.color[2]) << ") \"" << c.prompt << "\"";
+    out << "  " << i << " " << printable(c.name) << " rgb(" << int(c.color[0]) << "," << int(c.color[1]) << ","
+        << int(c.color[2]) << ") \"" << printable(c.prompt) << "\"";
     if (pseudo_views > 0) out << ", " << kept_pixels[i] << " pseudo-labelled pixels";
     out << "\n";
   }
@@ -319,7 +318,13 @@ std::string describeFile(const std::string& path) {
                 "a .ply, .pcd, .splat, .spz, .sog or .las file, a scene cache or a scene directory",
                 ext.empty() ? "no extension" : ext);
   }
-  return out.str();
+  // Whatever else came from the file: no control byte reaches the terminal (the lines stay).
+  std::string text = out.str(), shown;
+  std::size_t start = 0;
+  for (std::size_t nl; (nl = text.find('\n', start)) != std::string::npos; start = nl + 1) {
+    shown += printable(text.substr(start, nl - start)) + "\n";
+  }
+  return shown + printable(text.substr(start));
 }
 
 std::string describeCameras(const std::string& path) {
@@ -329,7 +334,7 @@ std::string describeCameras(const std::string& path) {
   out << "name,width,height,fx,fy,cx,cy,qw,qx,qy,qz,tx,ty,tz,role\n";
   for (const View& v : scene.views) {
     const PinholeCamera& c = v.camera;
-    out << v.name << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << "," << c.cx
+    out << printable(v.name) << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << "," << c.cx
         << "," << c.cy;
     for (double q : c.qvec) out << "," << q;
     for (double t : c.tvec) out << "," << t;

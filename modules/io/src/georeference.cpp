@@ -12,6 +12,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/filesystem.h"
+#include "json_field.h"
 
 #if SADSPLAT_HAVE_EXIF
 #include <libexif/exif-data.h>
@@ -369,82 +370,58 @@ std::string georeferenceToJson(const Georeference& g) {
 
 Georeference georeferenceFromJson(const std::string& text, const std::string& origin) {
   Georeference g;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    const auto number = [&](const nlohmann::json& obj, const char* key, const std::string& field) {
-      if (!obj.contains(key) || !obj.at(key).is_number()) {
-        throw Error(origin, field, "a number", obj.contains(key) ? obj.at(key).dump() : "missing");
-      }
-      const double v = obj.at(key).get<double>();
-      if (!std::isfinite(v)) throw Error(origin, field, "a finite number", obj.at(key).dump());
-      return v;
+  const nlohmann::json parsed = parseJson(text, origin);
+  const JsonField j(parsed, origin);
+  const JsonField o = j["origin"];
+  g.origin = {o["latitude"].number(-90, 90), o["longitude"].number(-180, 180),
+              o["altitude"].number(-100000, 100000)};
+  const JsonField epsg = j["epsg_utm"];
+  // The UTM zone of the origin (sadsplat writes that one) or a neighbouring zone of the same
+  // hemisphere: another code would put the maps on a distorted or a wrong grid.
+  const int own = utmEpsg(g.origin);
+  const double code = epsg.number();
+  if (!(std::abs(code - own) <= 1) || std::floor(code) != code ||
+      static_cast<int>(code) / 100 != own / 100) {
+    epsg.fail("the WGS84 / UTM zone of the origin, EPSG:" + std::to_string(own) +
+              " (or a neighbouring zone)");
+  }
+  g.epsg_utm = static_cast<int>(code);
+  if (j.has("sfm_to_local")) {
+    const JsonField s = j["sfm_to_local"];
+    g.sfm_to_local.scale = s["scale"].number(1e-12, 1e12);
+    const JsonField r = s["rotation"], t = s["translation"];
+    if (r.size() != 9) r.fail("9 numbers (a row-major rotation)");
+    if (t.size() != 3) t.fail("3 numbers");
+    for (std::size_t k = 0; k < 9; ++k) g.sfm_to_local.rotation[k] = r.at(k).number(-1.001, 1.001);
+    for (std::size_t k = 0; k < 3; ++k) g.sfm_to_local.translation[k] = t.at(k).number();
+  }
+  const auto count = [&](const char* key) {
+    return j.has(key) ? static_cast<int>(j[key].integer(0, 1 << 30)) : 0;
+  };
+  g.photos_with_gps = count("photos_with_gps");
+  g.inliers = count("inliers");
+  g.rms_metres = j.has("rms_metres") ? j["rms_metres"].number() : 0.0;
+  g.consensus = j.has("consensus") ? j["consensus"].boolean() : true;  // older files: none
+  if (j.has("up_source")) {
+    g.up_source = j["up_source"].text();
+    const auto optional = [&](const char* key, double fallback) {
+      return j.has(key) ? j[key].number() : fallback;
     };
-    if (!j.is_object() || !j.contains("origin") || !j.at("origin").is_object()) {
-      throw Error(origin, "origin", "an object with latitude, longitude, altitude", "missing");
+    g.gps_accuracy_metres = optional("gps_accuracy_metres", 0);
+    g.gps_noise_metres = optional("gps_noise_metres", 0);
+    g.inlier_metres = optional("inlier_metres", 0);
+    g.horizontal_rms_metres = optional("horizontal_rms_metres", 0);
+    g.vertical_rms_metres = optional("vertical_rms_metres", 0);
+    g.scale_uncertainty = optional("scale_uncertainty", 0);
+    g.ground_tilt_deg = optional("ground_tilt_deg", -1);
+    g.views_tilt_deg = optional("views_tilt_deg", -1);
+    g.control_points = count("control_points");
+    g.check_points = count("check_points");
+    g.check_rmse_horizontal = optional("check_rmse_horizontal", -1);
+    g.check_rmse_vertical = optional("check_rmse_vertical", -1);
+    if (j.has("doubts")) {
+      for (const JsonField& d : j["doubts"].elements()) g.doubts.push_back(d.text());
     }
-    const auto& o = j.at("origin");
-    g.origin = {number(o, "latitude", "origin.latitude"),
-                number(o, "longitude", "origin.longitude"),
-                number(o, "altitude", "origin.altitude")};
-    if (std::abs(g.origin.latitude) > 90 || std::abs(g.origin.longitude) > 180) {
-      throw Error(origin, "origin", "latitude within +-90, longitude within +-180", o.dump());
-    }
-    const double epsg = number(j, "epsg_utm", "epsg_utm");
-    // The UTM zone of the origin (sadsplat writes that one) or a neighbouring zone of the same
-    // hemisphere: another code would put the maps on a distorted or a wrong grid.
-    const int own = utmEpsg(g.origin);
-    if (!(std::abs(epsg - own) <= 1) || std::floor(epsg) != epsg ||
-        std::floor(epsg / 100) != own / 100) {
-      throw Error(origin, "epsg_utm",
-                  "the WGS84 / UTM zone of the origin, EPSG:" + std::to_string(own) +
-                      " (or a neighbouring zone)",
-                  j.at("epsg_utm").dump());
-    }
-    g.epsg_utm = static_cast<int>(epsg);
-    if (!(std::abs(g.origin.altitude) <= 100000)) {
-      throw Error(origin, "origin.altitude", "metres within +-100 km", o.at("altitude").dump());
-    }
-    if (j.contains("sfm_to_local")) {
-      const auto& s = j.at("sfm_to_local");
-      g.sfm_to_local.scale = number(s, "scale", "sfm_to_local.scale");
-      g.sfm_to_local.rotation = s.at("rotation").get<std::array<double, 9>>();
-      g.sfm_to_local.translation = s.at("translation").get<std::array<double, 3>>();
-    }
-    g.photos_with_gps = static_cast<int>(j.value("photos_with_gps", 0));
-    g.inliers = static_cast<int>(j.value("inliers", 0));
-    g.rms_metres = j.value("rms_metres", 0.0);
-    g.consensus = j.value("consensus", true);  // older files carry no such field
-    if (j.contains("up_source")) {
-      if (!j.at("up_source").is_string()) {
-        throw Error(origin, "up_source", "a string", j.at("up_source").dump());
-      }
-      g.up_source = j.at("up_source").get<std::string>();
-      const auto optional = [&](const char* key, double fallback) {
-        return j.contains(key) ? number(j, key, key) : fallback;
-      };
-      g.gps_accuracy_metres = optional("gps_accuracy_metres", 0);
-      g.gps_noise_metres = optional("gps_noise_metres", 0);
-      g.inlier_metres = optional("inlier_metres", 0);
-      g.horizontal_rms_metres = optional("horizontal_rms_metres", 0);
-      g.vertical_rms_metres = optional("vertical_rms_metres", 0);
-      g.scale_uncertainty = optional("scale_uncertainty", 0);
-      g.ground_tilt_deg = optional("ground_tilt_deg", -1);
-      g.views_tilt_deg = optional("views_tilt_deg", -1);
-      g.control_points = static_cast<int>(optional("control_points", 0));
-      g.check_points = static_cast<int>(optional("check_points", 0));
-      g.check_rmse_horizontal = optional("check_rmse_horizontal", -1);
-      g.check_rmse_vertical = optional("check_rmse_vertical", -1);
-      if (j.contains("doubts")) {
-        const auto& d = j.at("doubts");
-        if (!d.is_array()) throw Error(origin, "doubts", "an array of strings", d.dump());
-        for (const auto& x : d) {
-          if (!x.is_string()) throw Error(origin, "doubts", "an array of strings", x.dump());
-          g.doubts.push_back(x.get<std::string>());
-        }
-      }
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(origin, "JSON", "a georeference.json as sadsplat writes it", e.what());
   }
   return g;
 }

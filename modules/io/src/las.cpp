@@ -6,12 +6,15 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
+#include "json_field.h"
 
 namespace sadsplat {
 namespace io {
@@ -139,12 +142,30 @@ void writeLas(const std::string& path, const std::vector<LasPoint>& points, LasH
   });
 }
 
-std::vector<LasPoint> readLas(const std::string& path, LasHeader* out_header) {
-  const std::string b = readWholeFile(path);
-  if (b.size() < kLasHeaderSize || b.compare(0, 4, "LASF") != 0) {
+LasHeader forEachLasPoint(const std::string& path,
+                          const std::function<void(const LasPoint&)>& visit) {
+  requireRegularFile(path);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw Error(path, "file", "a readable LAS file", "cannot open");
+  const auto file_size = static_cast<std::uint64_t>(std::max<std::streamoff>(in.tellg(), 0));
+  in.seekg(0);
+  const auto readAt = [&](std::uint64_t at, std::size_t n, const char* field) {
+    std::string bytes(n, '\0');
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(&bytes[0], static_cast<std::streamsize>(n))) {
+      throw Error(path, field, std::to_string(n) + " bytes at offset " + std::to_string(at),
+                  "a truncated file");
+    }
+    return bytes;
+  };
+  if (file_size < kLasHeaderSize) {
     throw Error(path, "signature", "a LAS file (\"LASF\" and a 375-byte header)",
-                b.size() < 4 ? "a file of " + std::to_string(b.size()) + " bytes"
-                             : "\"" + b.substr(0, 4) + "\"");
+                "a file of " + std::to_string(file_size) + " bytes");
+  }
+  const std::string b = readAt(0, kLasHeaderSize, "header");
+  if (b.compare(0, 4, "LASF") != 0) {
+    throw Error(path, "signature", "a LAS file (\"LASF\" and a 375-byte header)",
+                "\"" + b.substr(0, 4) + "\"");
   }
   LasHeader h;
   h.version_minor = static_cast<unsigned char>(b[25]);
@@ -163,55 +184,105 @@ std::vector<LasPoint> readLas(const std::string& path, LasHeader* out_header) {
                 std::to_string(length));
   }
   const std::size_t header_size = get<std::uint16_t>(b, 94);
-  const std::size_t data_offset = get<std::uint32_t>(b, 96);
+  const std::uint64_t data_offset = get<std::uint32_t>(b, 96);
   const std::uint32_t vlr_count = get<std::uint32_t>(b, 100);
   h.point_count = get<std::uint64_t>(b, 247);
+  const char* kAxes[3] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k) {
     h.scale[k] = get<double>(b, 131 + 8 * k);
     h.offset[k] = get<double>(b, 155 + 8 * k);
     h.max[k] = get<double>(b, 179 + 16 * k);
     h.min[k] = get<double>(b, 187 + 16 * k);
+    // Every stored integer times the scale plus the offset must be a finite coordinate.
+    if (!(h.scale[k] > 0 && h.scale[k] <= 1e3)) {
+      throw Error(path, std::string(kAxes[k]) + " scale factor", "a positive scale up to 1000",
+                  std::to_string(h.scale[k]));
+    }
+    if (!(std::abs(h.offset[k]) <= 1e12)) {
+      throw Error(path, std::string(kAxes[k]) + " offset", "a finite offset within +-1e12",
+                  std::to_string(h.offset[k]));
+    }
+    if (!(std::isfinite(h.min[k]) && std::isfinite(h.max[k]) && h.min[k] <= h.max[k]) &&
+        h.point_count > 0) {
+      throw Error(path, std::string("min / max ") + kAxes[k], "finite bounds with min <= max",
+                  std::to_string(h.min[k]) + " / " + std::to_string(h.max[k]));
+    }
   }
-  if (header_size < kLasHeaderSize || data_offset < header_size || data_offset > b.size()) {
+  if (header_size < kLasHeaderSize || data_offset < header_size || data_offset > file_size) {
     throw Error(path, "offset to point data", "inside the file, after the header",
                 std::to_string(data_offset));
   }
-  const std::uint64_t available = (b.size() - data_offset) / length;
+  const std::uint64_t available = (file_size - data_offset) / length;
   if (h.point_count > available) {
     throw Error(path, "number of point records",
                 "at most " + std::to_string(available) + " (the file's size)",
                 std::to_string(h.point_count));
   }
-  std::size_t v = header_size;
+  std::uint64_t v = header_size;
   for (std::uint32_t i = 0; i < vlr_count; ++i) {
     if (v + kLasVlrHeaderSize > data_offset) {
       throw Error(path, "VLR " + std::to_string(i), "a record before the point data",
                   "one running past it");
     }
-    const std::size_t len = get<std::uint16_t>(b, v + 20);
+    const std::string vh = readAt(v, kLasVlrHeaderSize, "VLR header");
+    const std::size_t len = get<std::uint16_t>(vh, 20);
     if (v + kLasVlrHeaderSize + len > data_offset) {
       throw Error(path, "VLR " + std::to_string(i), "a record before the point data",
                   "one running past it");
     }
-    const std::string user(b.data() + v + 2, strnlen(b.data() + v + 2, 16));
-    if (user == "LASF_Projection" && get<std::uint16_t>(b, v + 18) == kWktRecordId) {
-      h.wkt.assign(b.data() + v + kLasVlrHeaderSize,
-                   strnlen(b.data() + v + kLasVlrHeaderSize, len));
+    const std::string user(vh.data() + 2, strnlen(vh.data() + 2, 16));
+    if (user == "LASF_Projection" && get<std::uint16_t>(vh, 18) == kWktRecordId) {
+      const std::string body = readAt(v + kLasVlrHeaderSize, len, "WKT record");
+      h.wkt.assign(body.data(), strnlen(body.data(), len));
     }
     v += kLasVlrHeaderSize + len;
   }
-  std::vector<LasPoint> points(h.point_count);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::size_t r = data_offset + i * length;
-    LasPoint& p = points[i];
-    p.x = get<std::int32_t>(b, r + 0) * h.scale[0] + h.offset[0];
-    p.y = get<std::int32_t>(b, r + 4) * h.scale[1] + h.offset[1];
-    p.z = get<std::int32_t>(b, r + 8) * h.scale[2] + h.offset[2];
-    p.classification = static_cast<std::uint8_t>(b[r + 16]);
-    if (format == 7) {
-      for (int k = 0; k < 3; ++k) p.rgb[k] = get<std::uint16_t>(b, r + 30 + 2 * k);
+  // The points, streamed in blocks: memory stays bounded whatever the file's size.
+  std::array<double, 3> lo{std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity()};
+  std::array<double, 3> hi{-lo[0], -lo[1], -lo[2]};
+  constexpr std::uint64_t kBlock = 65536;
+  std::string block;
+  LasPoint p;
+  for (std::uint64_t first = 0; first < h.point_count; first += kBlock) {
+    const std::uint64_t n = std::min(kBlock, h.point_count - first);
+    block = readAt(data_offset + first * length, static_cast<std::size_t>(n * length),
+                   "point records");
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const std::size_t r = static_cast<std::size_t>(i * length);
+      p.x = get<std::int32_t>(block, r + 0) * h.scale[0] + h.offset[0];
+      p.y = get<std::int32_t>(block, r + 4) * h.scale[1] + h.offset[1];
+      p.z = get<std::int32_t>(block, r + 8) * h.scale[2] + h.offset[2];
+      p.classification = static_cast<std::uint8_t>(block[r + 16]);
+      if (format == 7) {
+        for (int k = 0; k < 3; ++k) p.rgb[k] = get<std::uint16_t>(block, r + 30 + 2 * k);
+      }
+      const double xyz[3] = {p.x, p.y, p.z};
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], xyz[k]);
+        hi[k] = std::max(hi[k], xyz[k]);
+      }
+      visit(p);
     }
   }
+  // The header's bounds must hold the points (within a scale unit: writers round); a header
+  // whose bounds disagree with its points is refused rather than summarised.
+  for (int k = 0; k < 3 && h.point_count > 0; ++k) {
+    const double slack = h.scale[k] + 1e-9 * std::max(std::abs(lo[k]), std::abs(hi[k]));
+    if (lo[k] < h.min[k] - slack || hi[k] > h.max[k] + slack) {
+      std::ostringstream got;
+      got << "header " << h.min[k] << " .. " << h.max[k] << ", points " << lo[k] << " .. " << hi[k];
+      throw Error(path, std::string("min / max ") + kAxes[k], "bounds that hold the points",
+                  got.str());
+    }
+  }
+  return h;
+}
+
+std::vector<LasPoint> readLas(const std::string& path, LasHeader* out_header) {
+  std::vector<LasPoint> points;
+  const LasHeader h = forEachLasPoint(path, [&](const LasPoint& p) { points.push_back(p); });
   if (out_header) *out_header = h;
   return points;
 }
@@ -261,17 +332,10 @@ std::vector<int> asprsCodes(const std::vector<std::string>& class_names,
     codes[i] = defaultAsprsCode(class_names[i], static_cast<int>(i));
   }
   if (mapping_json_path.empty()) return codes;
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(readWholeFile(mapping_json_path));
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(mapping_json_path, "JSON", "a JSON object {\"class name\": ASPRS code}", e.what());
-  }
-  if (!j.is_object()) {
-    throw Error(mapping_json_path, "top level", "an object {\"class name\": ASPRS code}",
-                j.type_name());
-  }
-  for (auto it = j.begin(); it != j.end(); ++it) {
+  const nlohmann::json parsed = readJsonFile(mapping_json_path);
+  const JsonField j(parsed, mapping_json_path);
+  if (!j.isObject()) j.fail("an object {\"class name\": ASPRS code}");
+  for (auto it = parsed.begin(); it != parsed.end(); ++it) {
     const auto found = std::find(class_names.begin(), class_names.end(), it.key());
     if (found == class_names.end()) {
       std::string list;
@@ -279,11 +343,8 @@ std::vector<int> asprsCodes(const std::vector<std::string>& class_names,
       throw Error(mapping_json_path, it.key(), "a class of the model (" + list + ")",
                   "an unknown name");
     }
-    if (!it.value().is_number_integer() || it.value().get<int>() < 0 ||
-        it.value().get<int>() > 255) {
-      throw Error(mapping_json_path, it.key(), "an ASPRS code 0..255", it.value().dump());
-    }
-    codes[found - class_names.begin()] = it.value().get<int>();
+    codes[found - class_names.begin()] =
+        static_cast<int>(JsonField(it.value(), mapping_json_path, it.key()).integer(0, 255));
   }
   return codes;
 }

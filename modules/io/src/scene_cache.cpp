@@ -1,5 +1,6 @@
 #include "sadsplat/io/scene_cache.h"
 
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/image_file.h"
 #include "plane_codec.h"
 
 namespace sadsplat {
@@ -341,19 +343,7 @@ Scene readSceneCache(const std::string& path) {
       v.labelled = roles & 4;
       const bool has_labels = c.get<std::uint8_t>("has labels") != 0;
       const int w = v.camera.width, h = v.camera.height;
-      // Focal lengths below a thousandth of a pixel or a zero quaternion are no cameras: they
-      // would train on NaN rays without a word.
-      if (w <= 0 || h <= 0 || !(v.camera.fx >= 1e-3) || !(v.camera.fy >= 1e-3)) {
-        throw Error(path, "view " + v.name + " camera",
-                    "a positive size and focal lengths of at least 0.001 px",
-                    std::to_string(w) + "x" + std::to_string(h) + ", f " +
-                        std::to_string(v.camera.fx) + " " + std::to_string(v.camera.fy));
-      }
-      double qnorm2 = 0;
-      for (double q : v.camera.qvec) qnorm2 += q * q;
-      if (!(qnorm2 > 1e-12)) {
-        throw Error(path, "view " + v.name + " qvec", "a non-zero rotation quaternion", "zero");
-      }
+      v.camera.validate(path, "view " + v.name + " camera");
       v.rgb = readImage(c, version, w, h, 3, "rgb");
       v.mask = readImage(c, version, w, h, 1, "mask");
       if (has_labels) {

@@ -10,6 +10,7 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/image_file.h"
 #include "sadsplat/io/transforms_json.h"
 
 #if SADSPLAT_HAVE_OPENCV
@@ -180,9 +181,8 @@ std::string userMaskPath(const std::string& dir, const PosedImages& posed,
 // A mask as users draw them (nerfstudio, COLMAP, OpenDroneMap): 0 = leave out, else keep; any
 // channel count (a colour mask keeps a pixel where any channel is non-zero).
 cv::Mat readUserMask(const std::string& path, const cv::Size& size) {
-  requireRegularFile(path);
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
-  if (raw.empty()) throw Error(path, "image data", "a readable mask (PNG)", "cannot decode");
+  const cv::Mat raw =
+      decodeImage(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION, "mask (PNG)");
   if (raw.depth() != CV_8U) {
     throw Error(path, "pixel depth", "an 8-bit mask", "depth code " + std::to_string(raw.depth()));
   }
@@ -207,14 +207,25 @@ cv::Mat readUserMask(const std::string& path, const cv::Size& size) {
 }
 
 cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
-  requireRegularFile(path);  // imread would block on a FIFO
-  cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty()) throw Error(path, "image data", "a readable PNG label map", "cannot decode");
+  const ImageHeader header = checkImageBudget(path, "PNG label map");
+  cv::Mat raw = decodeImage(path, cv::IMREAD_UNCHANGED, "PNG label map");
   if (raw.depth() != CV_8U) {
     throw Error(path, "pixel depth", "8-bit label map",
                 "depth code " + std::to_string(raw.depth()));
   }
   cv::Mat labels(raw.rows, raw.cols, CV_8UC1);
+  // A grey PNG with an alpha channel (colour type 4) or a transparent grey (tRNS) is decoded as
+  // BGRA with B = G = R = the grey: its grey is the class id, a fully transparent pixel ignore.
+  const bool grey_png = header.png_colour_type == 0 || header.png_colour_type == 4;
+  if (grey_png && raw.channels() == 4) {
+    cv::Mat ids(raw.rows, raw.cols, CV_8UC1);
+    for (int y = 0; y < raw.rows; ++y) {
+      const std::uint8_t* px = raw.ptr<std::uint8_t>(y);
+      auto* out = ids.ptr<std::uint8_t>(y);
+      for (int x = 0; x < raw.cols; ++x) out[x] = px[4 * x + 3] == 0 ? kIgnoreLabel : px[4 * x];
+    }
+    raw = ids;
+  }
   if (raw.channels() == 1) {
     labels = raw;
     for (int y = 0; y < labels.rows; ++y) {
@@ -256,6 +267,33 @@ cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& clas
   return labels;
 }
 
+// Sutherland-Hodgman: the polygon clipped to the box [x0, x1] x [y0, y1] (exact inside it).
+std::vector<std::array<double, 2>> clipToBox(std::vector<std::array<double, 2>> polygon, double x0,
+                                             double y0, double x1, double y1) {
+  for (int edge = 0; edge < 4; ++edge) {
+    const int axis = edge % 2;  // 0: x, 1: y
+    const double bound = edge == 0 ? x0 : edge == 1 ? y0 : edge == 2 ? x1 : y1;
+    const bool keep_above = edge < 2;
+    const auto inside = [&](const std::array<double, 2>& p) {
+      return keep_above ? p[axis] >= bound : p[axis] <= bound;
+    };
+    std::vector<std::array<double, 2>> out;
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+      const auto& a = polygon[i];
+      const auto& b = polygon[(i + 1) % polygon.size()];
+      if (inside(a)) out.push_back(a);
+      if (inside(a) != inside(b)) {
+        const double t = (bound - a[axis]) / (b[axis] - a[axis]);
+        std::array<double, 2> c = {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+        c[axis] = bound;
+        out.push_back(c);
+      }
+    }
+    polygon = std::move(out);
+  }
+  return polygon;
+}
+
 // The label map of an annotated image at the scene image's size (before undistortion).
 cv::Mat rasterise(const AnnotatedImage& a, const cv::Size& size,
                   const std::map<std::string, std::uint8_t>& class_ids, const std::string& origin) {
@@ -280,13 +318,18 @@ cv::Mat rasterise(const AnnotatedImage& a, const cv::Size& size,
     }
     std::vector<std::vector<cv::Point> > rings;
     for (const auto& polygon : shape.polygons) {
+      std::vector<std::array<double, 2>> scaled;
+      // Annotation coordinates: pixel centres at +0.5, as sadsplat's cameras.
+      for (const auto& p : polygon) scaled.push_back({p[0] * sx - 0.5, p[1] * sy - 0.5});
+      // Clipped to just outside the image first: a rectangle drawn far beyond the photo still
+      // covers it, and no vertex overflows OpenCV's fixed-point int coordinates.
+      scaled = clipToBox(scaled, -2.0, -2.0, size.width + 1.0, size.height + 1.0);
       std::vector<cv::Point> ring;
-      for (const auto& p : polygon) {
-        // Annotation coordinates: pixel centres at +0.5, as sadsplat's cameras.
-        ring.emplace_back(static_cast<int>(std::lround((p[0] * sx - 0.5) * (1 << kShift))),
-                          static_cast<int>(std::lround((p[1] * sy - 0.5) * (1 << kShift))));
+      for (const auto& p : scaled) {
+        ring.emplace_back(static_cast<int>(std::lround(p[0] * (1 << kShift))),
+                          static_cast<int>(std::lround(p[1] * (1 << kShift))));
       }
-      rings.push_back(std::move(ring));
+      if (ring.size() >= 3) rings.push_back(std::move(ring));
     }
     cv::fillPoly(labels, rings, cv::Scalar(id), cv::LINE_8, kShift);
   }
@@ -309,9 +352,13 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     scene.classes = readClassesJson(dir + "/classes.json");
   }
   const PosedImages posed = readPosedImages(dir, [](const std::string& image_path) {
-    requireRegularFile(image_path);
-    const cv::Mat image = cv::imread(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
-    if (image.empty()) throw Error(image_path, "image data", "a readable image", "cannot decode");
+    // The header's size when the format is known (no decoding), else the decoded image's.
+    const ImageHeader header = checkImageBudget(image_path, "image");
+    if (!header.format.empty()) {
+      return std::array<int, 2>{static_cast<int>(header.width), static_cast<int>(header.height)};
+    }
+    const cv::Mat image =
+        decodeImage(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION, "image");
     return std::array<int, 2>{image.cols, image.rows};
   });
   const ColmapModel& model = posed.model;
@@ -379,14 +426,21 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
   for (const ColmapImage* im : images) {
     const ColmapCamera& cam = *cameras.at(im->camera_id);
     const std::string image_path = posed.image_dir + "/" + im->name;
-    requireRegularFile(image_path);
+    if (!pathExists(image_path)) {
+      throw Error(image_path, "image data", "a readable image named in " + posed.origin, "missing");
+    }
+    // The header's size is checked against the camera before anything is decoded.
+    const ImageHeader header = checkImageBudget(image_path, "image named in " + posed.origin);
+    if (!header.format.empty() && (header.width != cam.width || header.height != cam.height)) {
+      throw Error(image_path, "size",
+                  std::to_string(cam.width) + "x" + std::to_string(cam.height) + " (camera " +
+                      std::to_string(cam.id) + ")",
+                  std::to_string(header.width) + "x" + std::to_string(header.height));
+    }
     // Pixels as stored, as COLMAP and nerfstudio read them: their cameras describe those pixels
     // (an EXIF orientation tag is not applied; `sadsplat sfm` makes upright copies first).
-    cv::Mat bgr = cv::imread(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
-    if (bgr.empty()) {
-      throw Error(image_path, "image data", "a readable image named in " + posed.origin,
-                  pathExists(image_path) ? "cannot decode" : "missing");
-    }
+    cv::Mat bgr = decodeImage(image_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION,
+                              "image named in " + posed.origin);
     if (bgr.cols != static_cast<int>(cam.width) || bgr.rows != static_cast<int>(cam.height)) {
       throw Error(image_path, "size",
                   std::to_string(cam.width) + "x" + std::to_string(cam.height) + " (camera " +
@@ -478,6 +532,7 @@ Scene importScene(const std::string& dir, const ImportOptions& options) {
     }
     view.camera.width = w;
     view.camera.height = h;
+    view.camera.validate(posed.origin, "image " + im->name + " camera");
     cv::Mat rgb;
     cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
     view.rgb = toImage8(rgb);

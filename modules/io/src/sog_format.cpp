@@ -28,6 +28,7 @@ namespace {
 
 constexpr std::size_t kMaxCount = std::size_t{1} << 28;
 constexpr std::size_t kMaxEntryBytes = std::size_t{1} << 30;
+constexpr std::size_t kMaxGaussiansPerByte = 64;
 constexpr std::size_t kMaxMetaBytes = std::size_t{1} << 24;
 
 struct Image {
@@ -133,6 +134,15 @@ pcl::PointCloud<GaussianPoint> readSog(const std::string& path, SogFileInfo* inf
                 count_json.dump().substr(0, 20));
   }
   const std::size_t n = count_json.get<std::size_t>();
+  // The images hold one pixel per Gaussian in lossless WebP; a file claiming more Gaussians than
+  // kMaxGaussiansPerByte per byte of itself is refused before any image is decoded (real SOG files
+  // take 10-20 bytes per Gaussian).
+  if (n > kMaxGaussiansPerByte * bytes.size()) {
+    throw Error(path, "meta.json count",
+                "at most " + std::to_string(kMaxGaussiansPerByte) + " Gaussians per byte of the "
+                "file (" + std::to_string(kMaxGaussiansPerByte * bytes.size()) + ")",
+                std::to_string(n));
+  }
   const nlohmann::json& means = member(path, meta, "means", "");
   const std::vector<float> mins = numbers(path, means, "mins", "means.", 3);
   const std::vector<float> maxs = numbers(path, means, "maxs", "means.", 3);

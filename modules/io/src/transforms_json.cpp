@@ -14,6 +14,7 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/semantic_ply.h"
+#include "json_field.h"
 
 namespace sadsplat {
 namespace io {
@@ -126,13 +127,25 @@ ColmapCamera cameraOf(const std::string& path, const FrameReader& f, int width, 
                   std::to_string(ax));
     }
     fx = 0.5 * width / std::tan(0.5 * ax);
-    fy = f.has("camera_angle_y") ? 0.5 * height / std::tan(0.5 * f.number("camera_angle_y")) : fx;
+    fy = fx;
+    if (f.has("camera_angle_y")) {
+      const double ay = f.number("camera_angle_y");
+      if (!(ay > 0 && ay < M_PI)) {
+        throw Error(path, f.where() + " camera_angle_y", "an angle in (0, pi) radians",
+                    std::to_string(ay));
+      }
+      fy = 0.5 * height / std::tan(0.5 * ay);
+    }
   } else {
     throw Error(path, f.where() + " fl_x", "a focal length (fl_x, or camera_angle_x)", "missing");
   }
-  if (!(fx > 0 && fy > 0)) {
-    throw Error(path, f.where() + " fl_x / fl_y", "positive focal lengths",
-                std::to_string(fx) + " / " + std::to_string(fy));
+  // As the scene cache requires (PinholeCamera::validate): a focal length below a thousandth of
+  // a pixel is no camera.
+  if (!(fx >= 1e-3 && fy >= 1e-3 && std::isfinite(fx) && std::isfinite(fy))) {
+    std::ostringstream got;
+    got << fx << " / " << fy;
+    throw Error(path, f.where() + " fl_x / fl_y", "finite focal lengths of at least 0.001 px",
+                got.str());
   }
   const double cx = f.number("cx", width / 2.0), cy = f.number("cy", height / 2.0);
   const std::string model = f.text("camera_model", "OPENCV");
@@ -178,11 +191,7 @@ std::string normalisedRelative(const std::string& file_path) {
 TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& image_size) {
   requireRegularFile(path);
   json top;
-  try {
-    top = json::parse(readWholeFile(path));
-  } catch (const json::parse_error& e) {
-    throw Error(path, "JSON", "valid JSON", e.what());
-  }
+  top = parseJson(readWholeFile(path), path);
   if (!top.is_object() || !top.contains("frames") || !top["frames"].is_array()) {
     throw Error(path, "frames", "an array of frames (nerfstudio / instant-ngp transforms.json)",
                 top.is_object() && top.contains("frames") ? top["frames"].type_name() : "missing");
@@ -220,8 +229,13 @@ TransformsJson readTransformsJson(const std::string& path, const ImageSizeOf& im
     const std::string image_path = dir + "/" + files[i];
     int width, height;
     if (f.has("w") && f.has("h")) {
-      width = static_cast<int>(f.number("w"));
-      height = static_cast<int>(f.number("h"));
+      const double w = f.number("w"), h = f.number("h");
+      if (!(w >= 1 && h >= 1 && w <= 1e6 && h <= 1e6) || w != std::floor(w) || h != std::floor(h)) {
+        throw Error(path, f.where() + " w / h", "a size of 1..1000000 whole pixels",
+                    std::to_string(w) + "x" + std::to_string(h));
+      }
+      width = static_cast<int>(w);
+      height = static_cast<int>(h);
     } else {
       if (!pathExists(image_path)) {
         throw Error(path, f.where() + " file_path",

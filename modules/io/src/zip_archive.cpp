@@ -93,6 +93,8 @@ const ZipArchive::Entry& ZipArchive::find(const std::string& name) const {
   throw Error(path_, "ZIP entry " + name, "present in the archive", "missing");
 }
 
+constexpr std::uint64_t kMaxDeflateRatio = 64;
+
 std::vector<std::uint8_t> ZipArchive::read(const std::string& name, std::size_t max_bytes) const {
   const Entry& e = find(name);
   const std::string field = "ZIP entry " + name;
@@ -119,6 +121,15 @@ std::vector<std::uint8_t> ZipArchive::read(const std::string& name, std::size_t 
     return std::vector<std::uint8_t>(begin, begin + e.compressed);
   }
   if (e.method == 8) {
+    // The archives sadsplat reads (.sog) hold WebP images, which deflate cannot shrink much, and
+    // a small meta.json: an entry that claims to expand far beyond that is a bomb, refused before
+    // it is inflated.
+    if (e.uncompressed > kMaxDeflateRatio * e.compressed + (std::uint64_t{1} << 20)) {
+      throw Error(path_, field,
+                  "at most " + std::to_string(kMaxDeflateRatio) + "x its compressed " +
+                      std::to_string(e.compressed) + " bytes (+1 MiB) uncompressed",
+                  std::to_string(e.uncompressed) + " bytes");
+    }
     return compression::inflateRaw(path_, field, begin, e.compressed, e.uncompressed);
   }
   throw Error(path_, field, "method 0 (stored) or 8 (deflate)",

@@ -30,6 +30,7 @@
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/exif_orientation.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/image_file.h"
 #include "sadsplat/io/georeference.h"
 
 #if SADSPLAT_HAVE_OPENCV
@@ -194,12 +195,10 @@ std::map<std::string, std::string> photoMasks(const std::string& photos_dir,
 // A mask as COLMAP takes it: 8-bit, 0 = leave out, 255 = keep, the photo's size. No mask: all
 // kept.
 void writeBinaryMask(const std::string& mask, const std::string& photo, const std::string& out) {
-  const cv::Mat image = cv::imread(photo, cv::IMREAD_COLOR);
-  if (image.empty()) throw Error(photo, "image data", "a readable photo", "cannot decode");
+  const cv::Mat image = io::decodeImage(photo, cv::IMREAD_COLOR, "photo");
   cv::Mat keep(image.size(), CV_8UC1, cv::Scalar(255));
   if (!mask.empty()) {
-    const cv::Mat raw = cv::imread(mask, cv::IMREAD_GRAYSCALE);
-    if (raw.empty()) throw Error(mask, "image data", "a readable mask", "cannot decode");
+    const cv::Mat raw = io::decodeImage(mask, cv::IMREAD_GRAYSCALE, "mask");
     if (raw.size() != image.size()) {
       throw Error(mask, "size",
                   std::to_string(image.cols) + "x" + std::to_string(image.rows) + " (its photo)",
@@ -212,8 +211,7 @@ void writeBinaryMask(const std::string& mask, const std::string& photo, const st
 
 // COLMAP's undistorted mask (interpolated, maybe JPEG) back to 0 / 255.
 void binariseUndistortedMask(const std::string& in, const std::string& out) {
-  const cv::Mat raw = cv::imread(in, cv::IMREAD_GRAYSCALE);
-  if (raw.empty()) throw Error(in, "image data", "COLMAP's undistorted mask", "cannot decode");
+  const cv::Mat raw = io::decodeImage(in, cv::IMREAD_GRAYSCALE, "undistorted mask (COLMAP's)");
   cv::Mat keep;
   cv::threshold(raw, keep, 127, 255, cv::THRESH_BINARY);
   if (!cv::imwrite(out, keep)) throw Error(out, "file", "a writable mask", "cannot write");
@@ -375,8 +373,7 @@ std::string uprightPhotos(const std::string& photos_dir, const std::vector<std::
     }
     // imread applies the EXIF orientation unless told not to; the copy carries no EXIF, so
     // COLMAP reads it upright (the GPS is taken from the original).
-    const cv::Mat upright = cv::imread(from, cv::IMREAD_COLOR);
-    if (upright.empty()) throw Error(from, "image data", "a readable photo", "cannot decode");
+    const cv::Mat upright = io::decodeImage(from, cv::IMREAD_COLOR, "photo");
     const std::string ext = io::lowerExtension(photos[i]);
     const bool jpeg = ext == ".jpg" || ext == ".jpeg";
     if (!cv::imwrite(to, upright,

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -48,6 +49,14 @@ void writeLas(const std::string& path, const std::vector<LasPoint>& points, LasH
 /// \throws sadsplat::Error naming the file and the field for anything else (LAZ, older versions,
 /// a truncated file, counts that do not match the size)
 std::vector<LasPoint> readLas(const std::string& path, LasHeader* header = nullptr);
+
+/// \brief Reads a LAS file as readLas does, handing each point to `visit` instead of keeping
+/// them (memory stays bounded whatever the file's size). The header is checked first (scale
+/// factors in (0, 1000], finite offsets, finite bounds) and its bounds against the points at the
+/// end (they must hold every point within a scale unit).
+/// \returns the header
+LasHeader forEachLasPoint(const std::string& path,
+                          const std::function<void(const LasPoint&)>& visit);
 
 /// \brief The ASPRS classes of LAS 1.4 (table 17): code -> name, for the codes sadsplat assigns.
 const std::map<int, std::string>& asprsClassNames();

@@ -29,6 +29,12 @@ struct PinholeCamera {
 
   /// \brief R(qvec), row-major (qvec is normalised first, so any non-zero quaternion works).
   std::array<double, 9> rotation() const;
+
+  /// \brief Throws unless this is a camera sadsplat can train on and read back from a scene
+  /// cache: a size of 1..kMaxImagePixels pixels, finite focal lengths of at least 0.001 px, a
+  /// finite principal point and translation, a finite non-zero quaternion.
+  /// \param[in] origin the file the camera came from; \param[in] field where in it ("view a.jpg")
+  void validate(const std::string& origin, const std::string& field) const;
 };
 
 /// \brief An 8-bit image, row-major, channels interleaved.

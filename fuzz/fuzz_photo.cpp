@@ -1,0 +1,7 @@
+// libFuzzer program for fuzz::fuzz_photo (fuzz_targets.h).
+#include "fuzz_targets.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  sadsplat::fuzz::fuzz_photo(data, size);
+  return 0;
+}
