@@ -2,6 +2,7 @@
 seeds the mutation pass (mutation_pass.py) starts from. Standard library only.
 
     python3 scripts/reliability/inputs.py regressions fuzz/regressions   # (re)write the regressions
+    python3 scripts/reliability/inputs.py seeds fuzz/corpus               # good inputs, new targets
 """
 import json
 import math
@@ -266,8 +267,39 @@ def write_regressions(root):
     print("%d regression inputs in %s" % (len(expected), root))
 
 
+def seeds():
+    """One good input per reader that the hand-made inputs cover (the fuzzers' and the mutation
+    pass's starting points)."""
+    return {
+        "las/good.las": las([(0.0, 0.0, 0.0), (1.0, 2.0, 3.0), (10.0, -5.0, 2.5)],
+                            wkt=b'PROJCS["WGS 84 / UTM zone 30N",UNIT["metre",1]]',
+                            classes=[2, 6, 11]),
+        "georeference/good.json": text(georeference(inliers=12, photos_with_gps=12)),
+        "transforms_json/good.json": text(transforms()),
+        "annotations/labelme.json": text(labelme([
+            {"label": "road", "points": [[0, 0], [30, 0], [30, 20], [0, 20]]},
+            {"label": "building", "points": [[40, 10], [60, 40]], "shape_type": "rectangle"}])),
+        "annotations/coco.json": text(coco(annotations=[
+            {"id": 1, "image_id": 1, "category_id": 1,
+             "segmentation": [[0, 0, 30, 0, 30, 20, 0, 20]]},
+            {"id": 2, "image_id": 2, "category_id": 3,
+             "segmentation": {"size": [H, W], "counts": [100, 200, W * H - 300]}}])),
+    }
+
+
+def write_files(root, files):
+    for name, data in sorted(files.items()):
+        path = os.path.join(root, name)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "wb") as f:
+            f.write(data)
+    print("%d files in %s" % (len(files), root))
+
+
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "regressions":
         write_regressions(sys.argv[2])
+    elif len(sys.argv) == 3 and sys.argv[1] == "seeds":
+        write_files(sys.argv[2], seeds())
     else:
         sys.exit(__doc__)

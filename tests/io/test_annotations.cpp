@@ -153,6 +153,63 @@ TEST_F(AnnotatedImport, BadAnnotationsAreOneLineErrors) {
   expectError(labelme("i.json", "view_000.png", 64, tri), "classes.json");
 }
 
+TEST_F(AnnotatedImport, ShapesFarBeyondTheImageAreClippedNotWrapped) {
+  // A rectangle drawn far past the photo's corners covers all of it (clipped to the image before
+  // OpenCV's fixed-point coordinates; it once wrapped and labelled one pixel), and a triangle
+  // with a vertex 5 million pixels away still labels the part of the photo it covers.
+  test::writeFile(tmp_.file("far.json"), R"({"imagePath": "view_002.png", "imageWidth": 64,
+    "imageHeight": 48, "shapes": [
+      {"label": "grass", "shape_type": "rectangle", "points": [[-50000, -50000], [90000, 90000]]},
+      {"label": "building", "points": [[0, 0], [5000000, 0], [0, 24]]}]})");
+  const io::Scene scene = importWith(tmp_.file("far.json"));
+  const io::View& v = scene.views[2];
+  ASSERT_EQ(v.labels.width, 64);
+  std::size_t grass = 0, building = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      grass += v.labels.at(x, y) == 1;
+      building += v.labels.at(x, y) == 2;
+    }
+  }
+  EXPECT_EQ(grass + building, 64u * 48u);  // every pixel labelled
+  EXPECT_EQ(v.labels.at(63, 47), 1);
+  EXPECT_EQ(v.labels.at(63, 5), 2);   // the triangle's long edge falls ~0.0003 px per px
+  EXPECT_EQ(v.labels.at(10, 30), 1);
+}
+
+TEST_F(AnnotatedImport, ValuesOfTheWrongTypeOrRangeNameTheirField) {
+  const auto write = [&](const std::string& name, const std::string& json) {
+    test::writeFile(tmp_.file(name), json);
+    return tmp_.file(name);
+  };
+  const std::string image = R"({"id": 1, "file_name": "view_000.png", "width": 64, "height": 48})";
+  const std::string cats = R"([{"id": 1, "name": "road"}])";
+  // Two images with one id would draw one photo's annotations on the other.
+  expectError(write("dup.json", "{\"images\": [" + image + R"(, {"id": 1, "file_name":
+      "view_001.png", "width": 64, "height": 48}], "categories": )" + cats +
+                                    ", \"annotations\": []}"),
+              "images[1].id: expected an id no other image has");
+  expectError(write("noid.json", "{\"images\": [" + image + "], \"categories\": " + cats +
+                                     R"(, "annotations": [{"image_id": 1, "segmentation": []}]})"),
+              "annotations[0].category_id: expected a value, got missing");
+  expectError(write("str.json", "{\"images\": [" + image + "], \"categories\": " + cats +
+                                    R"(, "annotations": ["road"]})"),
+              "annotations[0]: expected an object");
+  expectError(write("wrap.json", "{\"images\": [" + image + "], \"categories\": " + cats +
+                                     R"(, "annotations": [{"image_id": 1, "category_id": 1,
+      "segmentation": {"size": [48, 64], "counts": [4294967296, 3072]}}]})"),
+              "counts[0]: expected an integer in [0, 3072]");
+  expectError(write("type.json", R"({"imagePath": "view_000.png", "imageWidth": 64,
+      "imageHeight": 48, "shapes": [{"label": "road", "shape_type": 7, "points": []}]})"),
+              "shapes[0].shape_type: expected a string, got 7");
+  expectError(write("huge.json", R"({"imagePath": "view_000.png", "imageWidth": 64,
+      "imageHeight": 48, "shapes": [{"label": "road", "points": [[0, 0], [1e308, 0], [0, 9]]}]})"),
+              "shapes[0].points[1][0]: expected a number in [");
+  expectError(write("big.json", "{\"shapes\": [], \"imagePath\": \"view_000.png\", "
+                                "\"imageWidth\": 1e400, \"imageHeight\": 48}"),
+              "JSON syntax");
+}
+
 TEST_F(AnnotatedImport, ScenesWithoutClassesOrSplitAndTheUndistortersLayout) {
   // No classes.json, no labels: a plain 3DGS scene. No split.json: every 8th view is a test view
   // (the tiny scene's 8 views are fewer than 2 x 8: all train).

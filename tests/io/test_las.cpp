@@ -132,6 +132,42 @@ TEST(Las, BadCloudsAndBadFilesAreClearErrors) {
   std::string laz = good;
   laz[104] = static_cast<char>(7 | 0x80);
   expectError(laz, "point data format");
+  // Scale factors, offsets and bounds (LAS 1.4 table 3, offsets 131, 155, 179): a zero, NaN or
+  // huge scale, a non-finite offset, NaN bounds or bounds that do not hold the points.
+  const auto patched = [&](std::size_t offset, double value) {
+    std::string b = good;
+    std::memcpy(&b[offset], &value, 8);
+    return b;
+  };
+  expectError(patched(131, 0.0), "X scale factor");
+  expectError(patched(139, std::nan("")), "Y scale factor");
+  expectError(patched(147, 1e308), "Z scale factor");
+  expectError(patched(155, std::numeric_limits<double>::infinity()), "X offset");
+  expectError(patched(171, 1e308), "Z offset");
+  expectError(patched(187, std::nan("")), "min / max X");         // min X
+  expectError(patched(179, 500000.0), "min / max X");             // max X below the points
+  expectError(patched(211, -1000.0), "min / max Z");              // max Z below the points
+}
+
+TEST(Las, StreamingVisitsEveryPointAndSummariesEscapeTheWkt) {
+  test::TempDir dir;
+  io::LasHeader h;
+  h.wkt = "PROJCS[\"\x1b[2J evil\"]";
+  io::writeLas(dir.file("a.las"), somePoints(), h);
+  std::size_t visited = 0;
+  double sum_x = 0;
+  const io::LasHeader read = io::forEachLasPoint(dir.file("a.las"), [&](const io::LasPoint& p) {
+    ++visited;
+    sum_x += p.x;
+  });
+  EXPECT_EQ(visited, 5u);
+  EXPECT_EQ(read.point_count, 5u);
+  EXPECT_NEAR(sum_x, 5 * 500123.25 + 10.5 * 10, 1e-3);
+  std::string out;
+  ASSERT_EQ(test::runCommand(std::string(test::kCli) + " info " + dir.file("a.las"), &out), 0)
+      << out;
+  EXPECT_EQ(out.find('\x1b'), std::string::npos) << out;
+  EXPECT_NE(out.find("CRS: \\x1B[2J evil"), std::string::npos) << out;
 }
 
 TEST(Las, ClassNamesMapToAsprsCodesAndAMapOverridesThem) {
@@ -152,6 +188,17 @@ TEST(Las, ClassNamesMapToAsprsCodesAndAMapOverridesThem) {
   EXPECT_THROW(io::asprsCodes({"road"}, dir.file("unknown.json")), Error);
   test::writeFile(dir.file("range.json"), "{\"road\": 300}");
   EXPECT_THROW(io::asprsCodes({"road"}, dir.file("range.json")), Error);
+  // 2^32 + 11 is not 11 (no silent wrap), 11.5 no code.
+  for (const char* code : {"4294967307", "11.5", "-1", "\"11\""}) {
+    test::writeFile(dir.file("wrap.json"), std::string("{\"road\": ") + code + "}");
+    try {
+      io::asprsCodes({"road"}, dir.file("wrap.json"));
+      ADD_FAILURE() << code;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.field(), "road") << e.what();
+      EXPECT_NE(std::string(e.what()).find("an integer in [0, 255]"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/image_file.h"
 #include "sadsplat/io/scene_import.h"
 #include "test_support/test_support.h"
 
@@ -188,6 +189,48 @@ TEST_F(SceneImport, MapsColourLabelMapsThroughThePalette) {
   const io::Scene scene = io::importScene(dir);
   EXPECT_EQ(scene.views[0].labels.at(5, 0), io::kIgnoreLabel);
   EXPECT_EQ(scene.views[0].labels.at(5, 1), 2);
+}
+
+TEST_F(SceneImport, GreyAlphaLabelMapsAreClassIdsWithTransparentIgnore) {
+  // fuzz/regressions/label_png/grey_alpha.png (scripts/reliability/inputs.py): grey = x * 3 / 64
+  // (classes 0, 1, 2 across the image), alpha 255 for y < 40, 0 below. It was read as BGRA colours
+  // and became all "ignore" without a word.
+  const std::string dir = copy();
+  std::filesystem::copy_file(std::string(SADSPLAT_TEST_DATA_DIR) +
+                                 "/../fuzz/regressions/label_png/grey_alpha.png",
+                             dir + "/labels/view_000.png",
+                             std::filesystem::copy_options::overwrite_existing);
+  const io::Scene scene = io::importScene(dir);
+  const io::Image8& l = scene.views[0].labels;
+  EXPECT_EQ(l.at(0, 0), 0);
+  EXPECT_EQ(l.at(30, 10), 1);
+  EXPECT_EQ(l.at(63, 39), 2);
+  EXPECT_EQ(l.at(30, 40), io::kIgnoreLabel);
+}
+
+TEST_F(SceneImport, ImageHeadersAreCheckedBeforeDecoding) {
+  // A 676-byte JPEG that claims 10000 x 10000 pixels (once decoded whole: 2.1-2.8 GB for 30000^2)
+  // and a PNG that claims 60000 x 60000 (once OpenCV's assertion, exit 3).
+  for (const char* name : {"jpeg_10000x10000_676_bytes.png", "png_60000x60000.png"}) {
+    const std::string dir = copy();
+    std::filesystem::copy_file(std::string(SADSPLAT_TEST_DATA_DIR) + "/../fuzz/regressions/photo/" +
+                                   name,
+                               dir + "/images/view_003.png",
+                               std::filesystem::copy_options::overwrite_existing);
+    try {
+      io::importScene(dir);
+      ADD_FAILURE() << name;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.file(), dir + "/images/view_003.png");
+      EXPECT_NE(e.field().find("header size"), std::string::npos) << e.what();
+    }
+    std::filesystem::remove_all(dir);
+  }
+  // A header's size is what the decoder then gives.
+  const io::ImageHeader h = io::readImageHeader(std::string(kTinyScene) + "/images/view_000.png");
+  EXPECT_EQ(h.format, "png");
+  EXPECT_EQ(h.width, 64u);
+  EXPECT_EQ(h.height, 48u);
 }
 
 TEST_F(SceneImport, BadInputsNameTheFileAndTheField) {

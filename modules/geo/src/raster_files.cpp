@@ -59,6 +59,9 @@ void initGdal() {
   static const bool once = [] {
     GDALAllRegister();
     CPLSetConfigOption("GDAL_PAM_ENABLED", "NO");  // no .aux.xml side files
+    // GDAL's (and, through it, PROJ's) messages are not printed: sadsplat's one-line error
+    // carries the last of them (CPLGetLastErrorMsg), instead of 15 lines before it on a full disk.
+    CPLSetErrorHandler(CPLQuietErrorHandler);
     return true;
   }();
   (void)once;

@@ -9,6 +9,10 @@
 #include "sadsplat/io/filesystem.h"
 
 #if SADSPLAT_HAVE_OPENCV
+#include <unistd.h>
+
+#include <cstdio>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #endif
 
@@ -135,15 +139,75 @@ ImageHeader checkImageBudget(const std::string& path, const std::string& what) {
 }
 
 #if SADSPLAT_HAVE_OPENCV
+namespace {
+
+// The codecs under OpenCV (libpng, libjpeg, libtiff) print their warnings and errors on the
+// process's stderr themselves ("libpng warning: iCCP: ..."): while one image is decoded, stderr
+// goes to a temporary file instead, and what was written there joins sadsplat's one-line error
+// (a successful decode's warnings are dropped).
+class StderrCapture {
+ public:
+  StderrCapture() : lock_(mutex()) {
+    std::fflush(stderr);
+    file_ = std::tmpfile();
+    saved_ = file_ ? ::dup(2) : -1;
+    if (saved_ >= 0) ::dup2(::fileno(file_), 2);
+  }
+  ~StderrCapture() { restore(); }
+  // Restores stderr and returns what was written meanwhile, on one line.
+  std::string restore() {
+    std::string text;
+    if (saved_ >= 0) {
+      std::fflush(stderr);
+      ::dup2(saved_, 2);
+      ::close(saved_);
+      saved_ = -1;
+      std::rewind(file_);
+      char buffer[512];
+      std::size_t n;
+      while ((n = std::fread(buffer, 1, sizeof buffer, file_)) > 0 && text.size() < 2000) {
+        text.append(buffer, n);
+      }
+    }
+    if (file_) {
+      std::fclose(file_);
+      file_ = nullptr;
+    }
+    for (char& c : text) {
+      if (c == '\n' || c == '\r') c = ' ';
+    }
+    while (!text.empty() && text.back() == ' ') text.pop_back();
+    return text;
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::FILE* file_ = nullptr;
+  int saved_ = -1;
+};
+
+}  // namespace
+
 cv::Mat decodeImage(const std::string& path, int imread_flags, const std::string& what) {
   checkImageBudget(path, what);
   cv::Mat image;
-  try {
-    image = cv::imread(path, imread_flags);
-  } catch (const cv::Exception& e) {
-    throw Error(path, "image data", "a readable " + what, e.msg);
+  std::string failure;
+  {
+    StderrCapture capture;
+    try {
+      image = cv::imread(path, imread_flags);
+    } catch (const cv::Exception& e) {
+      failure = e.msg;
+    }
+    const std::string said = capture.restore();
+    if (image.empty() && failure.empty()) failure = "cannot decode";
+    if (!failure.empty() && !said.empty()) failure += " (" + said + ")";
   }
-  if (image.empty()) throw Error(path, "image data", "a readable " + what, "cannot decode");
+  if (!failure.empty()) throw Error(path, "image data", "a readable " + what, failure);
   return image;
 }
 #endif

@@ -15,6 +15,7 @@
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/output_set.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/runs.h"
@@ -71,7 +72,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
   }
-  io::makeDirectory(o.out);  // an unwritable output fails before the work
+  // Written as a set: a failure leaves the previous set whole, a rerun replaces all of it.
+  io::OutputSet files(o.out, {"orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png",
+                              "confidence.tif", "confidence.png", "dsm.tif", "dsm.png",
+                              "classes.csv", "ortho.json"});
   OpenedRun run = openRun(o.run);
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
@@ -89,8 +93,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
     for (int c = 0; c < 3; ++c) photo.bytes[4 * i + c] = img.rgb[3 * i + c];
     photo.bytes[4 * i + 3] = img.covered[i] ? 255 : 0;
   }
-  geo::writeGeoTiff(o.out + "/orthophoto.tif", photo, &map);
-  geo::writePng(o.out + "/orthophoto.png", photo);
+  geo::writeGeoTiff(files.path("orthophoto.tif"), photo, &map);
+  geo::writePng(files.path("orthophoto.png"), photo);
 
   const auto& classes = run.scene.classes;
   const bool semantic = run.trainer->numClasses() > 0;
@@ -105,7 +109,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     ids.bytes = img.classes;
     ids.nodata = 255;
     for (const ClassInfo& c : classes) ids.palette.push_back(c.color);
-    geo::writeGeoTiff(o.out + "/classes.tif", ids, &map);
+    geo::writeGeoTiff(files.path("classes.tif"), ids, &map);
     geo::Raster preview = geo::Raster::bytesOf(img.width, img.height, 4);
     preview.last_band_is_alpha = true;
     for (std::size_t i = 0; i < n; ++i) {
@@ -113,7 +117,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
       for (int c = 0; c < 3; ++c) preview.bytes[4 * i + c] = classes[img.classes[i]].color[c];
       preview.bytes[4 * i + 3] = 255;
     }
-    geo::writePng(o.out + "/classes.png", preview);
+    geo::writePng(files.path("classes.png"), preview);
     geo::Raster conf = geo::Raster::floatsOf(img.width, img.height);
     conf.nodata = -1;
     geo::Raster conf_preview = geo::Raster::bytesOf(img.width, img.height, 2);
@@ -124,8 +128,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
           static_cast<std::uint8_t>(std::lround(255 * std::max(0.f, img.confidence[i])));
       conf_preview.bytes[2 * i + 1] = img.covered[i] ? 255 : 0;
     }
-    geo::writeGeoTiff(o.out + "/confidence.tif", conf, &map);
-    geo::writePng(o.out + "/confidence.png", conf_preview);
+    geo::writeGeoTiff(files.path("confidence.tif"), conf, &map);
+    geo::writePng(files.path("confidence.png"), conf_preview);
   }
   geo::Raster dsm = geo::Raster::floatsOf(img.width, img.height);
   dsm.nodata = -9999;
@@ -134,7 +138,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     dsm.floats[i] = img.covered[i] ? img.elevation[i] : -9999.f;
     if (img.covered[i]) heights.push_back(img.elevation[i]);
   }
-  geo::writeGeoTiff(o.out + "/dsm.tif", dsm, &map);
+  geo::writeGeoTiff(files.path("dsm.tif"), dsm, &map);
   float lo = 0, hi = 1;
   if (!heights.empty()) {
     std::sort(heights.begin(), heights.end());
@@ -148,7 +152,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     dsm_preview.bytes[2 * i] = static_cast<std::uint8_t>(std::lround(255 * t));
     dsm_preview.bytes[2 * i + 1] = img.covered[i] ? 255 : 0;
   }
-  geo::writePng(o.out + "/dsm.png", dsm_preview);
+  geo::writePng(files.path("dsm.png"), dsm_preview);
 
   // Ground area of a pixel: (gsd / k)^2 (the map's scale factor k; 1 in local metres).
   const double cell_area = gsd * gsd * grid.frame.groundAreaPerMapArea();
@@ -163,7 +167,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   }
   csv << "255,nodata," << (static_cast<std::int64_t>(n) - covered) << "," << std::setprecision(2)
       << (static_cast<std::int64_t>(n) - covered) * cell_area << ",\n";
-  writeTextFile(o.out + "/classes.csv", csv.str());
+  writeTextFile(files.path("classes.csv"), csv.str());
 
   nlohmann::json j;
   j["run"] = o.run;
@@ -199,7 +203,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["files"] = semantic ? nlohmann::json{"orthophoto.tif", "classes.tif", "dsm.tif",
                                          "confidence.tif", "classes.csv"}
                         : nlohmann::json{"orthophoto.tif", "dsm.tif", "classes.csv"};
-  writeTextFile(o.out + "/ortho.json", j.dump(2) + "\n");
+  writeTextFile(files.path("ortho.json"), j.dump(2) + "\n");
+  files.commit();
 
   std::ostringstream s;
   s << "wrote " << o.out << ": " << grid.width << " x " << grid.height << " pixels, " << gsd

@@ -15,6 +15,7 @@
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/output_set.h"
 #include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/runs.h"
 
@@ -209,8 +210,9 @@ int renderRun(const RenderRunOptions& o) {
   if (views.empty() && orbit == 0) {
     throw Error(run.scene_path, "--views", "a selection with at least one view", o.views);
   }
-  io::makeDirectory(o.out);
-  for (const std::string& x : outputs) io::makeDirectory(o.out + "/" + x);
+  // Written as a set: a failure leaves the previous renders whole, a rerun replaces them.
+  io::OutputSet files(o.out, kRenderOutputs);
+  for (const std::string& x : outputs) io::makeDirectory(files.path(x));
   const std::string scene_dir = sceneDirectoryOf(run);
 
   auto sized = [&](gaussians::RasterCamera cam, const std::string& image) {
@@ -254,10 +256,11 @@ int renderRun(const RenderRunOptions& o) {
                   << cameras[i].camera.width << "x" << cameras[i].camera.height << ")   "
                   << std::flush;
     }
-    writeViewImages(*run.trainer, run.scene.classes, cameras[i].camera, cameras[i].name, o.out,
-                    outputs);
+    writeViewImages(*run.trainer, run.scene.classes, cameras[i].camera, cameras[i].name,
+                    files.staging(), outputs);
     ++written;
   }
+  files.commit();
   if (o.progress) *o.progress << "\n";
   return written;
 }
