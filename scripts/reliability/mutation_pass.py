@@ -108,7 +108,8 @@ def mutate_binary(data, rng, fields=()):
                                 -1e308, 5e-324, 1e-300])
         else:
             bits = struct.calcsize(fmt) * 8
-            value = rng.choice([0, 1, 2 ** bits - 1, 2 ** (bits - 1), 2 ** (bits - 1) - 1, 60000])
+            value = rng.choice([0, 1, 2 ** bits - 1, 2 ** (bits - 1), 2 ** (bits - 1) - 1,
+                                60000]) % (2 ** bits)
             if fmt[-1].islower() and value >= 2 ** (bits - 1):
                 value -= 2 ** bits
         struct.pack_into(fmt, b, offset, value)

@@ -115,14 +115,15 @@ std::vector<std::uint8_t> gunzip(
 
 std::vector<std::uint8_t> inflateRaw(const std::string& path, const std::string& field,
                                      const std::uint8_t* data, std::size_t size,
-                                     std::size_t expected) {
+                                     std::size_t expected, std::size_t max_ratio) {
   // Deflate expands at most 1032:1 (a 258-byte match per ~2 bits): a header asking for more than
-  // that of the bytes behind it is refused before anything is allocated.
-  if (expected / 1032 > size + 1) {
+  // that (or than the caller's format allows) of the bytes behind it is refused before anything
+  // is allocated.
+  if (expected / max_ratio > size + 1) {
     throw Error(path, field,
-                "a compressed block of at least " + std::to_string(expected / 1032) +
-                    " bytes for " + std::to_string(expected) + " bytes (deflate's ratio is at "
-                    "most 1032:1)",
+                "a compressed block of at least " + std::to_string(expected / max_ratio) +
+                    " bytes for " + std::to_string(expected) + " bytes (a ratio of at most " +
+                    std::to_string(max_ratio) + ":1)",
                 std::to_string(size) + " bytes");
   }
   if (size > std::numeric_limits<uInt>::max()) {

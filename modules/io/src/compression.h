@@ -30,10 +30,12 @@ std::vector<std::uint8_t> gunzip(
 std::vector<std::uint8_t> deflateRaw(const std::string& path, const std::uint8_t* data,
                                      std::size_t size, int level, bool huffman_only = false);
 
-/// Inflates a raw deflate stream (ZIP method 8) that must produce exactly `expected` bytes.
+/// Inflates a raw deflate stream (ZIP method 8) that must produce exactly `expected` bytes;
+/// `expected` above `max_ratio` x `size` is refused before anything is allocated (deflate's own
+/// limit is 1032:1; a Huffman-only stream's 8:1).
 std::vector<std::uint8_t> inflateRaw(const std::string& path, const std::string& field,
                                      const std::uint8_t* data, std::size_t size,
-                                     std::size_t expected);
+                                     std::size_t expected, std::size_t max_ratio = 1032);
 
 /// Whether this build can read and write zstd (SPZ version 4).
 bool haveZstd();

@@ -59,11 +59,16 @@ std::vector<std::uint8_t> encodeImage(const std::string& path, const Image8& ima
                                  /*huffman_only=*/true);
 }
 
+// Plane blocks are written Huffman-only (no string matches), which cannot expand beyond 8:1; a
+// block that claims far more is refused before its pixels are allocated (a 1 MB cache once took
+// 1.9 GB to describe).
+constexpr std::size_t kMaxPlaneRatio = 16;
+
 Image8 decodeImage(const std::string& path, const std::string& field, const std::uint8_t* data,
                    std::size_t size, int width, int height, int channels) {
   const std::size_t n = static_cast<std::size_t>(width) * height;
   const std::vector<std::uint8_t> residual =
-      compression::inflateRaw(path, field, data, size, n * channels);
+      compression::inflateRaw(path, field, data, size, n * channels, kMaxPlaneRatio);
   Image8 image;
   image.width = width;
   image.height = height;

@@ -7,6 +7,7 @@
 // {count, bands, codebook[256], files [centroids, labels]} (optional). Axes as the PLY.
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -66,8 +67,11 @@ std::vector<float> numbers(const std::string& path, const nlohmann::json& group,
   }
   std::vector<float> out;
   for (const auto& v : j) {
-    if (!v.is_number()) {
-      throw Error(path, "meta.json " + where + key, "numbers", v.dump().substr(0, 30));
+    // Finite as floats: 1e300 is a number but an infinite float scale or colour.
+    if (!v.is_number() || !std::isfinite(v.get<double>()) ||
+        std::fabs(v.get<double>()) > std::numeric_limits<float>::max()) {
+      throw Error(path, "meta.json " + where + key, "finite numbers (as 32-bit floats)",
+                  v.dump().substr(0, 30));
     }
     out.push_back(v.get<float>());
   }

@@ -5,7 +5,7 @@
 /// LASF_Projection VLR (record 2112). Debian ships no LAS library (no PDAL, no LAStools, no
 /// laspy), so this is a small writer and a reader for exactly what it writes (and any other
 /// uncompressed format 6/7 file); the tests check it byte by byte against the specification and
-/// scripts/check_las.mjs reads it with an independent reader (loaders.gl's LAS loader).
+/// scripts/interop/las_check.sh reads it with an independent reader (loaders.gl's LAS loader).
 /// Also: the ASPRS standard classes and the default class-name -> code mapping.
 
 #include <array>
