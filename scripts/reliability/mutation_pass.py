@@ -137,6 +137,46 @@ def mutate_png(data, rng):
     return mutate_binary(data, rng, PNG_FIELDS)
 
 
+def mutate_sog_meta(data, rng):
+    """A .sog with its meta.json mutated (the WebP images kept)."""
+    import io
+    import zipfile
+    src = zipfile.ZipFile(io.BytesIO(data))
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
+        for name in src.namelist():
+            body = src.read(name)
+            z.writestr(name, mutate_json(body, rng) if name == "meta.json" else body)
+    return out.getvalue()
+
+
+def fnv1a64(data):
+    h = 0xcbf29ce484222325
+    for byte in data:
+        h = ((h ^ byte) * 0x100000001b3) & 0xffffffffffffffff
+    return h
+
+
+def mutate_cache(data, rng):
+    """A scene cache with its payload mutated and its size and checksum made valid again, so that
+    the chunk parsers see the mutation (not only the checksum test)."""
+    payload = mutate_binary(data[32:], rng, [(i, "<I") for i in range(0, 400, 4)])
+    return data[:16] + struct.pack("<QQ", len(payload), fnv1a64(payload)) + payload
+
+
+def mutate_text_numbers(data, rng):
+    """A text file (a COLMAP model) with one number replaced by an extreme value or a word."""
+    words = data.split(b" ")
+    numeric = [i for i, w in enumerate(words) if w.strip().replace(b".", b"").replace(b"-", b"")
+               .isdigit()]
+    if not numeric:
+        return data
+    i = rng.choice(numeric)
+    words[i] = rng.choice([b"nan", b"inf", b"1e400", b"-1", b"0", b"4294967307", b"1e308",
+                           b"x", b"99999999999999999999"])
+    return b" ".join(words)
+
+
 # ---------------------------------------------------------------------------------------------
 # Readers: how a mutated input is placed and which commands read it.
 
@@ -183,6 +223,10 @@ def corpus(path):
     return open(os.path.join(ROOT, "fuzz", "corpus", path), "rb").read()
 
 
+def interop(path):
+    return open(os.path.join(ROOT, "data", "interop", path), "rb").read()
+
+
 def fixture(path):
     return open(os.path.join(FIXTURE, path), "rb").read()
 
@@ -208,6 +252,17 @@ def readers():
          lambda d, r: mutate_binary(d, r), place_file("m.ply")),
         ("SPZ", [corpus("splat_formats/g.spz")], lambda d, r: mutate_binary(d, r),
          place_file("m.spz")),
+        ("SOG meta.json", [interop("splat_transform.sog")], mutate_sog_meta, place_file("m.sog")),
+        ("SOG bytes", [interop("splat_transform.sog")], lambda d, r: mutate_binary(d, r),
+         place_file("m.sog")),
+        ("compressed PLY", [interop("splat_transform.compressed.ply")],
+         lambda d, r: mutate_binary(d, r), place_file("m.compressed.ply")),
+        ("scene cache", [open(FIXTURE + ".cache", "rb").read()], mutate_cache,
+         place_file("m.cache")),
+        ("COLMAP cameras.txt", [fixture("sparse/0/cameras.txt")], mutate_text_numbers,
+         place_in_scene("sparse/0/cameras.txt")),
+        ("COLMAP images.txt", [fixture("sparse/0/images.txt")], mutate_text_numbers,
+         place_in_scene("sparse/0/images.txt")),
     ]
 
 

@@ -3,6 +3,8 @@
 // `eval --ortho`, LAS from `convert`, and the one-line errors of bad options.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -276,6 +278,28 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_NE(out.find("\"cells\": 640000"), std::string::npos) << out;  // 200 m at 0.25 m
   EXPECT_NE(out.find("\"miou\""), std::string::npos) << out;
   EXPECT_TRUE(io::pathExists(run() + "/ortho_metrics.json"));
+}
+
+TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + " eval " + run() + " --3d", &out), 0) << out;
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(run() + "/metrics_3d.json"));
+  EXPECT_EQ(j["truth"].get<std::string>().rfind("synth:city:", 0), 0u) << j.dump();
+  EXPECT_GT(j["gaussians"].get<int>(), 100);
+  EXPECT_GT(j["scored"].get<int>(), 0);
+  EXPECT_LE(j["scored"].get<int>(), j["gaussians"].get<int>());
+  for (const char* key : {"point_miou", "point_oacc", "weighted_miou", "share_within_0.5_m",
+                          "share_beyond_1.0_m", "completeness_all"}) {
+    EXPECT_GE(j[key].get<double>(), 0.0) << key;
+    EXPECT_LE(j[key].get<double>(), 1.0) << key;
+  }
+  // This short run has few opaque Gaussians (if any); every Gaussian's distance is there.
+  EXPECT_GT(j["distance_median_all_m"].get<double>(), 0.0) << j.dump();
+  EXPECT_LE(j["distance_median_all_m"].get<double>(), j["distance_p90_all_m"].get<double>());
+  EXPECT_LE(j["distance_median_m"].get<double>(), j["distance_p90_m"].get<double>());
+  EXPECT_TRUE(j["point_iou"].contains("building")) << j.dump();
+  // A scene that names no generated world has no 3D truth: one line.
+  EXPECT_EQ(test::runCommand(kCli + " eval " + run() + " --3d --ortho", &out), 1) << out;
 }
 
 TEST_F(MapProducts, BadOptionsAreOneLineErrors) {

@@ -105,6 +105,50 @@ TEST(AerialBenchmark, RaysHitTheGroundAndObjectsExactly) {
   EXPECT_FALSE(world.trace(top, up, 1e4f, &hit));
 }
 
+TEST(AerialBenchmark, TheNearestTrueSurfaceOfAPointIsTheOneATraceFinds) {
+  // The 3D truth of `eval --3d`: 0.25 m above the top of every box taller than 3 m, the nearest
+  // surface is that roof (the trace down from above agrees); 1.5 m above open ground, the ground.
+  const synth::World world(synth::SceneKind::kCity, 7);
+  const float down[3] = {0.f, 0.f, -1.f};
+  int boxes = 0, roofs = 0;
+  for (int i = 0; i < static_cast<int>(world.objects().size()); ++i) {
+    const synth::Object& ob = world.objects()[i];
+    if (ob.shape != synth::Object::kBox || ob.hi[2] < 3.f) continue;
+    const float p[3] = {0.5f * (ob.lo[0] + ob.hi[0]), 0.5f * (ob.lo[1] + ob.hi[1]), ob.hi[2] + 0.25f};
+    synth::Hit hit;
+    ASSERT_TRUE(world.trace(p, down, 1e4f, &hit));
+    if (hit.t > 0.2501f) continue;  // something else sits on top of this box
+    const synth::NearestSurface s = world.nearestSurface(p);
+    // Never farther than the roof below; nearer only where another object's side is closer
+    // (a narrow box beside a taller one).
+    EXPECT_LE(s.distance, 0.25f + 1e-4f) << i;
+    if (std::fabs(s.distance - 0.25f) < 1e-4f) {
+      EXPECT_EQ(s.cls, hit.cls) << i;
+      ++roofs;
+    }
+    ++boxes;
+  }
+  EXPECT_GE(boxes, 10);
+  EXPECT_GE(roofs, boxes * 3 / 4) << boxes;
+  // Open ground: find a point with nothing within 3 m.
+  for (float x = -world.extent() + 2; x < world.extent(); x += 3.7f) {
+    const float p[3] = {x, 0.3f * x, 1.5f};
+    synth::Hit hit;
+    const float top[3] = {p[0], p[1], world.maxHeight() + 5};
+    if (!world.trace(top, down, 1e4f, &hit) || hit.object != -1) continue;
+    const synth::NearestSurface s = world.nearestSurface(p);
+    if (s.object != -1) continue;  // an object's side nearer than the ground
+    EXPECT_FLOAT_EQ(s.distance, 1.5f);
+    EXPECT_EQ(s.cls, hit.cls);
+  }
+  // Inside a box: the nearest face.
+  const synth::Object& ob = world.objects().front();
+  const float inside[3] = {ob.lo[0] + 0.1f, 0.5f * (ob.lo[1] + ob.hi[1]), 0.5f * ob.hi[2]};
+  if (ob.shape == synth::Object::kBox && ob.hi[0] - ob.lo[0] > 0.3f) {
+    EXPECT_LE(world.nearestSurface(inside).distance, 0.1f + 1e-4f);
+  }
+}
+
 TEST(AerialBenchmark, SparsePointsProjectOntoTheirSurfaceInTheWrittenFiles) {
   const auto scene = synth::generate(small(synth::SceneKind::kCountry, 2));
   ASSERT_GE(scene.points.size(), 200u);

@@ -2,6 +2,8 @@
 #include <iostream>
 
 #include "commands.h"
+#include "sadsplat/common/error.h"
+#include "sadsplat/pipeline/cloud_eval.h"
 #include "sadsplat/pipeline/map_products.h"
 #include "sadsplat/pipeline/runs.h"
 
@@ -19,9 +21,20 @@ class EvalCommand : public Command {
                 "score the class map on the map grid instead: against the scene's "
                 "ortho_truth.json (from `sadsplat synth`); writes RUN/ortho_metrics.json");
     c->add_option("--truth", truth_, "--ortho: the ground truth's JSON (default: the scene's)");
+    c->add_flag("--3d", cloud_,
+                "score the per-class cloud in 3D instead: every Gaussian's class against the "
+                "nearest true surface of a `sadsplat synth` scene's world, distances to it, "
+                "completeness; writes RUN/metrics_3d.json");
     return c;
   }
   int run(const Invocation&) override {
+    if (cloud_ && ortho_) {
+      throw Error("<eval>", "--3d / --ortho", "one of them per call", "both");
+    }
+    if (cloud_) {
+      std::cout << pipeline::evalCloudRun(run_);
+      return 0;
+    }
     if (ortho_) {
       std::cout << pipeline::evalOrthoRun(run_, truth_);
       return 0;
@@ -33,6 +46,7 @@ class EvalCommand : public Command {
  private:
   std::string run_, scene_, truth_;
   bool ortho_ = false;
+  bool cloud_ = false;
 };
 
 }  // namespace

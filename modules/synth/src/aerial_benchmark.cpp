@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -452,6 +453,7 @@ OrthoTruth orthoTruth(const World& world, double gsd) {
   t.y0 = e;
   t.width = t.height = static_cast<int>(std::ceil(2 * e / gsd));
   t.classes.assign(static_cast<std::size_t>(t.width) * t.height, 255);
+  t.heights.assign(t.classes.size(), std::numeric_limits<float>::quiet_NaN());
   const float down[3] = {0.f, 0.f, -1.f};
   const float top = world.maxHeight() + 10.f;
   for (int j = 0; j < t.height; ++j) {
@@ -461,6 +463,7 @@ OrthoTruth orthoTruth(const World& world, double gsd) {
       Hit hit;
       if (world.trace(origin, down, top + 100.f, &hit)) {
         t.classes[static_cast<std::size_t>(j) * t.width + i] = hit.cls;
+        t.heights[static_cast<std::size_t>(j) * t.width + i] = hit.p[2];
       }
     }
   }

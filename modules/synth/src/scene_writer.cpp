@@ -129,7 +129,8 @@ void writeScene(const SynthScene& scene, const std::string& dir, ColmapFormat co
         << "{\n  \"frame\": \"scene (metres, z up)\",\n  \"gsd\": " << t.gsd
         << ",\n  \"x0\": " << t.x0 << ",\n  \"y0\": " << t.y0 << ",\n  \"width\": " << t.width
         << ",\n  \"height\": " << t.height
-        << ",\n  \"classes_png\": \"ortho_truth.png\",\n  \"note\": \"class of the topmost surface "
+        << ",\n  \"classes_png\": \"ortho_truth.png\",\n  \"world\": \"" << scene.world
+        << "\",\n  \"note\": \"class of the topmost surface "
            "at each cell centre, 255 = outside the labelled area\"\n}\n";
     io::writeFileAtomically(dir + "/ortho_truth.json",
                             [&](std::ostream& out) { out << json.str(); });

@@ -572,6 +572,75 @@ bool World::occluded(const float origin[3], const float dir[3], float tmax) cons
   return traverse<true>(origin, dir, tmax, &unused);
 }
 
+namespace {
+
+// Distance from p to the surface of an object (boxes exact; ellipsoids along the centre ray).
+float surfaceDistance(const Object& ob, const float p[3]) {
+  if (ob.shape == Object::kBox) {
+    float outside2 = 0, inside = std::numeric_limits<float>::max();
+    bool in = true;
+    for (int k = 0; k < 3; ++k) {
+      const float below = ob.lo[k] - p[k], above = p[k] - ob.hi[k];
+      const float d = std::max(below, above);
+      if (d > 0) {
+        outside2 += d * d;
+        in = false;
+      } else {
+        inside = std::min(inside, -d);
+      }
+    }
+    return in ? inside : std::sqrt(outside2);
+  }
+  float u2 = 0, r2 = 0;
+  float min_radius = std::numeric_limits<float>::max();
+  for (int k = 0; k < 3; ++k) {
+    const float c = 0.5f * (ob.lo[k] + ob.hi[k]), a = std::max(1e-6f, 0.5f * (ob.hi[k] - ob.lo[k]));
+    const float d = p[k] - c;
+    u2 += (d / a) * (d / a);
+    r2 += d * d;
+    min_radius = std::min(min_radius, a);
+  }
+  const float u = std::sqrt(u2);
+  if (u < 1e-6f) return min_radius;
+  return std::fabs(1.f - 1.f / u) * std::sqrt(r2);
+}
+
+}  // namespace
+
+NearestSurface World::nearestSurface(const float p[3]) const {
+  NearestSurface best;
+  best.distance = std::fabs(p[2]);
+  best.cls = ground(p[0], p[1]).cls;
+  best.object = -1;
+  // Objects whose cells lie within the current best distance of p (the grid covers the labelled
+  // area; objects outside it are not listed and not considered).
+  const float r = best.distance;
+  const auto cellOf = [&](float v) {
+    return std::min(cells_per_side_ - 1,
+                    std::max(0, static_cast<int>(std::floor((v + extent_) / cell_))));
+  };
+  if (p[0] + r < -extent_ || p[0] - r > extent_ || p[1] + r < -extent_ || p[1] - r > extent_) {
+    return best;
+  }
+  const int x0 = cellOf(p[0] - r), x1 = cellOf(p[0] + r);
+  const int y0 = cellOf(p[1] - r), y1 = cellOf(p[1] + r);
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const int cell = y * cells_per_side_ + x;
+      for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+        const int index = cell_items_[k];
+        const float d = surfaceDistance(objects_[index], p);
+        if (d < best.distance) {
+          best.distance = d;
+          best.cls = objects_[index].cls;
+          best.object = index;
+        }
+      }
+    }
+  }
+  return best;
+}
+
 GroundSample World::ground(float x, float y) const {
   GroundSample g;
   if (std::fabs(x) > extent_ || std::fabs(y) > extent_) {

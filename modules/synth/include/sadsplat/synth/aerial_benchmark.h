@@ -96,6 +96,7 @@ struct OrthoTruth {
   double x0 = 0, y0 = 0;
   int width = 0, height = 0;
   std::vector<std::uint8_t> classes;  ///< row-major, 255 = outside the labelled area
+  std::vector<float> heights;  ///< row-major: z of that topmost surface (the true DSM), NaN = none
 };
 
 /// \brief "synth:KIND:SEED:TILES": names a generated world; toScene stores it as the scene's

@@ -64,6 +64,13 @@ struct Hit {
   float color[3] = {0, 0, 0};  ///< base colour before texture and light
 };
 
+/// \brief The true surface nearest to a point (World::nearestSurface).
+struct NearestSurface {
+  float distance = 0;    ///< metres from the point to the surface
+  std::uint8_t cls = 0;  ///< its class id, 255 = outside the labelled area
+  int object = -1;       ///< index into World::objects (its instance), -1 = ground
+};
+
 /// \brief Ground class and base colour at a point of the z = 0 plane.
 struct GroundSample {
   std::uint8_t cls = 255;
@@ -95,6 +102,10 @@ class World {
   bool occluded(const float origin[3], const float dir[3], float tmax) const;
   /// \brief The ground at (x, y).
   GroundSample ground(float x, float y) const;
+  /// \brief The nearest true surface to `p`: the ground plane or an object's surface (a box's
+  /// faces exactly; an ellipsoid's along the ray from its centre, exact for spheres). Faces that
+  /// touch the ground (a box's bottom) count as surfaces too.
+  NearestSurface nearestSurface(const float p[3]) const;
 
  private:
   void buildCity();

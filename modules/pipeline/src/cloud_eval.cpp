@@ -1,0 +1,114 @@
+#include "sadsplat/pipeline/cloud_eval.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/eval/cloud_scores.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
+#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/synth/aerial_benchmark.h"
+
+namespace sadsplat {
+namespace pipeline {
+namespace {
+
+// The true top surface, sampled on a map grid of this spacing (metres).
+constexpr double kSurfaceSpacing = 0.5;
+
+nlohmann::json perClass(const std::vector<ClassInfo>& classes, const std::vector<double>& values) {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t c = 0; c < classes.size() && c < values.size(); ++c) {
+    j[classes[c].name] = values[c] < 0 ? nlohmann::json(nullptr) : nlohmann::json(values[c]);
+  }
+  return j;
+}
+
+}  // namespace
+
+std::string evalCloudRun(const std::string& run_dir) {
+  OpenedRun run = openRun(run_dir);
+  const int C = run.trainer->numClasses();
+  if (C == 0) {
+    throw Error(run_dir, "model", "a semantic model (classes) to score in 3D", "no classes");
+  }
+  // The world: named by a synth scene cache's source, or by a synth scene directory's
+  // ortho_truth.json.
+  std::string world_id = run.scene.source;
+  std::optional<synth::World> world = synth::worldFromId(world_id);
+  const std::string dir = sceneDirectoryOf(run);
+  if (!world && !dir.empty() && io::optionalFileExists(dir + "/ortho_truth.json")) {
+    const nlohmann::json t = nlohmann::json::parse(io::readWholeFile(dir + "/ortho_truth.json"),
+                                                   nullptr, /*allow_exceptions=*/false);
+    if (t.is_object() && t.contains("world") && t["world"].is_string()) {
+      world_id = t["world"].get<std::string>();
+      world = synth::worldFromId(world_id);
+    }
+  }
+  if (!world) {
+    throw Error(run.scene_path, "source",
+                "a scene made by `sadsplat synth` (its world is the 3D truth)",
+                "\"" + run.scene.source.substr(0, 80) + "\"");
+  }
+  // The cloud as PCL users take it: model_semantic's class per Gaussian.
+  const auto cloud = run.trainer->toCloud();
+  const auto semantic = toSemanticCloud(cloud, run.scene.classes);
+  std::vector<eval::CloudPoint> points(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    points[i].xyz = {cloud[i].x, cloud[i].y, cloud[i].z};
+    points[i].cls = semantic[i].label < static_cast<std::uint32_t>(C)
+                        ? static_cast<int>(semantic[i].label)
+                        : -1;
+    points[i].opacity = 1.f / (1.f + std::exp(-cloud[i].opacity));
+  }
+  const eval::NearestTruthSurface truth = [&](const std::array<float, 3>& p) {
+    const synth::NearestSurface s = world->nearestSurface(p.data());
+    return eval::TruthSurface{s.distance, s.cls};
+  };
+  const synth::OrthoTruth top = synth::orthoTruth(*world, kSurfaceSpacing);
+  std::vector<eval::SurfaceSample> surface;
+  for (int j = 0; j < top.height; ++j) {
+    for (int i = 0; i < top.width; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * top.width + i;
+      if (top.classes[k] >= C || !std::isfinite(top.heights[k])) continue;
+      surface.push_back({{static_cast<float>(top.x0 + (i + 0.5) * top.gsd),
+                          static_cast<float>(top.y0 - (j + 0.5) * top.gsd), top.heights[k]},
+                         top.classes[k]});
+    }
+  }
+  eval::CloudScoreOptions options;
+  options.num_classes = C;
+  const eval::CloudScores s = eval::scoreCloud(points, truth, surface, options);
+
+  nlohmann::json j;
+  j["truth"] = world_id + " (nearest true surface; top surface every " +
+               std::to_string(kSurfaceSpacing).substr(0, 3) + " m)";
+  j["gaussians"] = cloud.size();
+  j["scored"] = s.points;
+  j["point_miou"] = s.miou;
+  j["point_oacc"] = s.oacc;
+  j["point_iou"] = perClass(run.scene.classes, s.iou);
+  j["weighted_miou"] = s.weighted_miou;
+  j["weighted_oacc"] = s.weighted_oacc;
+  j["weighted_iou"] = perClass(run.scene.classes, s.weighted_iou);
+  j["opaque_at"] = options.opaque;
+  j["opaque"] = s.opaque;
+  j["distance_median_m"] = s.median_metres;
+  j["distance_p90_m"] = s.p90_metres;
+  j["distance_median_all_m"] = s.median_all_metres;
+  j["distance_p90_all_m"] = s.p90_all_metres;
+  j["share_within_" + std::to_string(options.near_metres).substr(0, 3) + "_m"] = s.share_near;
+  j["share_beyond_" + std::to_string(options.far_metres).substr(0, 3) + "_m"] = s.share_far;
+  j["completeness_within_m"] = options.complete_metres;
+  j["completeness"] = perClass(run.scene.classes, s.completeness);
+  j["completeness_all"] = s.completeness_all;
+  const std::string text = j.dump(2) + "\n";
+  io::writeFileAtomically(run_dir + "/metrics_3d.json", [&](std::ostream& out) { out << text; });
+  return text;
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat
