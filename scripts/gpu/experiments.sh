@@ -15,7 +15,8 @@
 #       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
-#       scenes); $OUT gets scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
+#       scenes), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); $OUT gets
+#       scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
 #       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
 #       summary says at which iteration it stopped). The deadline counts from the call's start
 #       (lib.sh's CALL_START), a fresh machine's build (~100-140 s) and scene making included:
@@ -274,7 +275,9 @@ mode_scene() {
         --out "$work/run_$name" $flags > "$work/results/train_$name.log" 2>&1 &&
         "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" &&
         { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho \
-            > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } || {
+            > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } &&
+        { [ "${THREED:-0}" = 0 ] || "$bin" eval "$work/run_$name" --3d \
+            > "$work/results/3d_$name.json" 2>> "$work/results/eval_$name.log"; } || {
         echo "$name: stopped (rc $?)"
         # A training stopped at the deadline leaves its checkpoint: evaluate the model as it was
         # (metrics.json says at which iteration), so that a run too long for the call still says
@@ -301,6 +304,8 @@ mode_scene() {
     fi
     f="$work/results/ortho_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
+    f="$work/results/3d_$name.json"
+    [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    3d: point mIoU %.2f (weighted %.2f)  OA %.2f  opaque %d of %d: median %.2f m, p90 %.2f m, within 0.5 m %.1f %%, beyond 1 m %.1f %%  completeness %.1f %% (%s)" % (100*m["point_miou"], 100*m["weighted_miou"], 100*m["point_oacc"], m["opaque"], m["gaussians"], m["distance_median_m"], m["distance_p90_m"], 100*m["share_within_0.5_m"], 100*m["share_beyond_1.0_m"], 100*m["completeness_all"], " ".join("%s %.0f" % (k, 100*v) for k, v in m["completeness"].items() if v is not None)))' "$f" >> "$summary"
     f="$work/results/train_$name.log"
     if [ -f "$f" ]; then
       echo "    flags: ${spec#*:}; $(train_summary "$f"); drops: $(tr '\r' '\n' < "$f" | grep -c '^\[drop\]')" >> "$summary"
