@@ -278,6 +278,14 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_NE(out.find("\"cells\": 640000"), std::string::npos) << out;  // 200 m at 0.25 m
   EXPECT_NE(out.find("\"miou\""), std::string::npos) << out;
   EXPECT_TRUE(io::pathExists(run() + "/ortho_metrics.json"));
+  // The DSM against the world's true top surface (ortho_truth.json names the world), all cells
+  // and per class.
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(run() + "/ortho_metrics.json"));
+  ASSERT_TRUE(j.contains("dsm")) << out;
+  EXPECT_GT(j["dsm"]["cells"].get<int>(), 100000) << out;
+  EXPECT_GT(j["dsm"]["rmse_m"].get<double>(), 0.0);
+  EXPECT_LE(j["dsm"]["median_abs_m"].get<double>(), j["dsm"]["rmse_m"].get<double>() * 3);
+  EXPECT_TRUE(j["dsm"]["per_class"]["building"].contains("rmse_m")) << out;
 }
 
 TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {

@@ -15,8 +15,8 @@
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/atomic_file.h"
-#include "sadsplat/io/output_set.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/output_set.h"
 #include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/synth/aerial_benchmark.h"
@@ -273,6 +273,25 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     }
     truth = png.bytes;
   }
+  // The true DSM (the height of that topmost surface) where the world is known: traced on the
+  // same grid (a synth cache names its world; a synth directory's ortho_truth.json does).
+  std::vector<float> true_heights;
+  {
+    std::optional<synth::World> dsm_world = world;
+    if (!dsm_world && io::isRegularFile(truth_json)) {
+      const nlohmann::json t =
+          nlohmann::json::parse(io::readWholeFile(truth_json), nullptr, /*allow_exceptions=*/false);
+      if (t.is_object() && t.contains("world") && t["world"].is_string()) {
+        dsm_world = synth::worldFromId(t["world"].get<std::string>());
+      }
+    }
+    if (dsm_world) {
+      synth::OrthoTruth t = synth::orthoTruth(*dsm_world, grid.gsd);
+      if (t.width == grid.width && t.height == grid.height && t.x0 == grid.x0 && t.y0 == grid.y0) {
+        true_heights = std::move(t.heights);
+      }
+    }
+  }
   grid.top = orthoTop(*run.trainer, grid.frame);
   const OrthoImages img = renderOrtho(*run.trainer, grid);
   const int C = run.trainer->numClasses();
@@ -319,6 +338,38 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   }
   j["per_class_iou"] = per_class;
   j["area"] = area;
+  // DSM error (the rendered elevation against the true top surface's height) over covered cells
+  // of the labelled area, all and per true class: roofs, ground, vegetation apart.
+  if (!true_heights.empty()) {
+    std::vector<std::vector<float>> errors(C + 1);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      const std::uint8_t g = truth[i];
+      if (g >= C || !img.covered[i] || !std::isfinite(true_heights[i]) ||
+          !std::isfinite(img.elevation[i])) {
+        continue;
+      }
+      const float e = img.elevation[i] - true_heights[i];
+      errors[g].push_back(e);
+      errors[C].push_back(e);
+    }
+    const auto summary = [](std::vector<float> e) {
+      nlohmann::json d;
+      d["cells"] = e.size();
+      if (e.empty()) return d;
+      double sq = 0;
+      for (float v : e) sq += double(v) * v;
+      d["rmse_m"] = std::sqrt(sq / e.size());
+      for (float& v : e) v = std::fabs(v);
+      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
+      d["median_abs_m"] = e[e.size() / 2];
+      return d;
+    };
+    nlohmann::json dsm = summary(errors[C]);
+    nlohmann::json dsm_class = nlohmann::json::object();
+    for (int c = 0; c < C; ++c) dsm_class[run.scene.classes[c].name] = summary(errors[c]);
+    dsm["per_class"] = dsm_class;
+    j["dsm"] = dsm;
+  }
   const std::string text = j.dump(2) + "\n";
   writeTextFile(run_dir + "/ortho_metrics.json", text);
   return text;
