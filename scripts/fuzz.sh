@@ -20,7 +20,8 @@ fi
 seconds=${1:?usage: fuzz.sh SECONDS_PER_TARGET [TARGET ...]}
 shift
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(gaussian_ply pcd splat_formats scene_cache colmap json train_config checkpoint label_png)
+[ ${#targets[@]} -gt 0 ] || targets=(gaussian_ply pcd splat_formats scene_cache colmap json train_config checkpoint label_png
+                                  las georeference transforms_json annotations photo)
 if [ ! -f build-fuzz/build.ninja ]; then
   CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DSADSPLAT_BUILD_FUZZERS=ON -DSADSPLAT_BUILD_TESTS=OFF -DSADSPLAT_WITH_VTK=OFF \
