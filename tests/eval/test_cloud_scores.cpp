@@ -59,6 +59,13 @@ TEST(CloudScores, ClassesDistancesAndCompletenessOfAHandMadeWorld) {
   EXPECT_NEAR(s.p90_metres, 2.0, 1e-6);
   EXPECT_NEAR(s.share_near, 0.75, 1e-9);
   EXPECT_NEAR(s.share_far, 0.25, 1e-9);
+  // Per class of the nearest surface (opaque only): class 0 has A (0.1) and E (0.0), class 1
+  // has D (2.0), class 2 has C (0.3).
+  EXPECT_EQ(s.opaque_per_class, (std::vector<std::size_t>{2, 1, 1}));
+  EXPECT_NEAR(s.median_per_class[1], 2.0, 1e-6);
+  EXPECT_NEAR(s.share_far_per_class[0], 0.0, 1e-9);
+  EXPECT_NEAR(s.share_far_per_class[1], 1.0, 1e-9);
+  EXPECT_EQ(s.confusion, (std::vector<std::size_t>{1, 0, 0, 1, 1, 0, 0, 0, 1}));
   // Over all five: 0.1, 0.2, 0.3, 2.0, 0.0 -> median 0.2, 90th 2.0.
   EXPECT_NEAR(s.median_all_metres, 0.2, 1e-6);
   EXPECT_NEAR(s.p90_all_metres, 2.0, 1e-6);

@@ -54,6 +54,8 @@ CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruth
   CloudScores s;
   std::vector<double> plain(static_cast<std::size_t>(n) * n, 0.0), weighted(plain);
   std::vector<float> distances, all_distances;
+  std::vector<std::vector<float>> class_distances(n);
+  s.confusion.assign(static_cast<std::size_t>(n) * n, 0);
   std::size_t near = 0, far = 0;
   // Opaque centres in a voxel hash of the completeness distance, for the coverage of the truth.
   const float voxel = o.complete_metres;
@@ -68,6 +70,7 @@ CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruth
     if (p.cls >= 0 && p.cls < n && t.cls < n) {
       ++s.points;
       plain[static_cast<std::size_t>(t.cls) * n + p.cls] += 1.0;
+      ++s.confusion[static_cast<std::size_t>(t.cls) * n + p.cls];
       weighted[static_cast<std::size_t>(t.cls) * n + p.cls] += p.opacity;
     }
     if (p.opacity >= o.opaque) {
@@ -75,6 +78,7 @@ CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruth
       distances.push_back(t.distance);
       near += t.distance <= o.near_metres;
       far += t.distance > o.far_metres;
+      if (t.cls < n) class_distances[t.cls].push_back(t.distance);
       opaque_at.emplace(key(p.xyz[0], p.xyz[1], p.xyz[2]), p.xyz);
     }
   }
@@ -82,6 +86,18 @@ CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruth
   s.weighted_iou = iouOf(weighted, n, &s.weighted_miou, &s.weighted_oacc);
   s.median_metres = quantile(distances, 0.5);
   s.p90_metres = quantile(distances, 0.9);
+  s.opaque_per_class.assign(n, 0);
+  s.median_per_class.assign(n, -1.0);
+  s.share_far_per_class.assign(n, -1.0);
+  for (int c = 0; c < n; ++c) {
+    const auto& d = class_distances[c];
+    s.opaque_per_class[c] = d.size();
+    if (d.empty()) continue;
+    s.median_per_class[c] = quantile(d, 0.5);
+    s.share_far_per_class[c] =
+        double(std::count_if(d.begin(), d.end(), [&](float v) { return v > o.far_metres; })) /
+        d.size();
+  }
   s.median_all_metres = quantile(all_distances, 0.5);
   s.p90_all_metres = quantile(all_distances, 0.9);
   s.share_near = s.opaque ? double(near) / s.opaque : 0.0;

@@ -102,6 +102,15 @@ std::string evalCloudRun(const std::string& run_dir) {
   j["distance_p90_all_m"] = s.p90_all_metres;
   j["share_within_" + std::to_string(options.near_metres).substr(0, 3) + "_m"] = s.share_near;
   j["share_beyond_" + std::to_string(options.far_metres).substr(0, 3) + "_m"] = s.share_far;
+  j["distance_median_per_class_m"] = perClass(run.scene.classes, s.median_per_class);
+  j["share_beyond_1.0_m_per_class"] = perClass(run.scene.classes, s.share_far_per_class);
+  nlohmann::json confusion = nlohmann::json::array();
+  for (int t = 0; t < C; ++t) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int p = 0; p < C; ++p) row.push_back(s.confusion[static_cast<std::size_t>(t) * C + p]);
+    confusion.push_back(row);
+  }
+  j["confusion"] = confusion;  // rows: the nearest true surface's class; columns: the Gaussian's
   j["completeness_within_m"] = options.complete_metres;
   j["completeness"] = perClass(run.scene.classes, s.completeness);
   j["completeness_all"] = s.completeness_all;

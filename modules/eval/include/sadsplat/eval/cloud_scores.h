@@ -54,6 +54,12 @@ struct CloudScores {
   double median_metres = 0, p90_metres = 0;     ///< distance of opaque centres to the truth
   double share_near = 0, share_far = 0;         ///< of opaque Gaussians: <= near, > far
   double median_all_metres = 0, p90_all_metres = 0;  ///< the same over every Gaussian
+  /// Per class of the nearest true surface: the opaque Gaussians there, their median distance,
+  /// and the share beyond far_metres (-1 where none).
+  std::vector<std::size_t> opaque_per_class;
+  std::vector<double> median_per_class, share_far_per_class;
+  /// Gaussians counted once, row = the nearest true surface's class, column = the Gaussian's.
+  std::vector<std::size_t> confusion;
   std::vector<double> completeness;  ///< per class: share of its surface samples covered; -1 none
   std::vector<std::size_t> samples;  ///< per class: surface samples
   double completeness_all = 0;       ///< over all scored samples
