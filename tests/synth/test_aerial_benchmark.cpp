@@ -352,5 +352,47 @@ TEST(AerialBenchmark, TheGridCaptureFliesNadirLinesWithTheStatedOverlap) {
   EXPECT_THROW(synth::captureFromName("spiral"), Error);
 }
 
+// Grid-oblique: the first half nadir on the grid, the second half on four passes at the same
+// altitude pitched 45 degrees towards north, east, south and west in turn.
+TEST(AerialBenchmark, TheGridObliqueCaptureAddsFourPassesPitched45Degrees) {
+  synth::SynthOptions o = synth::SynthOptions::demo(synth::SceneKind::kCity, 3);
+  o.capture = synth::Capture::kGridOblique;
+  o.views = 40;
+  o.width = 160;
+  o.height = 90;
+  o.max_points = 500;
+  EXPECT_EQ(synth::nadirViews(o), 20);
+  const synth::GridLayout g = synth::gridLayout(o);
+  EXPECT_NEAR(g.forward_overlap, 0.75, 1e-9);
+  const synth::SynthScene scene = synth::generate(o);
+  ASSERT_EQ(scene.views.size(), 40u);
+  int towards[4] = {0, 0, 0, 0};  // north, east, south, west
+  for (int i = 0; i < 40; ++i) {
+    const auto& c = scene.views[i].camera;
+    const Eigen::Matrix3d R =
+        Eigen::Quaterniond(c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]).normalized().toRotationMatrix();
+    const Eigen::Vector3d centre = -R.transpose() * Eigen::Vector3d(c.tvec[0], c.tvec[1], c.tvec[2]);
+    const Eigen::Vector3d viewing = R.transpose() * Eigen::Vector3d::UnitZ();
+    const double off_nadir = std::acos(-viewing.z()) * 180 / M_PI;
+    EXPECT_NEAR(centre.z(), g.altitude, 1.0) << i;
+    if (i < 20) {
+      EXPECT_LT(off_nadir, 1.0) << i;
+      continue;
+    }
+    EXPECT_NEAR(off_nadir, synth::kObliquePitchDeg, 0.5) << i;
+    const int k = (i - 20) % 4;
+    const Eigen::Vector2d expected[4] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+    EXPECT_GT(viewing.head<2>().normalized().dot(expected[k]), 0.999) << i;
+    // It looks at the labelled area: the ray through the image centre meets the ground inside.
+    const Eigen::Vector3d ground = centre - centre.z() / viewing.z() * viewing;
+    EXPECT_LE(std::abs(ground.x()), 100.0) << i;
+    EXPECT_LE(std::abs(ground.y()), 100.0) << i;
+    ++towards[k];
+  }
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(towards[k], 5) << k;
+  EXPECT_EQ(synth::captureFromName("grid-oblique"), synth::Capture::kGridOblique);
+  EXPECT_EQ(synth::captureName(synth::Capture::kGridOblique), "grid-oblique");
+}
+
 }  // namespace
 }  // namespace sadsplat

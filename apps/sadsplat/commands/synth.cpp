@@ -25,9 +25,10 @@ class SynthCommand : public Command {
                   "of 1600x900)");
     c->add_option("--views", views_, "number of views (70)");
     c->add_option("--capture", capture_,
-                  "orbit (oblique views around the scene, the paper's) or grid (a nadir "
-                  "drone-mapping mission, 75 % forward overlap)")
-        ->check(CLI::IsMember({"orbit", "grid"}))
+                  "orbit (oblique views around the scene, the paper's), grid (a nadir "
+                  "drone-mapping mission, 75 % forward overlap) or grid-oblique (half the views "
+                  "on that grid, half on four passes pitched 45 degrees to N, E, S, W)")
+        ->check(CLI::IsMember({"orbit", "grid", "grid-oblique"}))
         ->capture_default_str();
     c->add_option("--width", width_, "image width (1600)");
     c->add_option("--height", height_, "image height (900)");
@@ -59,8 +60,12 @@ class SynthCommand : public Command {
     const synth::SynthOptions o = options();
     std::cout << "generating " << kind_ << " seed " << seed_ << ": " << o.views << " views of "
               << o.width << "x" << o.height << " (" << capture_ << ")";
-    if (o.capture == synth::Capture::kGrid) {
+    if (o.capture != synth::Capture::kOrbit) {
       const synth::GridLayout g = synth::gridLayout(o);
+      if (o.capture == synth::Capture::kGridOblique) {
+        std::cout << ": " << synth::nadirViews(o) << " nadir + " << o.views - synth::nadirViews(o)
+                  << " oblique (" << synth::kObliquePitchDeg << " deg, 4 passes)";
+      }
       std::cout << ": " << g.lines << " lines of " << g.per_line << " photos at " << g.altitude
                 << " m, overlap " << 100 * g.forward_overlap << " % forward, "
                 << 100 * g.side_overlap << " % side";

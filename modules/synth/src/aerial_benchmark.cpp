@@ -94,7 +94,49 @@ Pose gridPose(const World& world, const SynthOptions& o, int i) {
   return p;
 }
 
+// An oblique pass of a grid-oblique capture: photo j of pass `direction` (0 north, 1 east,
+// 2 south, 3 west) flies the grid of a quarter of the oblique views at the nadir grid's altitude,
+// the camera pitched kObliquePitchDeg from nadir towards `direction`, its footprint centred on
+// the grid position.
+Pose obliquePose(const World& world, const SynthOptions& o, int i) {
+  const int nadir = nadirViews(o), oblique = o.views - nadir;
+  const int direction = (i - nadir) % 4, j = (i - nadir) / 4;
+  SynthOptions pass = o;
+  pass.capture = Capture::kGrid;
+  pass.views = std::max(2, (oblique + 3) / 4);
+  Pose p = gridPose(world, pass, std::min(j, pass.views - 1));
+  p.centre.z = static_cast<float>(gridLayout(o).altitude + (p.centre.z - gridLayout(pass).altitude));
+  const double pitch = kObliquePitchDeg * kPi / 180.0;
+  const double azimuth = kPi / 2 - direction * kPi / 2;  // north = +y, east = +x
+  const Vec3 toward = {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)),
+                       0.f};
+  // Flown offset against the look direction, so that each photo's footprint centre lies over
+  // its grid position (as oblique mission planners widen the flown area): the passes look at
+  // the labelled area, not past its edge.
+  const float offset = static_cast<float>(p.centre.z * std::tan(pitch));
+  p.centre.x -= toward.x * offset;
+  p.centre.y -= toward.y * offset;
+  const Vec3 forward = normalize({static_cast<float>(std::sin(pitch) * toward.x),
+                                  static_cast<float>(std::sin(pitch) * toward.y),
+                                  static_cast<float>(-std::cos(pitch))});
+  const Vec3 right = normalize(cross(forward, {0, 0, 1}));
+  const Vec3 down = cross(forward, right);
+  p.rows[0] = right;
+  p.rows[1] = down;
+  p.rows[2] = forward;
+  return p;
+}
+
 Pose viewPose(const World& world, const SynthOptions& o, int i) {
+  if (o.capture == Capture::kGridOblique) {
+    if (i < nadirViews(o)) {
+      SynthOptions nadir = o;
+      nadir.capture = Capture::kGrid;
+      nadir.views = nadirViews(o);
+      return gridPose(world, nadir, i);
+    }
+    return obliquePose(world, o, i);
+  }
   return o.capture == Capture::kGrid ? gridPose(world, o, i) : orbitPose(world, o, i);
 }
 
@@ -372,15 +414,25 @@ void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthSc
 
 }  // namespace
 
-std::string captureName(Capture capture) { return capture == Capture::kGrid ? "grid" : "orbit"; }
+std::string captureName(Capture capture) {
+  return capture == Capture::kGrid ? "grid" : capture == Capture::kGridOblique ? "grid-oblique"
+                                                                               : "orbit";
+}
 
 Capture captureFromName(const std::string& name) {
   if (name == "orbit") return Capture::kOrbit;
   if (name == "grid") return Capture::kGrid;
-  throw Error("<synth>", "--capture", "orbit or grid", name);
+  if (name == "grid-oblique") return Capture::kGridOblique;
+  throw Error("<synth>", "--capture", "orbit, grid or grid-oblique", name);
 }
 
-GridLayout gridLayout(const SynthOptions& o) {
+int nadirViews(const SynthOptions& o) {
+  return o.capture == Capture::kGridOblique ? std::max(2, o.views / 2) : o.views;
+}
+
+GridLayout gridLayout(const SynthOptions& options) {
+  SynthOptions o = options;
+  o.views = nadirViews(options);
   GridLayout g;
   const double tan_h = std::tan(o.horizontal_fov_deg * kPi / 360.0);
   const double tan_v = tan_h * o.height / o.width;

@@ -19,9 +19,14 @@ namespace synth {
 enum class Capture {
   kOrbit,  ///< the paper's: oblique views on an orbit around the scene (pitch 28-56 degrees)
   kGrid,   ///< a drone-mapping mission: nadir photos on parallel lines (75 % forward overlap)
+  /// The grid flown by the first half of the views, then four oblique passes by the other half:
+  /// the same kind of lines at the same altitude, the camera pitched 45 degrees from nadir
+  /// towards north, east, south and west in turn (view nadir + k: pass k % 4), each photo flown
+  /// one altitude back from its grid position so that it looks at it.
+  kGridOblique,
 };
 
-/// \brief "orbit" or "grid".
+/// \brief "orbit", "grid" or "grid-oblique".
 std::string captureName(Capture capture);
 /// \brief The capture a name gives. \throws sadsplat::Error for another name
 Capture captureFromName(const std::string& name);
@@ -67,8 +72,14 @@ struct GridLayout {
   double forward_overlap = 0;  ///< share of a photo's footprint the next one sees (flat ground)
   double side_overlap = 0;     ///< the same between neighbouring lines
 };
-/// \brief The layout Capture::kGrid flies for `options` (its world's extent).
+/// \brief The layout Capture::kGrid flies for `options` (its world's extent); for
+/// Capture::kGridOblique the layout of its nadir half (the oblique passes fly the layout of a
+/// quarter of the other half each, at the nadir half's altitude).
 GridLayout gridLayout(const SynthOptions& options);
+/// \brief Views flown nadir: all of a grid capture, the first half of a grid-oblique one.
+int nadirViews(const SynthOptions& options);
+/// \brief The pitch from nadir of the oblique passes of Capture::kGridOblique (degrees).
+constexpr double kObliquePitchDeg = 45.0;
 
 /// \brief One generated view.
 struct SynthView {
