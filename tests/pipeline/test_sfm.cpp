@@ -144,8 +144,8 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
   // 0.26-0.44 m. Since the GPS frame is a horizontal similarity plus a median altitude offset
   // (gps_georeference), seven runs on one machine, 2026-11-28: worst position 0.51 / 0.57 /
   // 0.71 / 0.72 / 1.32 / 1.37 m (one more above 1 m, not printed), rotations 0.25-0.56 degrees at
-  // the median, so the position bound is 2 % (it was 1 %, which two runs in seven missed). A wrong frame (axes
-  // swapped or mirrored, a bad fit) is tens of metres and degrees off.
+  // the median, so the position bound is 2 % (it was 1 %, which two runs in seven missed). A
+  // wrong frame (axes swapped or mirrored, a bad fit) is tens of metres and degrees off.
   EXPECT_LT(worst_position, 0.02 * radius);
   EXPECT_LT(median_angle, 2.0 * M_PI / 180);
   EXPECT_LT(worst_angle, 3.0 * M_PI / 180);
