@@ -242,13 +242,7 @@ inline std::vector<unsigned char> labelPngFromBytes(const std::uint8_t* data, st
 // with PNG's signature is written as it is; any other is made into a valid PNG first
 // (labelPngFromBytes).
 inline void fuzz_label_png(const std::uint8_t* data, std::size_t size) {
-  static const std::string scene = [] {
-    const std::string dir = fuzz::inputFile("scene");
-    std::filesystem::remove_all(dir);
-    std::filesystem::copy(std::string(SADSPLAT_SOURCE_DIR) + "/data/tiny_scene", dir,
-                          std::filesystem::copy_options::recursive);
-    return dir;
-  }();
+  static const std::string scene = fixtureSceneCopy("scene");
   const std::string path = scene + "/labels/view_000.png";
   static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (size >= 8 && std::memcmp(data, kSignature, 8) == 0) {

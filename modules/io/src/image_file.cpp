@@ -192,8 +192,10 @@ class StderrCapture {
 
 }  // namespace
 
-cv::Mat decodeImage(const std::string& path, int imread_flags, const std::string& what) {
-  checkImageBudget(path, what);
+cv::Mat decodeImage(const std::string& path, int imread_flags, const std::string& what,
+                    ImageHeader* header) {
+  const ImageHeader checked = checkImageBudget(path, what);
+  if (header) *header = checked;
   cv::Mat image;
   std::string failure;
   {

@@ -54,16 +54,20 @@ bool JsonField::has(const char* key) const {
   return it != value_->end() && !it->is_null();
 }
 
+std::string JsonField::memberPath(const char* key) const {
+  return field_ == "JSON" ? std::string(key) : field_ + "." + key;
+}
+
 JsonField JsonField::operator[](const char* key) const {
   if (!value_->is_object()) fail(std::string("an object with \"") + key + "\"");
-  const std::string path = field_ == "JSON" ? std::string(key) : field_ + "." + key;
+  const std::string path = memberPath(key);
   const auto it = value_->find(key);
   if (it == value_->end()) throw Error(file_, path, "a value", "missing");
   return JsonField(*it, file_, path);
 }
 
 JsonField JsonField::optional(const char* key) const {
-  const std::string path = field_ == "JSON" ? std::string(key) : field_ + "." + key;
+  const std::string path = memberPath(key);
   if (!value_->is_object()) fail(std::string("an object"));
   const auto it = value_->find(key);
   return JsonField(it == value_->end() ? nullValue() : *it, file_, path);

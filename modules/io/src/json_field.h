@@ -67,6 +67,9 @@ class JsonField {
   std::string shown() const;
 
  private:
+  // The field path of member `key` ("frames[3].fl_x"; a root member is its key alone).
+  std::string memberPath(const char* key) const;
+
   const nlohmann::json* value_;
   std::string file_;
   std::string field_;

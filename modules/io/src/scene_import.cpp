@@ -207,8 +207,8 @@ cv::Mat readUserMask(const std::string& path, const cv::Size& size) {
 }
 
 cv::Mat readLabelMap(const std::string& path, const std::vector<ClassInfo>& classes) {
-  const ImageHeader header = checkImageBudget(path, "PNG label map");
-  cv::Mat raw = decodeImage(path, cv::IMREAD_UNCHANGED, "PNG label map");
+  ImageHeader header;
+  cv::Mat raw = decodeImage(path, cv::IMREAD_UNCHANGED, "PNG label map", &header);
   if (raw.depth() != CV_8U) {
     throw Error(path, "pixel depth", "8-bit label map",
                 "depth code " + std::to_string(raw.depth()));

@@ -8,9 +8,9 @@
 #include "sadsplat/common/semantic_cloud.h"
 #include "sadsplat/eval/cloud_scores.h"
 #include "sadsplat/io/atomic_file.h"
-#include "sadsplat/io/filesystem.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/synth/aerial_benchmark.h"
+#include "truth_world.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -40,13 +40,9 @@ std::string evalCloudRun(const std::string& run_dir) {
   std::string world_id = run.scene.source;
   std::optional<synth::World> world = synth::worldFromId(world_id);
   const std::string dir = sceneDirectoryOf(run);
-  if (!world && !dir.empty() && io::optionalFileExists(dir + "/ortho_truth.json")) {
-    const nlohmann::json t = nlohmann::json::parse(io::readWholeFile(dir + "/ortho_truth.json"),
-                                                   nullptr, /*allow_exceptions=*/false);
-    if (t.is_object() && t.contains("world") && t["world"].is_string()) {
-      world_id = t["world"].get<std::string>();
-      world = synth::worldFromId(world_id);
-    }
+  if (!world && !dir.empty()) {
+    world_id = worldIdInTruthFile(dir + "/ortho_truth.json");
+    world = synth::worldFromId(world_id);
   }
   if (!world) {
     throw Error(run.scene_path, "source",

@@ -20,6 +20,7 @@
 #include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/runs.h"
 #include "sadsplat/synth/aerial_benchmark.h"
+#include "truth_world.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -277,14 +278,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   // same grid (a synth cache names its world; a synth directory's ortho_truth.json does).
   std::vector<float> true_heights;
   {
-    std::optional<synth::World> dsm_world = world;
-    if (!dsm_world && io::isRegularFile(truth_json)) {
-      const nlohmann::json t =
-          nlohmann::json::parse(io::readWholeFile(truth_json), nullptr, /*allow_exceptions=*/false);
-      if (t.is_object() && t.contains("world") && t["world"].is_string()) {
-        dsm_world = synth::worldFromId(t["world"].get<std::string>());
-      }
-    }
+    const std::optional<synth::World> dsm_world =
+        world ? world : synth::worldFromId(worldIdInTruthFile(truth_json));
     if (dsm_world) {
       synth::OrthoTruth t = synth::orthoTruth(*dsm_world, grid.gsd);
       if (t.width == grid.width && t.height == grid.height && t.x0 == grid.x0 && t.y0 == grid.y0) {

@@ -36,6 +36,15 @@ struct Pose {
   Vec3 rows[3];
 };
 
+// The rows of a camera looking along `forward` with its image's x axis level (right = forward x
+// up, down = forward x right); `forward` must not be vertical.
+void lookAlong(const Vec3& forward, Pose* p) {
+  const Vec3 right = normalize(cross(forward, {0, 0, 1}));
+  p->rows[0] = right;
+  p->rows[1] = cross(forward, right);
+  p->rows[2] = forward;
+}
+
 // View i orbits tile i % tiles^2 (the whole world when tiles = 1) as the j-th of its views.
 Pose orbitPose(const World& world, const SynthOptions& o, int i) {
   const std::uint64_t s = o.seed;
@@ -56,12 +65,7 @@ Pose orbitPose(const World& world, const SynthOptions& o, int i) {
   p.centre = {static_cast<float>(tile_x + dist * std::cos(pitch) * std::cos(theta)),
               static_cast<float>(tile_y + dist * std::cos(pitch) * std::sin(theta)),
               static_cast<float>(dist * std::sin(pitch))};
-  const Vec3 forward = normalize(target - p.centre);
-  const Vec3 right = normalize(cross(forward, {0, 0, 1}));
-  const Vec3 down = cross(forward, right);
-  p.rows[0] = right;
-  p.rows[1] = down;
-  p.rows[2] = forward;
+  lookAlong(normalize(target - p.centre), &p);
   return p;
 }
 
@@ -116,14 +120,10 @@ Pose obliquePose(const World& world, const SynthOptions& o, int i) {
   const float offset = static_cast<float>(p.centre.z * std::tan(pitch));
   p.centre.x -= toward.x * offset;
   p.centre.y -= toward.y * offset;
-  const Vec3 forward = normalize({static_cast<float>(std::sin(pitch) * toward.x),
-                                  static_cast<float>(std::sin(pitch) * toward.y),
-                                  static_cast<float>(-std::cos(pitch))});
-  const Vec3 right = normalize(cross(forward, {0, 0, 1}));
-  const Vec3 down = cross(forward, right);
-  p.rows[0] = right;
-  p.rows[1] = down;
-  p.rows[2] = forward;
+  lookAlong(normalize({static_cast<float>(std::sin(pitch) * toward.x),
+                       static_cast<float>(std::sin(pitch) * toward.y),
+                       static_cast<float>(-std::cos(pitch))}),
+            &p);
   return p;
 }
 

@@ -43,8 +43,9 @@ ImageHeader checkImageBudget(const std::string& path, const std::string& what);
 
 #if SADSPLAT_HAVE_OPENCV
 /// \brief cv::imread after checkImageBudget; OpenCV's exceptions and an empty result become one
-/// sadsplat::Error naming the file.
-cv::Mat decodeImage(const std::string& path, int imread_flags, const std::string& what);
+/// sadsplat::Error naming the file. `header` (if given) receives what the header said.
+cv::Mat decodeImage(const std::string& path, int imread_flags, const std::string& what,
+                    ImageHeader* header = nullptr);
 #endif
 
 }  // namespace io
