@@ -196,6 +196,35 @@ TEST_F(MapProducts, OrthoWritesGeoTiffsGdalReadsWithTheGridAndLocalCrs) {
   EXPECT_NEAR(share_sum, 1.0, 1e-4);
 }
 
+// Nodata where too few photos see the surface: a count no cell reaches leaves the map empty,
+// and every cell it took is counted; 0 keeps every covered cell, the default (2) a subset.
+TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
+  const auto covered = [&](const std::string& args, double* few) {
+    std::string out;
+    const std::string dir = dir_->file("ortho_views");
+    EXPECT_EQ(
+        test::runCommand(kCli + " ortho " + run() + " --gsd 1.5 " + args + " --out " + dir, &out),
+        0)
+        << out;
+    const nlohmann::json j = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
+    *few = j["few_views_share"].get<double>();
+    return j["covered_share"].get<double>();
+  };
+  double few_all = 0, few_default = 0, few_none = 0;
+  const double all = covered("--min-views 0", &few_all);
+  const double by_default = covered("", &few_default);
+  const double none = covered("--min-views 100000", &few_none);
+  EXPECT_EQ(few_all, 0.0);
+  EXPECT_GT(all, 0.1);
+  EXPECT_LE(by_default, all);
+  EXPECT_NEAR(by_default + few_default, all, 1e-9);
+  EXPECT_EQ(none, 0.0);
+  EXPECT_NEAR(few_none, all, 1e-9);
+  // The blend through the Gaussians is still there on request.
+  double few_blend = 0;
+  EXPECT_GT(covered("--surface blend --min-views 0", &few_blend), 0.1);
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");
@@ -286,6 +315,8 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_GT(j["dsm"]["rmse_m"].get<double>(), 0.0);
   EXPECT_LE(j["dsm"]["median_abs_m"].get<double>(), j["dsm"]["rmse_m"].get<double>() * 3);
   EXPECT_TRUE(j["dsm"]["per_class"]["building"].contains("rmse_m")) << out;
+  EXPECT_EQ(j["surface"], "first");
+  EXPECT_EQ(j["min_views"], 2);
 }
 
 TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
@@ -323,6 +354,9 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --bounds 5000,5000,5100,5100 --out " + dir_->file("x"),
               "footprint");
   expectError("ortho " + run() + " --bounds 10,10,0,20 --out " + dir_->file("x"), "--bounds");
+  expectError("ortho " + run() + " --surface top --out " + dir_->file("x"), "--surface");
+  expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
+  expectError("eval " + run() + " --ortho --surface top", "--surface");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");
   expectError("render " + run() + " --size 0x5 --out " + dir_->file("x"), "--size");

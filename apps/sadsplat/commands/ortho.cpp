@@ -26,6 +26,14 @@ class OrthoCommand : public Command {
                   "model's footprint)")
         ->delimiter(',')
         ->expected(4);
+    c->add_option("--surface", o_.surface,
+                  "first: each cell shows the first surface its vertical ray meets (where the "
+                  "transmittance falls below 0.5: its height and class); blend: the "
+                  "alpha-weighted blend through every Gaussian on the ray")
+        ->default_val("first");
+    c->add_option("--min-views", o_.min_views,
+                  "cells whose surface fewer training photos see are nodata (0: keep all)")
+        ->default_val(2);
     return c;
   }
   int run(const Invocation&) override {

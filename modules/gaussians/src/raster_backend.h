@@ -13,6 +13,7 @@
 namespace sadsplat {
 namespace gaussians {
 class TileListCapacity;
+struct RasterCamera;
 namespace raster {
 
 /// A camera as the backends take it (double so that it can be stored in autograd contexts).
@@ -24,6 +25,9 @@ struct CameraParams {
   double near_plane = 0.01;
   bool orthographic = false;
 };
+
+/// The backends' form of a camera (rasterizer.cpp).
+CameraParams cameraParams(const RasterCamera& camera);
 
 struct ProjectionResult {
   at::Tensor means2d;  ///< [N, 2]

@@ -21,14 +21,9 @@
 
 namespace sadsplat {
 namespace gaussians {
-namespace {
 
-using raster::CameraParams;
-using torch::autograd::AutogradContext;
-using torch::autograd::variable_list;
-
-raster::CameraParams toParams(const RasterCamera& c) {
-  CameraParams p;
+raster::CameraParams raster::cameraParams(const RasterCamera& c) {
+  raster::CameraParams p;
   const double q[4] = {c.qvec[0], c.qvec[1], c.qvec[2], c.qvec[3]};
   double R[9];
   raster::quatToRotation(q, R);
@@ -44,6 +39,12 @@ raster::CameraParams toParams(const RasterCamera& c) {
   p.orthographic = c.orthographic;
   return p;
 }
+
+namespace {
+
+using raster::CameraParams;
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
 
 std::vector<double> packCamera(const CameraParams& p) {
   std::vector<double> v(p.R.begin(), p.R.end());
@@ -404,7 +405,7 @@ std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Te
   expectTensor(means, "means", n, {3}, means);
   expectTensor(quats, "quats", n, {4}, means);
   expectTensor(log_scales, "log_scales", n, {3}, means);
-  const auto out = ProjectFunction::apply(means, quats, log_scales, packCamera(toParams(camera)));
+  const auto out = ProjectFunction::apply(means, quats, log_scales, packCamera(raster::cameraParams(camera)));
   return {out[0], out[1], out[2], out[3]};
 }
 

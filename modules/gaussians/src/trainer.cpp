@@ -138,11 +138,9 @@ struct Trainer::State {
   at::Tensor decode(const at::Tensor& features) const {
     return at::linear(features, params["decoder_w"].value, params["decoder_b"].value);
   }
-
 };
 
-Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
-    : state_(new State(config)) {
+Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State(config)) {
   State& s = *state_;
   config.check();
   if (config.device == "cuda") {
@@ -171,9 +169,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config)
     }
     random_points = randomPointsInView(cameras, config.init_random_count, config.seed);
   }
-  const GaussianTensors t = fromCloud(
-      initialCloud(random_points.empty() ? scene.points : random_points, init), s.device,
-      s.config.feature_dim);
+  const GaussianTensors t =
+      fromCloud(initialCloud(random_points.empty() ? scene.points : random_points, init), s.device,
+                s.config.feature_dim);
   ParameterStore& p = s.params;
   p.add("means", t.means, config.lr_position_init * s.extent);
   p.add("sh_dc", t.sh_dc, config.lr_sh_dc);
@@ -231,9 +229,8 @@ StepStats Trainer::step(bool read_losses) {
   // and the decoder's gradients any rank of the group has this step.
   const int ranks = s.collective ? s.collective->size() : 1;
   const int batch = c.views_per_step * ranks;
-  const StepViews step_views =
-      drawStepViews(s.views, c, it, s.collective ? s.collective->rank() : 0, ranks,
-                    s.collective != nullptr);
+  const StepViews step_views = drawStepViews(
+      s.views, c, it, s.collective ? s.collective->rank() : 0, ranks, s.collective != nullptr);
   const std::vector<int>& views = step_views.views;
 
   RenderSettings settings;
@@ -366,11 +363,10 @@ StepStats Trainer::step(bool read_losses) {
       stats.removed_closed_gates = s.drop.removeClosedGates(s.params, done, s.resizer());
       if (c.prune_floaters) {
         // Floaters: seen by too few training views, or far larger than the scene's detail.
-        const at::Tensor keep =
-            floaterMask(s.params["means"].value, s.params["scales"].value,
-                        s.views.trainingCameras(), c.floater_min_views,
-                        c.floater_max_scale * s.extent)
-                .logical_not();
+        const at::Tensor keep = floaterMask(s.params["means"].value, s.params["scales"].value,
+                                            s.views.trainingCameras(), c.floater_min_views,
+                                            c.floater_max_scale * s.extent)
+                                    .logical_not();
         stats.removed_floaters = s.params.rows() - keep.sum().item<std::int64_t>();
         if (stats.removed_floaters > 0) s.resize(keep, {});
       }
@@ -421,8 +417,9 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor&
   GaussianParams g = s.evaluationGaussians();
   if (keep.defined()) {
     if (keep.dim() != 1 || keep.size(0) != g.means.size(0)) {
-      throw Error("<render>", "keep mask", "one flag per Gaussian (" +
-                  std::to_string(g.means.size(0)) + ")", std::to_string(keep.numel()));
+      throw Error("<render>", "keep mask",
+                  "one flag per Gaussian (" + std::to_string(g.means.size(0)) + ")",
+                  std::to_string(keep.numel()));
     }
     const at::Tensor k = keep.to(g.means.device(), g.means.scalar_type());
     g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
@@ -437,11 +434,19 @@ at::Tensor Trainer::predictClasses(const RenderResult& r) const {
   return logits.argmax(2);
 }
 
-at::Tensor Trainer::classCosines(const RenderResult& r) const {
+at::Tensor Trainer::classCosines(const RenderResult& r) const { return classCosines(r.features); }
+
+at::Tensor Trainer::classCosines(const at::Tensor& features) const {
   c10::AutoGradMode no_grad(false);
   if (numClasses() == 0) return at::Tensor();
-  const at::Tensor d = state_->decode(r.features);
+  const at::Tensor& w = state_->params["decoder_w"].value;
+  const at::Tensor d = state_->decode(features.to(w.device(), w.scalar_type()));
   return d / d.norm(2, 2, true).clamp_min(1e-12);
+}
+
+SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level) const {
+  c10::AutoGradMode no_grad(false);
+  return renderSurfaceLayer(state_->evaluationGaussians(), camera, level);
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }
@@ -461,9 +466,8 @@ pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
   t.features = p["features"].value.detach();
   t.log_alpha = p["log_alpha"].value.detach();
   t.confidence = s.drop.confidence();
-  t.labels = t.features.size(1) > 0
-                 ? s.decode(t.features).argmax(1)
-                 : at::full({p.rows()}, -1, t.means.options().dtype(at::kLong));
+  t.labels = t.features.size(1) > 0 ? s.decode(t.features).argmax(1)
+                                    : at::full({p.rows()}, -1, t.means.options().dtype(at::kLong));
   return gaussians::toCloud(t);
 }
 

@@ -69,14 +69,18 @@ std::string orthoRun(const OrthoRunOptions& o) {
     throw Error("<ortho>", "--gsd", "a ground sample distance > 0 (metres per pixel)",
                 std::to_string(*o.gsd));
   }
+  const OrthoSurface surface = parseOrthoSurface(o.surface, "--surface");
+  if (o.min_views < 0) {
+    throw Error("<ortho>", "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
+  }
   if (!geo::haveGdal()) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
   }
   // Written as a set: a failure leaves the previous set whole, a rerun replaces all of it.
-  io::OutputSet files(o.out, {"orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png",
-                              "confidence.tif", "confidence.png", "dsm.tif", "dsm.png",
-                              "classes.csv", "ortho.json"});
+  io::OutputSet files(
+      o.out, {"orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png", "confidence.tif",
+              "confidence.png", "dsm.tif", "dsm.png", "classes.csv", "ortho.json"});
   OpenedRun run = openRun(o.run);
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
@@ -84,7 +88,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
     *o.progress << "ortho: " << grid.width << " x " << grid.height << " pixels at " << gsd << " m, "
                 << grid.frame.crs_name << "\n";
   }
-  const OrthoImages img = renderOrtho(*run.trainer, grid, o.progress);
+  const OrthoImages img = renderOrtho(
+      *run.trainer, grid, orthoRenderOptions(run.scene, surface, o.min_views), o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
 
@@ -181,6 +186,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["width"] = grid.width;
   j["height"] = grid.height;
   j["covered_share"] = n ? double(covered) / n : 0.0;
+  j["surface"] = o.surface;
+  j["min_views"] = o.min_views;
+  j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
   j["similarity_fit_residual_m"] = grid.frame.fit_residual;
@@ -221,7 +229,12 @@ std::string orthoRun(const OrthoRunOptions& o) {
   return s.str();
 }
 
-std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in) {
+std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in,
+                         const std::string& surface_text, int min_views) {
+  const OrthoSurface surface = parseOrthoSurface(surface_text, "--surface");
+  if (min_views < 0) {
+    throw Error("<eval>", "--min-views", "a number of photos >= 0", std::to_string(min_views));
+  }
   OpenedRun run = openRun(run_dir);
   if (run.trainer->numClasses() == 0) {
     throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
@@ -288,7 +301,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     }
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
-  const OrthoImages img = renderOrtho(*run.trainer, grid);
+  const OrthoImages img =
+      renderOrtho(*run.trainer, grid, orthoRenderOptions(run.scene, surface, min_views));
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
   std::vector<std::uint8_t> gt;
@@ -314,6 +328,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["truth"] = truth_source;
   j["gsd"] = grid.gsd;
   j["cells"] = labelled;
+  j["surface"] = surface_text;
+  j["min_views"] = min_views;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();

@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/raster_math.h"
+#include "sadsplat/gaussians/view_coverage.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -131,8 +133,53 @@ gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off,
   return cam;
 }
 
+OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface surface, int min_views) {
+  OrthoRenderOptions o;
+  o.surface = surface;
+  o.min_views = min_views;
+  for (const io::View& v : scene.views) {
+    if (v.train) o.cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  return o;
+}
+
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field) {
+  if (text == "first") return OrthoSurface::kFirst;
+  if (text == "blend") return OrthoSurface::kBlend;
+  throw Error("<ortho>", field, "first or blend", text);
+}
+
+namespace {
+
+// World points of the pixels of an orthographic tile at camera depths `depth` ([h, w]): [h w, 3]
+// double.
+at::Tensor backProject(const gaussians::RasterCamera& cam, const at::Tensor& depth) {
+  const int h = cam.height, w = cam.width;
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  const at::Tensor xs = (at::arange(w, opts) + 0.5 - cam.cx) / cam.fx;
+  const at::Tensor ys = (at::arange(h, opts) + 0.5 - cam.cy) / cam.fy;
+  const at::Tensor pc = at::stack({xs.unsqueeze(0).expand({h, w}), ys.unsqueeze(1).expand({h, w}),
+                                   depth.to(at::kDouble)},
+                                  2)
+                            .reshape({-1, 3});
+  // world = R^T p_c + centre (centre = -R^T t)
+  const std::array<double, 3> centre = cam.centre();
+  const double q[4] = {cam.qvec[0], cam.qvec[1], cam.qvec[2], cam.qvec[3]};
+  double R[9];
+  gaussians::raster::quatToRotation(q, R);
+  // Rows: p_c^T R = (R^T p_c)^T.
+  const at::Tensor rotation = at::tensor(std::vector<double>(R, R + 9), opts).view({3, 3});
+  return pc.matmul(rotation) + at::tensor(std::vector<double>(centre.begin(), centre.end()), opts);
+}
+
+}  // namespace
+
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                        std::ostream* progress, int tile) {
+                        const OrthoRenderOptions& options, std::ostream* progress, int tile) {
+  if (options.min_views > 0 && options.cameras.empty()) {
+    throw Error("<ortho>", "cameras", "the training cameras (to count the views of each cell)",
+                "none");
+  }
   OrthoImages out;
   out.width = grid.width;
   out.height = grid.height;
@@ -142,32 +189,52 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   out.classes.assign(pixels, 255);
   out.elevation.assign(pixels, 0.f);
   out.confidence.assign(pixels, 0.f);
+  const bool first = options.surface == OrthoSurface::kFirst;
   const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
   int done = 0;
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       const int x_off = tx * tile, y_off = ty * tile;
       const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
-      const gaussians::RenderResult r = trainer.renderCamera(orthoCamera(grid, x_off, y_off, w, h));
+      const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
+      const gaussians::RenderResult r = trainer.renderCamera(camera);
       const at::Tensor rgb =
           r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
-      const at::Tensor alpha = r.alpha.to(at::kCPU, at::kFloat).contiguous();
-      const at::Tensor depth = r.depth.to(at::kCPU, at::kFloat).contiguous();
-      at::Tensor cls, conf;
+      at::Tensor covered, depth, cls, conf;
+      at::Tensor features = r.features;
+      if (first) {
+        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5);
+        covered = layer.reached;
+        depth = layer.depth;
+        features = layer.features;
+      } else {
+        covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
+        depth = r.depth.to(at::kCPU, at::kFloat);
+      }
+      if (options.min_views > 0) {
+        const at::Tensor counts = gaussians::viewCounts(backProject(camera, depth), options.cameras)
+                                      .view({h, w})
+                                      .to(at::kCPU);
+        const at::Tensor few = covered & (counts < options.min_views);
+        out.few_views += few.sum().item<std::int64_t>();
+        covered = covered & ~few;
+      }
+      covered = covered.to(at::kByte).contiguous();
+      depth = depth.contiguous();
       if (trainer.numClasses() > 0) {
-        const auto best = trainer.classCosines(r).max(2);
+        const auto best = trainer.classCosines(features).max(2);
         conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
         cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
       }
       const auto* prgb = rgb.data_ptr<std::uint8_t>();
-      const float* pa = alpha.data_ptr<float>();
+      const auto* pc = covered.data_ptr<std::uint8_t>();
       const float* pd = depth.data_ptr<float>();
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
           const std::size_t s = static_cast<std::size_t>(y) * w + x;
           const std::size_t d = static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
           for (int c = 0; c < 3; ++c) out.rgb[3 * d + c] = prgb[3 * s + c];
-          if (pa[s] < 0.5f) continue;
+          if (!pc[s]) continue;
           out.covered[d] = 1;
           out.elevation[d] = static_cast<float>(grid.top - pd[s] + grid.frame.height_offset);
           if (cls.defined()) {

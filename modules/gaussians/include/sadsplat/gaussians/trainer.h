@@ -17,6 +17,7 @@
 #include "sadsplat/gaussians/collective.h"
 #include "sadsplat/gaussians/drop_strategy.h"
 #include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/gaussians/surface_layer.h"
 #include "sadsplat/gaussians/step_profile.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/train_config.h"
@@ -108,6 +109,13 @@ class Trainer {
   /// class's embedding; near 1/sqrt(classes): no class stands out). Not a calibrated
   /// probability. Undefined tensor when the model has no classes.
   at::Tensor classCosines(const RenderResult& render) const;
+  /// \brief The same for any feature image [H, W, C] (e.g. SurfaceLayer::features), on the
+  /// device of the model.
+  at::Tensor classCosines(const at::Tensor& features) const;
+  /// \brief The first surface of the current Gaussians through an orthographic camera: where
+  /// the transmittance falls below `level` (surface_layer.h), the Gaussians as renderCamera
+  /// draws them. On the CPU.
+  SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 

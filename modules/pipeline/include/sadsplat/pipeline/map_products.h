@@ -29,8 +29,8 @@ struct RenderRunOptions {
 /// \brief Renders the views; returns the number of images written. Files:
 /// OUT/class/NAME.png (8-bit class ids, 255 = none), OUT/colour/NAME.png (class palette),
 /// OUT/rgb/NAME.png, OUT/depth/NAME.tif (float32 camera z, 0 = none), OUT/confidence/NAME.png
-/// (8-bit, 255 x the decoded class's cosine, Trainer::classCosines), NAME = the image name without extension.
-/// \throws sadsplat::Error for unknown views or outputs, bad sizes, an unwritable OUT
+/// (8-bit, 255 x the decoded class's cosine, Trainer::classCosines), NAME = the image name without
+/// extension. \throws sadsplat::Error for unknown views or outputs, bad sizes, an unwritable OUT
 int renderRun(const RenderRunOptions& options);
 
 /// \brief Options of `sadsplat ortho`.
@@ -40,6 +40,8 @@ struct OrthoRunOptions {
   std::optional<double>
       gsd;  ///< metres per pixel (> 0); none = the photos' median ground sample distance
   std::optional<std::array<double, 4>> bounds;  ///< xmin, ymin, xmax, ymax in the map CRS
+  std::string surface = "first";  ///< --surface first|blend (ortho_render.h, OrthoSurface)
+  int min_views = 2;  ///< --min-views: cells fewer training photos see are nodata (0: off)
   std::ostream* progress = nullptr;
 };
 
@@ -51,8 +53,10 @@ std::string orthoRun(const OrthoRunOptions& options);
 
 /// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's
 /// ortho_truth.json (written by `sadsplat synth`) and scores it: mIoU, per-class IoU, and the
-/// area error per class. Writes RUN/ortho_metrics.json and returns its text.
-std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json = "");
+/// area error per class. The map is rendered as `ortho` renders it with `surface` and
+/// `min_views` (OrthoRunOptions). Writes RUN/ortho_metrics.json and returns its text.
+std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json = "",
+                         const std::string& surface = "first", int min_views = 2);
 
 }  // namespace pipeline
 }  // namespace sadsplat

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "sadsplat/gaussians/rasterizer.h"
@@ -42,21 +43,52 @@ double orthoTop(const gaussians::Trainer& trainer, const geo::MapFrame& frame);
 /// \brief The orthographic camera of the grid's pixels [x_off, x_off + w) x [y_off, y_off + h).
 gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off, int w, int h);
 
+/// \brief Which height and class a map cell shows.
+enum class OrthoSurface {
+  /// The first surface: where the transmittance along the cell's vertical ray falls below 0.5
+  /// (gaussians/surface_layer.h): its height, and the class of the Gaussians in front of it.
+  kFirst,
+  /// The blend through every Gaussian on the ray: the expected depth and the composited class
+  /// feature (a floater or an overhanging edge pulls both towards itself).
+  kBlend,
+};
+
+/// \brief How the map is rendered.
+struct OrthoRenderOptions {
+  OrthoSurface surface = OrthoSurface::kFirst;
+  /// A covered cell whose surface point fewer than this many of `cameras` see (in front of the
+  /// camera, inside its image; occlusion is not tested) is nodata: a surface only one photo
+  /// sees has no depth from the photos (the survey's edges). 0: every covered cell is kept.
+  int min_views = 2;
+  std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
+};
+
 /// \brief What an orthographic render gives per pixel (row-major; `covered` says which pixels
-/// the Gaussians cover: accumulated alpha >= 0.5; the others are nodata).
+/// show a surface: accumulated alpha >= 0.5, seen by at least OrthoRenderOptions::min_views
+/// training cameras; the others are nodata).
 struct OrthoImages {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb;      ///< 3 per pixel
   std::vector<std::uint8_t> covered;  ///< 1 = covered
   std::vector<std::uint8_t>
       classes;                    ///< class id, 255 = none (uncovered, or a model without classes)
-  std::vector<float> elevation;      ///< map height of the rendered surface (expected depth)
+  std::vector<float> elevation;   ///< map height of the rendered surface (OrthoSurface)
   std::vector<float> confidence;  ///< Trainer::classCosines of the class (0 without classes)
+  std::int64_t few_views = 0;     ///< cells with a surface made nodata by min_views
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.
+/// \throws sadsplat::Error for min_views > 0 without cameras
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                        std::ostream* progress = nullptr, int tile = 1024);
+                        const OrthoRenderOptions& options, std::ostream* progress = nullptr,
+                        int tile = 1024);
+
+/// \brief The options for a scene: its training cameras, `surface` and `min_views`.
+OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface surface, int min_views);
+
+/// \brief "first" or "blend" as an OrthoSurface.
+/// \throws sadsplat::Error naming `field` for any other text
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field);
 
 }  // namespace pipeline
 }  // namespace sadsplat

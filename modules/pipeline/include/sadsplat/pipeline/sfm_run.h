@@ -27,8 +27,8 @@ struct SfmOptions {
   /// Longest image side for feature extraction and for the undistorted images (COLMAP's
   /// max_image_size; a 4000x3000 survey photo is then 2000x1500).
   int max_image_size = 2000;
-  bool single_camera = true;      ///< one camera for every photo (one drone, one lens)
-  int threads = -1;               ///< -1: every core
+  bool single_camera = true;  ///< one camera for every photo (one drone, one lens)
+  int threads = -1;           ///< -1: every core
   /// Horizontal GPS accuracy (1 sigma, metres) the georeference starts from; 0: what the photos
   /// state in EXIF, else geo::kDefaultGpsAccuracy. The inlier distance then comes from the
   /// measured noise (geo::fitGpsGeoreference).
