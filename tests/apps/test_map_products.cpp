@@ -337,6 +337,11 @@ TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   EXPECT_LE(j["distance_median_all_m"].get<double>(), j["distance_p90_all_m"].get<double>());
   EXPECT_LE(j["distance_median_m"].get<double>(), j["distance_p90_m"].get<double>());
   EXPECT_TRUE(j["point_iou"].contains("building")) << j.dump();
+  // Buildings as objects: the world's standing buildings are the truth (a city has dozens).
+  ASSERT_TRUE(j.contains("objects")) << j.dump();
+  EXPECT_GT(j["objects"]["true"].get<int>(), 10) << j.dump();
+  EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["true"].get<int>());
+  EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["predicted"].get<int>());
   // A scene that names no generated world has no 3D truth: one line.
   EXPECT_EQ(test::runCommand(kCli + " eval " + run() + " --3d --ortho", &out), 1) << out;
 }

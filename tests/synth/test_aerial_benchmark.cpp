@@ -149,6 +149,32 @@ TEST(AerialBenchmark, TheNearestTrueSurfaceOfAPointIsTheOneATraceFinds) {
   }
 }
 
+TEST(AerialBenchmark, GroundFootprintsAreTheStandingBuildings) {
+  // A city's buildings (class 0) stand on the ground in separate lots: footprints do not
+  // overlap; the rooftop structures are not objects of their own; every footprint's centre lies
+  // in the labelled area and the trace down onto it hits a building.
+  const synth::World world(synth::SceneKind::kCity, 7);
+  const auto footprints = synth::groundFootprints(world, 0);
+  ASSERT_GE(footprints.size(), 10u);
+  int rooftops = 0;
+  for (const synth::Object& ob : world.objects()) rooftops += ob.cls == 0 && ob.lo[2] > 0.01f;
+  EXPECT_GT(rooftops, 0);
+  const float down[3] = {0.f, 0.f, -1.f};
+  for (std::size_t i = 0; i < footprints.size(); ++i) {
+    const synth::ObjectFootprint& f = footprints[i];
+    EXPECT_EQ(world.objects()[f.object].cls, 0);
+    EXPECT_EQ(world.objects()[f.object].lo[2], 0.f);
+    const float top[3] = {0.5f * (f.x0 + f.x1), 0.5f * (f.y0 + f.y1), world.maxHeight() + 5};
+    synth::Hit hit;
+    ASSERT_TRUE(world.trace(top, down, 1e4f, &hit));
+    EXPECT_EQ(hit.cls, 0) << i;
+    for (std::size_t k = i + 1; k < footprints.size(); ++k) {
+      const synth::ObjectFootprint& g = footprints[k];
+      EXPECT_TRUE(f.x1 <= g.x0 || g.x1 <= f.x0 || f.y1 <= g.y0 || g.y1 <= f.y0) << i << " " << k;
+    }
+  }
+}
+
 TEST(AerialBenchmark, SparsePointsProjectOntoTheirSurfaceInTheWrittenFiles) {
   const auto scene = synth::generate(small(synth::SceneKind::kCountry, 2));
   ASSERT_GE(scene.points.size(), 200u);

@@ -742,5 +742,18 @@ GroundSample World::ground(float x, float y) const {
   return g;
 }
 
+std::vector<ObjectFootprint> groundFootprints(const World& world, std::uint8_t cls) {
+  std::vector<ObjectFootprint> out;
+  const auto& objects = world.objects();
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const Object& o = objects[i];
+    if (o.cls != cls || o.lo[2] > 0.01f) continue;
+    const float cx = 0.5f * (o.lo[0] + o.hi[0]), cy = 0.5f * (o.lo[1] + o.hi[1]);
+    if (std::fabs(cx) > world.extent() || std::fabs(cy) > world.extent()) continue;
+    out.push_back({static_cast<int>(i), o.lo[0], o.lo[1], o.hi[0], o.hi[1]});
+  }
+  return out;
+}
+
 }  // namespace synth
 }  // namespace sadsplat

@@ -136,6 +136,17 @@ class World {
   float block_ = 40.f, road_half_ = 4.f, quay_y_ = 0.f, river_x_ = 0.f;
 };
 
+/// \brief The ground footprint of one true object: an axis-aligned rectangle on the ground.
+struct ObjectFootprint {
+  int object = -1;  ///< index into World::objects
+  float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/// \brief The footprints of the objects of class `cls` that stand on the ground (their bottom at
+/// z = 0; structures on top of them lie within their footprint and are not objects of their own)
+/// and whose centre lies in the labelled area: the true buildings of a scene, one per object.
+std::vector<ObjectFootprint> groundFootprints(const World& world, std::uint8_t cls);
+
 /// \brief Deterministic hash of integers to [0, 1).
 float hash01(std::uint64_t a, std::uint64_t b = 0, std::uint64_t c = 0, std::uint64_t d = 0);
 /// \brief Smooth value noise in [0, 1) at (x, y), deterministic in `seed`.

@@ -1,0 +1,54 @@
+#pragma once
+/// \file object_scores.h
+/// \brief Objects of one class scored against the true objects' footprints, as a PCL user
+/// extracts them (examples/building_footprints): the class's opaque Gaussians split into
+/// Euclidean clusters (connected components of the graph joining centres closer than a
+/// tolerance: what pcl::EuclideanClusterExtraction computes), each cluster's footprint the convex
+/// hull of its centres on the ground plane, matched one to one to the true footprints at
+/// footprint IoU >= 0.5 (best IoU first).
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace sadsplat {
+namespace eval {
+
+/// \brief A footprint on the ground plane: a simple polygon (x, y), either orientation.
+using Footprint = std::vector<std::array<double, 2>>;
+
+struct ObjectScoreOptions {
+  double tolerance = 1.0;       ///< metres: centres closer than this join one cluster
+  std::size_t min_points = 20;  ///< smaller clusters are not objects (the example's defaults)
+  double match_iou = 0.5;       ///< a predicted object matches a true one at this footprint IoU
+  double cell = 0.25;           ///< metres: the raster on which footprint areas are measured
+};
+
+struct ObjectScores {
+  std::size_t true_objects = 0, predicted = 0, matched = 0;
+  double precision = 0, recall = 0, f1 = 0;
+  double mean_matched_iou = 0;  ///< over the matched pairs (0 when none)
+  /// Per true object: the best IoU of any predicted footprint (0 when none overlaps).
+  std::vector<double> best_iou;
+  std::vector<Footprint> predicted_footprints;  ///< convex hulls, counter-clockwise
+};
+
+/// \brief Euclidean clusters of `points` (indices into it, each cluster sorted, clusters in
+/// order of their first point); clusters under min_points are dropped.
+std::vector<std::vector<std::size_t>> euclideanClusters(
+    const std::vector<std::array<float, 3>>& points, double tolerance, std::size_t min_points);
+
+/// \brief Counter-clockwise convex hull of points on a plane (Andrew's monotone chain); fewer
+/// than three distinct points give what there is.
+Footprint convexHull(std::vector<std::array<double, 2>> points);
+
+/// \brief IoU of two footprints, measured on a raster of `cell` metres (cell centres inside).
+double footprintIou(const Footprint& a, const Footprint& b, double cell);
+
+/// \brief Clusters `points` (the class's opaque Gaussians' centres, z up) and scores the
+/// clusters' footprints against `truth` (see the file comment).
+ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
+                          const std::vector<Footprint>& truth, const ObjectScoreOptions& options);
+
+}  // namespace eval
+}  // namespace sadsplat

@@ -1,0 +1,189 @@
+#include "sadsplat/eval/object_scores.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <tuple>
+#include <unordered_map>
+
+namespace sadsplat {
+namespace eval {
+namespace {
+
+std::size_t findRoot(std::vector<std::size_t>& parent, std::size_t i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+struct Box {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  void add(const std::array<double, 2>& p) {
+    x0 = std::min(x0, p[0]), y0 = std::min(y0, p[1]);
+    x1 = std::max(x1, p[0]), y1 = std::max(y1, p[1]);
+  }
+};
+
+bool inside(const Footprint& poly, double x, double y) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const auto& a = poly[i];
+    const auto& b = poly[j];
+    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::size_t>> euclideanClusters(
+    const std::vector<std::array<float, 3>>& points, double tolerance, std::size_t min_points) {
+  const std::size_t n = points.size();
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  // Cells of the tolerance's size: a neighbour lies in one of the 27 cells around a point.
+  using Key = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return static_cast<std::size_t>(std::get<0>(k) * 73856093LL ^ std::get<1>(k) * 19349663LL ^
+                                      std::get<2>(k) * 83492791LL);
+    }
+  };
+  std::unordered_map<Key, std::vector<std::size_t>, KeyHash> cells;
+  const auto keyOf = [&](const std::array<float, 3>& p) {
+    return Key{static_cast<std::int64_t>(std::floor(p[0] / tolerance)),
+               static_cast<std::int64_t>(std::floor(p[1] / tolerance)),
+               static_cast<std::int64_t>(std::floor(p[2] / tolerance))};
+  };
+  for (std::size_t i = 0; i < n; ++i) cells[keyOf(points[i])].push_back(i);
+  const double t2 = tolerance * tolerance;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [kx, ky, kz] = keyOf(points[i]);
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find(Key{kx + dx, ky + dy, kz + dz});
+          if (it == cells.end()) continue;
+          for (std::size_t j : it->second) {
+            if (j <= i) continue;
+            double d2 = 0;
+            for (int c = 0; c < 3; ++c) {
+              const double d = double(points[i][c]) - points[j][c];
+              d2 += d * d;
+            }
+            if (d2 <= t2) {
+              const std::size_t a = findRoot(parent, i), b = findRoot(parent, j);
+              if (a != b) parent[std::max(a, b)] = std::min(a, b);
+            }
+          }
+        }
+      }
+    }
+  }
+  std::unordered_map<std::size_t, std::size_t> cluster_of_root;
+  std::vector<std::vector<std::size_t>> clusters;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t r = findRoot(parent, i);
+    auto [it, fresh] = cluster_of_root.emplace(r, clusters.size());
+    if (fresh) clusters.emplace_back();
+    clusters[it->second].push_back(i);
+  }
+  clusters.erase(std::remove_if(clusters.begin(), clusters.end(),
+                                [&](const auto& c) { return c.size() < min_points; }),
+                 clusters.end());
+  return clusters;
+}
+
+Footprint convexHull(std::vector<std::array<double, 2>> p) {
+  std::sort(p.begin(), p.end());
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  const auto cross = [](const std::array<double, 2>& o, const std::array<double, 2>& a,
+                        const std::array<double, 2>& b) {
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  };
+  Footprint hull(2 * p.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+double footprintIou(const Footprint& a, const Footprint& b, double cell) {
+  if (a.size() < 3 || b.size() < 3) return 0;
+  Box ba, bb;
+  for (const auto& p : a) ba.add(p);
+  for (const auto& p : b) bb.add(p);
+  Box u{std::min(ba.x0, bb.x0), std::min(ba.y0, bb.y0), std::max(ba.x1, bb.x1),
+        std::max(ba.y1, bb.y1)};
+  // Disjoint boxes: nothing in common.
+  if (ba.x1 < bb.x0 || bb.x1 < ba.x0 || ba.y1 < bb.y0 || bb.y1 < ba.y0) return 0;
+  std::size_t both = 0, either = 0;
+  const auto nx = static_cast<std::int64_t>(std::ceil((u.x1 - u.x0) / cell));
+  const auto ny = static_cast<std::int64_t>(std::ceil((u.y1 - u.y0) / cell));
+  for (std::int64_t j = 0; j < ny; ++j) {
+    const double y = u.y0 + (j + 0.5) * cell;
+    for (std::int64_t i = 0; i < nx; ++i) {
+      const double x = u.x0 + (i + 0.5) * cell;
+      const bool ia = x >= ba.x0 && x <= ba.x1 && y >= ba.y0 && y <= ba.y1 && inside(a, x, y);
+      const bool ib = x >= bb.x0 && x <= bb.x1 && y >= bb.y0 && y <= bb.y1 && inside(b, x, y);
+      both += ia && ib;
+      either += ia || ib;
+    }
+  }
+  return either ? double(both) / either : 0.0;
+}
+
+ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
+                          const std::vector<Footprint>& truth, const ObjectScoreOptions& o) {
+  ObjectScores s;
+  s.true_objects = truth.size();
+  for (const auto& cluster : euclideanClusters(points, o.tolerance, o.min_points)) {
+    std::vector<std::array<double, 2>> xy;
+    xy.reserve(cluster.size());
+    for (std::size_t i : cluster) xy.push_back({points[i][0], points[i][1]});
+    s.predicted_footprints.push_back(convexHull(std::move(xy)));
+  }
+  s.predicted = s.predicted_footprints.size();
+  // Every overlapping pair, best IoU first; each object matches once.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  s.best_iou.assign(truth.size(), 0.0);
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    for (std::size_t p = 0; p < s.predicted; ++p) {
+      const double iou = footprintIou(truth[t], s.predicted_footprints[p], o.cell);
+      if (iou <= 0) continue;
+      s.best_iou[t] = std::max(s.best_iou[t], iou);
+      if (iou >= o.match_iou) pairs.emplace_back(iou, t, p);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end(),
+            [](const auto& a, const auto& b) { return std::get<0>(a) > std::get<0>(b); });
+  std::vector<char> true_used(truth.size(), 0), pred_used(s.predicted, 0);
+  double iou_sum = 0;
+  for (const auto& [iou, t, p] : pairs) {
+    if (true_used[t] || pred_used[p]) continue;
+    true_used[t] = pred_used[p] = 1;
+    ++s.matched;
+    iou_sum += iou;
+  }
+  s.precision = s.predicted ? double(s.matched) / s.predicted : 0.0;
+  s.recall = s.true_objects ? double(s.matched) / s.true_objects : 0.0;
+  s.f1 = s.precision + s.recall > 0 ? 2 * s.precision * s.recall / (s.precision + s.recall) : 0.0;
+  s.mean_matched_iou = s.matched ? iou_sum / s.matched : 0.0;
+  return s;
+}
+
+}  // namespace eval
+}  // namespace sadsplat

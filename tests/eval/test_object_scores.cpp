@@ -1,0 +1,80 @@
+// Objects of one class against true footprints: Euclidean clusters, convex hulls, footprint IoU
+// and the one-to-one matching, on hand-placed points whose answers are known.
+#include <gtest/gtest.h>
+
+#include "sadsplat/eval/object_scores.h"
+
+namespace sadsplat {
+namespace {
+
+// A grid of points spaced `step` over [x0, x1] x [y0, y1] at height z.
+void addRoof(std::vector<std::array<float, 3>>* points, float x0, float y0, float x1, float y1,
+             float z, float step = 0.5f) {
+  for (float y = y0; y <= y1 + 1e-4f; y += step) {
+    for (float x = x0; x <= x1 + 1e-4f; x += step) points->push_back({x, y, z});
+  }
+}
+
+TEST(ObjectScores, ClustersJoinCentresWithinTheTolerance) {
+  std::vector<std::array<float, 3>> p;
+  for (int i = 0; i < 10; ++i) p.push_back({0.9f * i, 0, 0});      // a chain 0.9 apart: one cluster
+  for (int i = 0; i < 5; ++i) p.push_back({20 + 0.5f * i, 0, 5});  // another, 11.9 m away
+  p.push_back({50, 50, 50});                                       // alone
+  const auto clusters = eval::euclideanClusters(p, 1.0, 2);
+  ASSERT_EQ(clusters.size(), 2u);
+  EXPECT_EQ(clusters[0].size(), 10u);
+  EXPECT_EQ(clusters[1].size(), 5u);
+  EXPECT_EQ(clusters[1].front(), 10u);
+  // A tolerance below the chain's spacing breaks it into single points, which min_points drops.
+  EXPECT_EQ(eval::euclideanClusters(p, 0.8, 2).size(), 1u);
+}
+
+TEST(ObjectScores, HullsAndFootprintIou) {
+  const eval::Footprint hull =
+      eval::convexHull({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 0.5}, {0, 0}});
+  ASSERT_EQ(hull.size(), 4u);
+  // Counter-clockwise: positive shoelace area 4.
+  double area = 0;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const auto& a = hull[i];
+    const auto& b = hull[(i + 1) % hull.size()];
+    area += a[0] * b[1] - b[0] * a[1];
+  }
+  EXPECT_NEAR(area / 2, 4.0, 1e-12);
+  const eval::Footprint square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const eval::Footprint shifted = {{0.5, 0}, {1.5, 0}, {1.5, 1}, {0.5, 1}};
+  EXPECT_NEAR(eval::footprintIou(square, shifted, 0.01), 1.0 / 3, 0.01);
+  EXPECT_NEAR(eval::footprintIou(square, square, 0.01), 1.0, 1e-9);
+  EXPECT_EQ(eval::footprintIou(square, {{5, 5}, {6, 5}, {6, 6}}, 0.01), 0.0);
+}
+
+TEST(ObjectScores, MatchesOneToOneAtHalfTheFootprint) {
+  const std::vector<eval::Footprint> truth = {{{0, 0}, {10, 0}, {10, 10}, {0, 10}},
+                                              {{20, 0}, {30, 0}, {30, 10}, {20, 10}}};
+  std::vector<std::array<float, 3>> p;
+  addRoof(&p, 0.25f, 0.25f, 9.75f, 9.75f, 8);    // the first roof: hull 9.5 x 9.5, IoU 0.9025
+  addRoof(&p, 20.25f, 0.25f, 24.75f, 9.75f, 6);  // half the second: 4.5 x 9.5, IoU 0.4275
+  addRoof(&p, 50, 50, 52, 52, 3);                // no building there
+  const eval::ObjectScores s = eval::scoreObjects(p, truth, {});
+  EXPECT_EQ(s.true_objects, 2u);
+  EXPECT_EQ(s.predicted, 3u);
+  EXPECT_EQ(s.matched, 1u);
+  EXPECT_NEAR(s.precision, 1.0 / 3, 1e-12);
+  EXPECT_NEAR(s.recall, 0.5, 1e-12);
+  EXPECT_NEAR(s.f1, 0.4, 1e-12);
+  ASSERT_EQ(s.best_iou.size(), 2u);
+  EXPECT_NEAR(s.best_iou[0], 0.9025, 0.01);
+  EXPECT_NEAR(s.best_iou[1], 0.4275, 0.01);
+  EXPECT_NEAR(s.mean_matched_iou, 0.9025, 0.01);
+  // Two clusters on one building: only one of them matches it.
+  std::vector<std::array<float, 3>> split;
+  addRoof(&split, 0.25f, 0.25f, 9.75f, 9.75f, 8);
+  addRoof(&split, 0.25f, 0.25f, 9.75f, 9.75f, 20);  // the same footprint 12 m higher
+  const eval::ObjectScores t = eval::scoreObjects(split, {truth[0]}, {});
+  EXPECT_EQ(t.predicted, 2u);
+  EXPECT_EQ(t.matched, 1u);
+  EXPECT_NEAR(t.precision, 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace sadsplat
