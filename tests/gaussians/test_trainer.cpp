@@ -147,6 +147,28 @@ TEST_P(TrainerOnDevice, TheScaleLimitBoundsEveryGaussiansScale) {
   EXPECT_TRUE(std::isfinite(stats.rgb_loss));
 }
 
+// The flatness loss shrinks every Gaussian's smallest scale (discs on the surfaces) and leaves
+// the photometric fit working.
+TEST_P(TrainerOnDevice, TheFlatnessLossMakesDiscs) {
+  const auto smallestOverLargest = [](const Trainer& t) {
+    const at::Tensor s = t.parameters().log_scales.detach().exp();
+    return (std::get<0>(s.min(1)) / std::get<0>(s.max(1))).mean().item<double>();
+  };
+  TrainConfig config = small(60);
+  Trainer plain(scene_, config);
+  config.lambda_flatten = 100;
+  Trainer flat(scene_, config);
+  const double start = smallestOverLargest(flat);
+  EXPECT_NEAR(start, smallestOverLargest(plain), 1e-12);
+  for (int i = 0; i < 60; ++i) {
+    plain.step(false);
+    flat.step(false);
+  }
+  EXPECT_LT(smallestOverLargest(flat), 0.8 * smallestOverLargest(plain))
+      << "start " << start << " plain " << smallestOverLargest(plain);
+  EXPECT_TRUE(std::isfinite(flat.step().rgb_loss));
+}
+
 // scale_limit_from: no bound before that iteration; at it, the Gaussians above the limit are
 // split (more rows, every state consistent) and from then on none exceeds it.
 TEST_P(TrainerOnDevice, ALateScaleLimitSplitsTheLargeGaussiansFirst) {

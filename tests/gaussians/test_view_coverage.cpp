@@ -58,8 +58,8 @@ TEST(ViewCoverage, PixelsCountTheTrainingViewsThatSeeTheirSurface) {
   const at::Tensor depth = at::full({100, 100}, 5.0, at::kFloat);
   at::Tensor alpha = at::ones({100, 100}, at::kFloat);
   alpha[7][70] = 0.2;
-  const at::Tensor counts = gaussians::pixelViewCounts(depth, alpha, viewCamera(0),
-                                                       {viewCamera(0), viewCamera(2)});
+  const at::Tensor counts =
+      gaussians::pixelViewCounts(depth, alpha, viewCamera(0), {viewCamera(0), viewCamera(2)});
   ASSERT_EQ(counts.sizes(), at::IntArrayRef({100, 100}));
   ASSERT_EQ(counts.scalar_type(), at::kInt);
   EXPECT_EQ(counts[50][0].item<int>(), 1);
@@ -87,17 +87,15 @@ TEST(ViewCoverage, PixelsCountTheTrainingViewsThatSeeTheirSurface) {
   const double h = std::sqrt(0.5), c15 = std::cos(M_PI / 12), s15 = std::sin(M_PI / 12);
   turned.qvec = {h * c15, h * c15, h * s15, -h * s15};  // q_y(30) * q_x(90)
   turned.tvec = {0.3, -1.0, 2.0};
-  const at::Tensor self =
-      gaussians::pixelViewCounts(at::full({100, 100}, 3.0, at::kFloat),
-                                 at::ones({100, 100}, at::kFloat), turned, {turned});
+  const at::Tensor self = gaussians::pixelViewCounts(
+      at::full({100, 100}, 3.0, at::kFloat), at::ones({100, 100}, at::kFloat), turned, {turned});
   EXPECT_EQ(self.sum().item<int>(), 100 * 100);
   // Every pixel's surface lies 3 in front of the centre: the same camera moved 4 along its axis
   // has all of it 1 behind it.
   RasterCamera beyond = turned;
   beyond.tvec = {turned.tvec[0], turned.tvec[1], turned.tvec[2] - 4.0};
-  const at::Tensor behind =
-      gaussians::pixelViewCounts(at::full({100, 100}, 3.0, at::kFloat),
-                                 at::ones({100, 100}, at::kFloat), turned, {beyond});
+  const at::Tensor behind = gaussians::pixelViewCounts(
+      at::full({100, 100}, 3.0, at::kFloat), at::ones({100, 100}, at::kFloat), turned, {beyond});
   EXPECT_EQ(behind.sum().item<int>(), 0);
 
   EXPECT_THROW(gaussians::pixelViewCounts(at::ones({10, 10}), at::ones({10, 10}), viewCamera(0),
@@ -114,29 +112,53 @@ TEST(ViewCoverage, SparseDepthIsTheMedianPerBlockFilledFromTheNearestBlock) {
     for (double x : {-2.4, -2.3, -2.1}) xyz.insert(xyz.end(), {x, y, 5.0});
     for (double x : {4.2, 4.5}) xyz.insert(xyz.end(), {x, y, 10.0});
   }
-  xyz.insert(xyz.end(), {-20.0, 0.0, 50.0});   // (u, v) = (10, 50): block (5, 1), alone
-  xyz.insert(xyz.end(), {0.0, 0.0, -5.0});     // behind
-  xyz.insert(xyz.end(), {100.0, 0.0, 5.0});    // outside
-  const at::Tensor points =
-      at::tensor(xyz, at::kDouble).view({-1, 3}).to(at::kFloat);
+  xyz.insert(xyz.end(), {-20.0, 0.0, 50.0});  // (u, v) = (10, 50): block (5, 1), alone
+  xyz.insert(xyz.end(), {0.0, 0.0, -5.0});    // behind
+  xyz.insert(xyz.end(), {100.0, 0.0, 5.0});   // outside
+  const at::Tensor points = at::tensor(xyz, at::kDouble).view({-1, 3}).to(at::kFloat);
   const at::Tensor depth = gaussians::sparseDepthImage(points, viewCamera(0), 10);
   ASSERT_TRUE(depth.defined());
   ASSERT_EQ(depth.sizes(), at::IntArrayRef({100, 100}));
   EXPECT_FLOAT_EQ(depth[50][5].item<float>(), 5.0f);    // its own block
   EXPECT_FLOAT_EQ(depth[55][15].item<float>(), 50.0f);  // the lone far point's block
   EXPECT_FLOAT_EQ(depth[50][95].item<float>(), 10.0f);
-  EXPECT_FLOAT_EQ(depth[0][0].item<float>(), 5.0f);     // empty: the nearest filled block
+  EXPECT_FLOAT_EQ(depth[0][0].item<float>(), 5.0f);  // empty: the nearest filled block
   EXPECT_FLOAT_EQ(depth[99][85].item<float>(), 10.0f);
   // Nothing in front and inside: no depth.
-  EXPECT_FALSE(gaussians::sparseDepthImage(at::tensor({0.0, 0.0, -5.0}).view({1, 3}),
-                                           viewCamera(0), 10)
-                   .defined());
+  EXPECT_FALSE(
+      gaussians::sparseDepthImage(at::tensor({0.0, 0.0, -5.0}).view({1, 3}), viewCamera(0), 10)
+          .defined());
 }
 
 TEST(ViewCoverage, SceneExtentIsTheCamerasRadiusTimes1point1) {
   // Centres (0, 0, 0) and (2, 0, 0): mean (1, 0, 0), radius 1.
   EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0), viewCamera(2)}), 1.1, 1e-12);
   EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0)}), 1e-3, 1e-12);  // one camera: the floor
+}
+
+}  // namespace
+}  // namespace sadsplat
+
+namespace sadsplat {
+namespace {
+
+TEST(ViewCoverage, AViewSeesOnlyWhatItsDepthImageShows) {
+  // The camera at the origin sees a wall at depth 5 (alpha 1), except one pixel with no surface.
+  const gaussians::RasterCamera c = viewCamera(0);
+  const at::Tensor depth = at::full({100, 100}, 5.0, at::kFloat);
+  at::Tensor alpha = at::ones({100, 100}, at::kFloat);
+  alpha[50][50] = 0.2;  // the pixel of (0.005, 0.005, z) for any z: u = 100 x / z + 50
+  // On the wall; behind it (occluded); in front of it (a point the view looks through); on the
+  // wall within 2 %; outside the image; where the image shows nothing.
+  const at::Tensor points = at::tensor({1.0, 1.0, 5.0, 1.0, 1.0, 8.0, 1.0, 1.0, 3.0, 1.0, 1.0, 5.09,
+                                        40.0, 0.0, 5.0, 0.0051, 0.0051, 5.0},
+                                       at::kDouble)
+                                .view({6, 3});
+  const at::Tensor seen = gaussians::seenUnoccluded(points, c, depth, alpha, 0.02);
+  ASSERT_EQ(seen.scalar_type(), at::kBool);
+  const std::vector<bool> expected = {true, false, false, true, false, false};
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(seen[i].item<bool>(), expected[i]) << i;
+  EXPECT_THROW(gaussians::seenUnoccluded(points, c, depth.view({10, 1000}), alpha), Error);
 }
 
 }  // namespace

@@ -103,8 +103,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // recommendations; the defaults are the field initialisers in train_config.h.
 const std::vector<TrainOption> kOptions = {
     {"iterations", &C::iterations, "training iterations (paper: 7000)", "--iterations", 1, kInf},
-    {"feature_dim", &C::feature_dim, "semantic feature channels per Gaussian (paper: 32)",
-     nullptr, 0, kFeatureDim},
+    {"feature_dim", &C::feature_dim, "semantic feature channels per Gaussian (paper: 32)", nullptr,
+     0, kFeatureDim},
     {"max_sh_degree", &C::max_sh_degree, "highest spherical-harmonics degree", nullptr, 0, 3},
     {"sh_increase_interval", &C::sh_increase_interval,
      "iterations between raising the SH degree by one", nullptr, 1, kInf},
@@ -121,9 +121,10 @@ const std::vector<TrainOption> kOptions = {
     {"lambda_rgb", &C::lambda_rgb, "weight of the RGB loss", nullptr, 0, kInf},
     {"lambda_semantic", &C::lambda_semantic, "weight of the semantic loss on labelled views",
      nullptr, 0, kInf},
+    {"lambda_flatten", &C::lambda_flatten,
+     "weight of the flatness loss: mean smallest scale / scene extent (0: off)", nullptr, 0, kInf},
     {"semantic_interval", &C::semantic_interval,
-     "every this many iterations a labelled view is rendered as well (0: never)", nullptr, 0,
-     kInf},
+     "every this many iterations a labelled view is rendered as well (0: never)", nullptr, 0, kInf},
     {"views_per_step", &C::views_per_step,
      "training views per step and rank; the loss is their mean", "--views-per-step", 1, 1024},
     {"use_pseudo_labels", &C::use_pseudo_labels,
@@ -137,8 +138,7 @@ const std::vector<TrainOption> kOptions = {
     {"lr_position_final", &C::lr_position_final, "position learning rate at the end (x extent)",
      nullptr, 0, kInf},
     {"lr_sh_dc", &C::lr_sh_dc, "learning rate of the SH DC coefficients", nullptr, 0, kInf},
-    {"lr_sh_rest", &C::lr_sh_rest, "learning rate of the higher SH coefficients", nullptr, 0,
-     kInf},
+    {"lr_sh_rest", &C::lr_sh_rest, "learning rate of the higher SH coefficients", nullptr, 0, kInf},
     {"lr_opacity", &C::lr_opacity, "learning rate of the opacity logits", nullptr, 0, kInf},
     {"lr_scaling", &C::lr_scaling, "learning rate of the log-scales", nullptr, 0, kInf},
     {"lr_rotation", &C::lr_rotation, "learning rate of the quaternions", nullptr, 0, kInf},
@@ -151,8 +151,8 @@ const std::vector<TrainOption> kOptions = {
      kInf},
     {"densify_grad_threshold", &C::densify_grad_threshold,
      "NDC-space positional gradient that triggers densification (3DGS)", nullptr, 0, kInf},
-    {"percent_dense", &C::percent_dense, "clone / split boundary as a share of the extent",
-     nullptr, 0, kInf},
+    {"percent_dense", &C::percent_dense, "clone / split boundary as a share of the extent", nullptr,
+     0, kInf},
     {"min_opacity", &C::min_opacity, "Gaussians below this opacity are pruned", nullptr, 0, 1},
     {"opacity_reset_interval", &C::opacity_reset_interval,
      "iterations between opacity resets (0: never)", nullptr, 0, kInf},
@@ -165,8 +165,8 @@ const std::vector<TrainOption> kOptions = {
      "after densification, split Gaussians larger than this x the scene extent every "
      "densify_interval (0: off)",
      nullptr, 0, kInf},
-    {"large_split_last", &C::large_split_last,
-     "the last iterations without large-Gaussian splits", nullptr, 0, kInf},
+    {"large_split_last", &C::large_split_last, "the last iterations without large-Gaussian splits",
+     nullptr, 0, kInf},
     {"scale_limit", &C::scale_limit,
      "no Gaussian's scale exceeds this x the scene extent from scale_limit_from on: log-scales "
      "clamped after every step (0: off)",
@@ -184,8 +184,7 @@ const std::vector<TrainOption> kOptions = {
      nullptr, 4, kInf},
     {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
     {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
-    {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1,
-     kInf},
+    {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1, kInf},
     {"prune_floaters", &C::prune_floaters,
      "after the last iteration remove Gaussians seen by fewer than floater_min_views training "
      "views or larger than floater_max_scale x the scene extent",
@@ -195,16 +194,16 @@ const std::vector<TrainOption> kOptions = {
     {"drop", &C::drop, "the semantic-aware drop", "--drop", -kInf, kInf,
      "none|semantic|structure|full"},
     {"p_base", &C::p_base, "base drop rate P_base (paper: 1.0)", "--p-base", 0, kInf},
-    {"drop_interval", &C::drop_interval, "iterations between drops (paper: 500)", nullptr, 1,
-     kInf},
+    {"drop_interval", &C::drop_interval, "iterations between drops (paper: 500)", nullptr, 1, kInf},
     {"lambda_l0", &C::lambda_l0, "weight of the L0 sparsity loss", "--lambda-l0", 0, kInf},
     {"lambda_l0_from", &C::lambda_l0_from,
-     "the L0 loss starts at this iteration; balanced rule: its first drop event too (not the paper; "
+     "the L0 loss starts at this iteration; balanced rule: its first drop event too (not the "
+     "paper; "
      "0: from the start)",
      "--lambda-l0-from", 0, kInf},
     {"lambda_l0_ramp", &C::lambda_l0_ramp,
-     "the L0 weight rises linearly over this many iterations (0: at once)", "--lambda-l0-ramp",
-     0, kInf},
+     "the L0 weight rises linearly over this many iterations (0: at once)", "--lambda-l0-ramp", 0,
+     kInf},
     {"l0_importance", &C::l0_importance,
      "weight the L0 loss towards the Gaussians that contribute least, exponent gamma (not the "
      "paper; 0: the plain mean)",
@@ -259,9 +258,9 @@ void setFromJson(const TrainOption& o, const nlohmann::json& value, TrainConfig&
           c.*member = value.get<T>();
         } else {  // the background colour
           if (!value.is_array() || value.size() != 3) {
-            throw Error(origin, o.key, "an array of 3 numbers (RGB)",
-                        value.is_array() ? std::to_string(value.size()) + " elements"
-                                         : value.type_name());
+            throw Error(
+                origin, o.key, "an array of 3 numbers (RGB)",
+                value.is_array() ? std::to_string(value.size()) + " elements" : value.type_name());
           }
           for (int k = 0; k < 3; ++k) {
             if (!value[k].is_number()) {
@@ -312,10 +311,10 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
   } else {
     value = nlohmann::json::parse(text, nullptr, false);
     if (value.is_discarded() || value.is_string()) {
-      throw Error(origin, option.flag ? option.flag : option.key,
-                  std::holds_alternative<bool TrainConfig::*>(option.member) ? "true or false"
-                                                                             : "a number",
-                  text);
+      throw Error(
+          origin, option.flag ? option.flag : option.key,
+          std::holds_alternative<bool TrainConfig::*>(option.member) ? "true or false" : "a number",
+          text);
     }
   }
   const nlohmann::json reference = toJsonValue(option, TrainConfig{});
@@ -390,10 +389,9 @@ void TrainConfig::check(const std::string& origin) const {
   for (const TrainOption& o : kOptions) {
     const nlohmann::json v = toJsonValue(o, *this);
     if (v.is_number() && !(v.get<double>() >= o.min && v.get<double>() <= o.max)) {
-      const std::string range =
-          o.max == kInf ? ">= " + numberText(o.min)
-                        : o.min == -kInf ? "<= " + numberText(o.max)
-                                         : numberText(o.min) + " .. " + numberText(o.max);
+      const std::string range = o.max == kInf    ? ">= " + numberText(o.min)
+                                : o.min == -kInf ? "<= " + numberText(o.max)
+                                                 : numberText(o.min) + " .. " + numberText(o.max);
       throw Error(origin, o.key, range, v.dump());
     }
     const std::vector<std::string> choices = optionChoices(o);
@@ -431,9 +429,8 @@ TrainConfig TrainConfig::fromJson(const std::string& text, const std::string& or
   TrainConfig c;
   const nlohmann::json defaults = nlohmann::json::parse(c.toJson());
   for (auto it = j.begin(); it != j.end(); ++it) {
-    const auto option = std::find_if(kOptions.begin(), kOptions.end(), [&](const TrainOption& o) {
-      return it.key() == o.key;
-    });
+    const auto option = std::find_if(kOptions.begin(), kOptions.end(),
+                                     [&](const TrainOption& o) { return it.key() == o.key; });
     if (option == kOptions.end()) {
       throw Error(origin, it.key(), "a known configuration key", "unknown");
     }

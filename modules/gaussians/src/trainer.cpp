@@ -309,6 +309,11 @@ StepStats Trainer::step(bool read_losses) {
     if (batch > 1) total = total / batch;
     const at::Tensor reg = s.drop.regularisation(s.params, it);
     if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);  // once over all ranks
+    if (c.lambda_flatten > 0) {
+      const at::Tensor flat = std::get<0>(s.params["scales"].value.exp().min(1)).mean() *
+                              (c.lambda_flatten / s.extent / ranks);
+      total = total + flat;
+    }
     enterPhase(profile, "backward");
     total.backward();
   };
@@ -425,6 +430,14 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor&
     g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
   }
   return render(g, camera, s.evaluationSettings());
+}
+
+RenderResult Trainer::renderDepth(const RasterCamera& camera) const {
+  c10::AutoGradMode no_grad(false);
+  const State& s = *state_;
+  RenderSettings settings = s.evaluationSettings();
+  settings.features = false;
+  return render(s.evaluationGaussians(), camera, settings);
 }
 
 at::Tensor Trainer::predictClasses(const RenderResult& r) const {

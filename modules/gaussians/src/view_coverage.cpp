@@ -71,6 +71,32 @@ at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& 
   return counts;
 }
 
+at::Tensor seenUnoccluded(const at::Tensor& points, const RasterCamera& camera,
+                          const at::Tensor& depth, const at::Tensor& alpha,
+                          double relative_tolerance) {
+  if (points.dim() != 2 || points.size(1) != 3) {
+    throw Error("<view coverage>", "points", "an [N, 3] tensor",
+                std::to_string(points.dim()) + "-d");
+  }
+  const std::vector<std::int64_t> shape = {camera.height, camera.width};
+  if (depth.sizes() != at::IntArrayRef(shape) || alpha.sizes() != at::IntArrayRef(shape)) {
+    throw Error("<view coverage>", "depth / alpha",
+                "[" + std::to_string(camera.height) + ", " + std::to_string(camera.width) +
+                    "] images of the camera",
+                "[" + std::to_string(depth.numel()) + "] and [" + std::to_string(alpha.numel()) +
+                    "] values");
+  }
+  const Projection p = project(points.detach().to(at::kDouble), camera);
+  const at::Tensor u = p.u.clamp(0, camera.width - 1).to(at::kLong);
+  const at::Tensor v = p.v.clamp(0, camera.height - 1).to(at::kLong);
+  const at::Tensor index = (v * camera.width + u).to(depth.device());
+  const at::Tensor d = depth.detach().reshape(-1).to(at::kDouble).index_select(0, index);
+  const at::Tensor a = alpha.detach().reshape(-1).index_select(0, index);
+  const at::Tensor z = p.z.to(depth.device());
+  const at::Tensor agrees = (d - z).abs() <= relative_tolerance * z.abs();
+  return (p.seen.to(depth.device()) & agrees & (a >= 0.5)).to(points.device());
+}
+
 at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                            const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
                            double min_alpha, int stride) {

@@ -192,6 +192,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   const bool first = options.surface == OrthoSurface::kFirst;
   const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
   int done = 0;
+  std::vector<at::Tensor> surface_points, surface_cells;
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       const int x_off = tx * tile, y_off = ty * tile;
@@ -250,6 +251,33 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     }
   }
   if (progress && tiles_x * tiles_y > 1) *progress << "\n";
+  if (options.min_views > 0 && !surface_points.empty()) {
+    const at::Tensor device_probe = trainer.parameters().means;
+    const at::Tensor points = at::cat(surface_points).to(device_probe.device());
+    const at::Tensor cells = at::cat(surface_cells);
+    at::Tensor counts = at::zeros({points.size(0)}, points.options().dtype(at::kInt));
+    int seen_by = 0;
+    for (const gaussians::RasterCamera& c : options.cameras) {
+      const gaussians::RenderResult r = trainer.renderDepth(c);
+      counts += gaussians::seenUnoccluded(points, c, r.depth, r.alpha).to(at::kInt);
+      if (progress &&
+          (++seen_by % 10 == 0 || seen_by == static_cast<int>(options.cameras.size()))) {
+        *progress << "\r  ortho: cells seen from " << seen_by << "/" << options.cameras.size()
+                  << " photos" << std::flush;
+      }
+    }
+    if (progress) *progress << "\n";
+    const at::Tensor few =
+        cells.index_select(0, (counts < options.min_views).to(at::kCPU).nonzero().reshape(-1));
+    const auto* pf = few.data_ptr<std::int64_t>();
+    for (std::int64_t i = 0; i < few.numel(); ++i) {
+      out.covered[pf[i]] = 0;
+      out.classes[pf[i]] = 255;
+      out.confidence[pf[i]] = 0.f;
+      out.elevation[pf[i]] = 0.f;
+    }
+    out.few_views = few.numel();
+  }
   return out;
 }
 

@@ -33,6 +33,11 @@ struct TrainConfig {
   double tile_list_margin = 1.25;
   double lambda_rgb = 1.0;
   double lambda_semantic = 1.0;
+  /// Not the paper: weight of a flatness loss, the mean over the Gaussians of their smallest
+  /// scale divided by the scene extent (the scale regulariser of PGSR and Gaussian surfels):
+  /// Gaussians become discs on the surfaces, so that a facade seen from above is a line, not a
+  /// band over the street. 0: off.
+  double lambda_flatten = 0.0;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;

@@ -100,6 +100,8 @@ class Trainer {
   /// \brief As renderCamera, drawing only the Gaussians where `keep` ([N] bool, on any device) is
   /// true (a viewer's class selection); an undefined `keep` draws them all.
   RenderResult renderCamera(const RasterCamera& camera, const at::Tensor& keep) const;
+  /// \brief As renderCamera, without the features: colour, alpha and expected depth.
+  RenderResult renderDepth(const RasterCamera& camera) const;
   /// \brief Per-pixel class ids [H, W] int64 from a render's feature image (argmax of the cosine
   /// similarity of the decoded feature to each class embedding).
   at::Tensor predictClasses(const RenderResult& render) const;

@@ -23,6 +23,16 @@ double sceneExtent(const std::vector<RasterCamera>& cameras);
 /// the device of `means`.
 at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras);
 
+/// \brief Which of `points` ([N, 3], world) a camera sees unoccluded, as a view's depth image
+/// says: in front of the camera, inside its image, and with their camera z within
+/// `relative_tolerance` x z of the depth at their pixel (`depth` [H, W], camera z, e.g. a
+/// render's RenderResult::depth; `alpha` [H, W]: pixels below 0.5 show no surface, so nothing
+/// there is seen). bool [N] on the device of `points`. A point behind what the image shows is
+/// occluded; one in front of it is one the view looks through (not a surface it supports).
+at::Tensor seenUnoccluded(const at::Tensor& points, const RasterCamera& camera,
+                          const at::Tensor& depth, const at::Tensor& alpha,
+                          double relative_tolerance = 0.02);
+
 /// \brief Per pixel of a view rendered through `camera`, how many of `cameras` see the surface
 /// point the pixel shows: the pixel's centre back-projected to its expected `depth` ([H, W],
 /// camera z, as RenderResult::depth), then counted as viewCounts() counts a centre. int32 [H, W]

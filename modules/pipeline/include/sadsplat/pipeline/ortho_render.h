@@ -56,9 +56,10 @@ enum class OrthoSurface {
 /// \brief How the map is rendered.
 struct OrthoRenderOptions {
   OrthoSurface surface = OrthoSurface::kFirst;
-  /// A covered cell whose surface point fewer than this many of `cameras` see (in front of the
-  /// camera, inside its image; occlusion is not tested) is nodata: a surface only one photo
-  /// sees has no depth from the photos (the survey's edges). 0: every covered cell is kept.
+  /// A covered cell whose surface point fewer than this many of `cameras` see unoccluded is
+  /// nodata (gaussians::seenUnoccluded against each camera's depth render): a surface only one
+  /// photo sees has no depth from the photos (the survey's edges), one no photo sees (an alley
+  /// between tall buildings) is a guess. 0: every covered cell is kept.
   int min_views = 2;
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
 };
