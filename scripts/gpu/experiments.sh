@@ -15,7 +15,7 @@
 #       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
-#       scenes), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); $OUT gets
+#       scenes; and as the blend through the Gaussians: orthoblend_*.json), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); $OUT gets
 #       scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
 #       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
 #       summary says at which iteration it stopped). The deadline counts from the call's start
@@ -263,6 +263,7 @@ mode_scene() {
     esac
   fi
   local tag; tag=$(basename "${scene%.cache}")
+  [ "${CAPTURE:-orbit}" = orbit ] || tag="${tag}_$CAPTURE"
   local work="/tmp/sadsplat-scene/$tag"; rm -rf "$work"; mkdir -p "$work/results"
   local spec
   for spec in "$@"; do
@@ -276,6 +277,8 @@ mode_scene() {
         "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" &&
         { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho \
             > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } &&
+        { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho --surface blend \
+            --min-views 0 > "$work/results/orthoblend_$name.json" 2>> "$work/results/eval_$name.log"; } &&
         { [ "${THREED:-0}" = 0 ] || "$bin" eval "$work/run_$name" --3d \
             > "$work/results/3d_$name.json" 2>> "$work/results/eval_$name.log"; } || {
         echo "$name: stopped (rc $?)"

@@ -8,7 +8,8 @@
 #   gpu_baseline TARBALL         unpack a baseline source tarball into /tmp/ab-base and build it
 #                                with this tree's lib.sh (sets BASE_BIN_DIR)
 #   scene_cache KIND_SEED [WxH] [BIN]
-#                                print the path of the synth scene cache (made once per kind,
+#                                print the path of the synth scene cache (CAPTURE=grid-oblique
+#                                for synth's drone-mission capture; made once per kind,
 #                                seed and size under /tmp/sadsplat-scenes; KIND_SEED e.g. city_0,
 #                                or city-xl for the large preset)
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
@@ -115,9 +116,13 @@ make_cache() {
 
 scene_cache() {
   local scene="$1" size="${2:-800x450}" bin="${3:-$SADSPLAT_BIN}"
-  local cache="$SCENES_DIR/${scene}_${size}.cache" args
+  # CAPTURE (orbit, the default | grid | grid-oblique): synth's --capture; its own cache name.
+  local capture="${CAPTURE:-orbit}" suffix=""
+  [ "$capture" = orbit ] || suffix="_$capture"
+  local cache="$SCENES_DIR/${scene}_${size}$suffix.cache" args
   if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
   else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
+  args+=(--capture "$capture")
   make_cache "$cache" "$OUT/synth_${scene}_$size.log" "$bin" synth "${args[@]}" \
     --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" ||
     { echo "synth $scene failed" >&2; return 1; }
