@@ -277,7 +277,7 @@ mode_scene() {
         "$bin" eval "$work/run_$name" > "$work/results/metrics_$name.json" 2> "$work/results/eval_$name.log" &&
         { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho \
             > "$work/results/ortho_$name.json" 2>> "$work/results/eval_$name.log"; } &&
-        { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho --surface blend \
+        { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho --height blend \
             --min-views 0 > "$work/results/orthoblend_$name.json" 2>> "$work/results/eval_$name.log"; } &&
         { [ "${THREED:-0}" = 0 ] || "$bin" eval "$work/run_$name" --3d \
             > "$work/results/3d_$name.json" 2>> "$work/results/eval_$name.log"; } || {

@@ -222,7 +222,7 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   EXPECT_NEAR(few_none, all, 1e-9);
   // The blend through the Gaussians is still there on request.
   double few_blend = 0;
-  EXPECT_GT(covered("--surface blend --min-views 0", &few_blend), 0.1);
+  EXPECT_GT(covered("--height blend --class-from first --min-views 0", &few_blend), 0.1);
 }
 
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
@@ -315,7 +315,8 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_GT(j["dsm"]["rmse_m"].get<double>(), 0.0);
   EXPECT_LE(j["dsm"]["median_abs_m"].get<double>(), j["dsm"]["rmse_m"].get<double>() * 3);
   EXPECT_TRUE(j["dsm"]["per_class"]["building"].contains("rmse_m")) << out;
-  EXPECT_EQ(j["surface"], "first");
+  EXPECT_EQ(j["height"], "first");
+  EXPECT_EQ(j["class_from"], "blend");
   EXPECT_EQ(j["min_views"], 2);
 }
 
@@ -359,9 +360,10 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --bounds 5000,5000,5100,5100 --out " + dir_->file("x"),
               "footprint");
   expectError("ortho " + run() + " --bounds 10,10,0,20 --out " + dir_->file("x"), "--bounds");
-  expectError("ortho " + run() + " --surface top --out " + dir_->file("x"), "--surface");
+  expectError("ortho " + run() + " --height top --out " + dir_->file("x"), "--height");
+  expectError("ortho " + run() + " --class-from top --out " + dir_->file("x"), "--class-from");
   expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
-  expectError("eval " + run() + " --ortho --surface top", "--surface");
+  expectError("eval " + run() + " --ortho --height top", "--height");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");
   expectError("render " + run() + " --size 0x5 --out " + dir_->file("x"), "--size");

@@ -21,9 +21,12 @@ class EvalCommand : public Command {
                 "score the class map on the map grid instead: against the scene's "
                 "ortho_truth.json (from `sadsplat synth`); writes RUN/ortho_metrics.json");
     c->add_option("--truth", truth_, "--ortho: the ground truth's JSON (default: the scene's)");
-    c->add_option("--surface", surface_, "--ortho: the map's surface, as `ortho --surface`")
+    c->add_option("--height", ortho_options_.height, "--ortho: as `ortho --height`")
         ->default_val("first");
-    c->add_option("--min-views", min_views_, "--ortho: as `ortho --min-views`")->default_val(2);
+    c->add_option("--class-from", ortho_options_.class_from, "--ortho: as `ortho --class-from`")
+        ->default_val("blend");
+    c->add_option("--min-views", ortho_options_.min_views, "--ortho: as `ortho --min-views`")
+        ->default_val(2);
     c->add_flag("--3d", cloud_,
                 "score the per-class cloud in 3D instead: every Gaussian's class against the "
                 "nearest true surface of a `sadsplat synth` scene's world, distances to it, "
@@ -39,7 +42,7 @@ class EvalCommand : public Command {
       return 0;
     }
     if (ortho_) {
-      std::cout << pipeline::evalOrthoRun(run_, truth_, surface_, min_views_);
+      std::cout << pipeline::evalOrthoRun(run_, truth_, ortho_options_);
       return 0;
     }
     std::cout << pipeline::evalRun(run_, scene_);
@@ -47,8 +50,8 @@ class EvalCommand : public Command {
   }
 
  private:
-  std::string run_, scene_, truth_, surface_ = "first";
-  int min_views_ = 2;
+  std::string run_, scene_, truth_;
+  pipeline::OrthoRunOptions ortho_options_;
   bool ortho_ = false;
   bool cloud_ = false;
 };

@@ -26,11 +26,15 @@ class OrthoCommand : public Command {
                   "model's footprint)")
         ->delimiter(',')
         ->expected(4);
-    c->add_option("--surface", o_.surface,
-                  "first: each cell shows the first surface its vertical ray meets (where the "
-                  "transmittance falls below 0.5: its height and class); blend: the "
-                  "alpha-weighted blend through every Gaussian on the ray")
+    c->add_option("--height", o_.height,
+                  "the DSM's height: first = of the first surface the cell's vertical ray meets "
+                  "(where the transmittance falls below 0.5); blend = the alpha-weighted mean "
+                  "depth through every Gaussian on the ray")
         ->default_val("first");
+    c->add_option("--class-from", o_.class_from,
+                  "the class map's class: blend = of the feature composited along the ray; "
+                  "first = of the Gaussians in front of the first surface")
+        ->default_val("blend");
     c->add_option("--min-views", o_.min_views,
                   "cells whose surface fewer training photos see are nodata (0: keep all)")
         ->default_val(2);

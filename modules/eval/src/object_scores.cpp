@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numeric>
 #include <tuple>
 #include <unordered_map>
@@ -146,6 +147,95 @@ double footprintIou(const Footprint& a, const Footprint& b, double cell) {
   return either ? double(both) / either : 0.0;
 }
 
+std::vector<int> connectedComponents(const std::vector<std::uint8_t>& mask, int width, int height) {
+  std::vector<int> label(mask.size(), 0);
+  std::vector<std::size_t> stack;
+  int next = 0;
+  for (std::size_t start = 0; start < mask.size(); ++start) {
+    if (!mask[start] || label[start]) continue;
+    label[start] = ++next;
+    stack.push_back(start);
+    while (!stack.empty()) {
+      const std::size_t k = stack.back();
+      stack.pop_back();
+      const int x = static_cast<int>(k % width), y = static_cast<int>(k / width);
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+          const std::size_t n = static_cast<std::size_t>(ny) * width + nx;
+          if (mask[n] && !label[n]) {
+            label[n] = next;
+            stack.push_back(n);
+          }
+        }
+      }
+    }
+  }
+  return label;
+}
+
+namespace {
+
+// Greedy one-to-one matching of (iou, truth, predicted) pairs at iou >= match_iou, best first.
+void matchPairs(std::vector<std::tuple<double, std::size_t, std::size_t>> pairs, double match_iou,
+                ObjectScores* s) {
+  std::sort(pairs.begin(), pairs.end(),
+            [](const auto& a, const auto& b) { return std::get<0>(a) > std::get<0>(b); });
+  std::vector<char> true_used(s->true_objects, 0), pred_used(s->predicted, 0);
+  double iou_sum = 0;
+  for (const auto& [iou, t, p] : pairs) {
+    if (iou < match_iou || true_used[t] || pred_used[p]) continue;
+    true_used[t] = pred_used[p] = 1;
+    ++s->matched;
+    iou_sum += iou;
+  }
+  s->precision = s->predicted ? double(s->matched) / s->predicted : 0.0;
+  s->recall = s->true_objects ? double(s->matched) / s->true_objects : 0.0;
+  s->f1 = s->precision + s->recall > 0 ? 2 * s->precision * s->recall / (s->precision + s->recall)
+                                       : 0.0;
+  s->mean_matched_iou = s->matched ? iou_sum / s->matched : 0.0;
+}
+
+}  // namespace
+
+ObjectScores scoreRasterObjects(const std::vector<int>& predicted, const std::vector<int>& truth,
+                                std::size_t min_cells, double match_iou) {
+  int max_p = 0, max_t = 0;
+  for (int v : predicted) max_p = std::max(max_p, v);
+  for (int v : truth) max_t = std::max(max_t, v);
+  std::vector<std::size_t> area_p(max_p + 1, 0), area_t(max_t + 1, 0);
+  std::map<std::pair<int, int>, std::size_t> overlap;
+  for (std::size_t i = 0; i < predicted.size() && i < truth.size(); ++i) {
+    ++area_p[predicted[i]];
+    ++area_t[truth[i]];
+    if (predicted[i] > 0 && truth[i] > 0) ++overlap[{predicted[i], truth[i]}];
+  }
+  // Predicted objects kept (>= min_cells), renumbered 0..; true objects 0.. as labelled.
+  std::vector<int> kept(max_p + 1, -1);
+  ObjectScores s;
+  for (int p = 1; p <= max_p; ++p) {
+    if (area_p[p] >= min_cells && area_p[p] > 0) kept[p] = static_cast<int>(s.predicted++);
+  }
+  for (int t = 1; t <= max_t; ++t) s.true_objects += area_t[t] > 0;
+  std::vector<int> true_index(max_t + 1, -1);
+  for (int t = 1, k = 0; t <= max_t; ++t) {
+    if (area_t[t] > 0) true_index[t] = k++;
+  }
+  s.best_iou.assign(s.true_objects, 0.0);
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (const auto& [key, inter] : overlap) {
+    const auto [p, t] = key;
+    if (kept[p] < 0) continue;
+    const double iou = double(inter) / double(area_p[p] + area_t[t] - inter);
+    const auto ti = static_cast<std::size_t>(true_index[t]);
+    s.best_iou[ti] = std::max(s.best_iou[ti], iou);
+    pairs.emplace_back(iou, ti, static_cast<std::size_t>(kept[p]));
+  }
+  matchPairs(std::move(pairs), match_iou, &s);
+  return s;
+}
+
 ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
                           const std::vector<Footprint>& truth, const ObjectScoreOptions& o) {
   ObjectScores s;
@@ -168,20 +258,7 @@ ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
       if (iou >= o.match_iou) pairs.emplace_back(iou, t, p);
     }
   }
-  std::sort(pairs.begin(), pairs.end(),
-            [](const auto& a, const auto& b) { return std::get<0>(a) > std::get<0>(b); });
-  std::vector<char> true_used(truth.size(), 0), pred_used(s.predicted, 0);
-  double iou_sum = 0;
-  for (const auto& [iou, t, p] : pairs) {
-    if (true_used[t] || pred_used[p]) continue;
-    true_used[t] = pred_used[p] = 1;
-    ++s.matched;
-    iou_sum += iou;
-  }
-  s.precision = s.predicted ? double(s.matched) / s.predicted : 0.0;
-  s.recall = s.true_objects ? double(s.matched) / s.true_objects : 0.0;
-  s.f1 = s.precision + s.recall > 0 ? 2 * s.precision * s.recall / (s.precision + s.recall) : 0.0;
-  s.mean_matched_iou = s.matched ? iou_sum / s.matched : 0.0;
+  matchPairs(std::move(pairs), o.match_iou, &s);
   return s;
 }
 

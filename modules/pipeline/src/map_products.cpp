@@ -13,6 +13,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/eval/metrics.h"
+#include "sadsplat/eval/object_scores.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
@@ -69,7 +70,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
     throw Error("<ortho>", "--gsd", "a ground sample distance > 0 (metres per pixel)",
                 std::to_string(*o.gsd));
   }
-  const OrthoSurface surface = parseOrthoSurface(o.surface, "--surface");
+  const OrthoSurface height = parseOrthoSurface(o.height, "--height");
+  const OrthoSurface class_from = parseOrthoSurface(o.class_from, "--class-from");
   if (o.min_views < 0) {
     throw Error("<ortho>", "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
   }
@@ -88,8 +90,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
     *o.progress << "ortho: " << grid.width << " x " << grid.height << " pixels at " << gsd << " m, "
                 << grid.frame.crs_name << "\n";
   }
-  const OrthoImages img = renderOrtho(
-      *run.trainer, grid, orthoRenderOptions(run.scene, surface, o.min_views), o.progress);
+  const OrthoImages img =
+      renderOrtho(*run.trainer, grid,
+                  orthoRenderOptions(run.scene, height, class_from, o.min_views), o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
 
@@ -186,7 +189,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["width"] = grid.width;
   j["height"] = grid.height;
   j["covered_share"] = n ? double(covered) / n : 0.0;
-  j["surface"] = o.surface;
+  j["height"] = o.height;
+  j["class_from"] = o.class_from;
   j["min_views"] = o.min_views;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
   j["map_scale_factor"] = grid.frame.k;
@@ -230,8 +234,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
 }
 
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in,
-                         const std::string& surface_text, int min_views) {
-  const OrthoSurface surface = parseOrthoSurface(surface_text, "--surface");
+                         const OrthoRunOptions& render) {
+  const OrthoSurface height = parseOrthoSurface(render.height, "--height");
+  const OrthoSurface class_from = parseOrthoSurface(render.class_from, "--class-from");
+  const int min_views = render.min_views;
   if (min_views < 0) {
     throw Error("<eval>", "--min-views", "a number of photos >= 0", std::to_string(min_views));
   }
@@ -290,25 +296,23 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   // The true DSM (the height of that topmost surface) where the world is known: traced on the
   // same grid (a synth cache names its world; a synth directory's ortho_truth.json does).
   std::vector<float> true_heights;
-  {
-    const std::optional<synth::World> dsm_world =
-        world ? world : synth::worldFromId(worldIdInTruthFile(truth_json));
-    if (dsm_world) {
-      synth::OrthoTruth t = synth::orthoTruth(*dsm_world, grid.gsd);
-      if (t.width == grid.width && t.height == grid.height && t.x0 == grid.x0 && t.y0 == grid.y0) {
-        true_heights = std::move(t.heights);
-      }
+  const std::optional<synth::World> dsm_world =
+      world ? world : synth::worldFromId(worldIdInTruthFile(truth_json));
+  if (dsm_world) {
+    synth::OrthoTruth t = synth::orthoTruth(*dsm_world, grid.gsd);
+    if (t.width == grid.width && t.height == grid.height && t.x0 == grid.x0 && t.y0 == grid.y0) {
+      true_heights = std::move(t.heights);
     }
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
   const OrthoImages img =
-      renderOrtho(*run.trainer, grid, orthoRenderOptions(run.scene, surface, min_views));
+      renderOrtho(*run.trainer, grid, orthoRenderOptions(run.scene, height, class_from, min_views));
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
   std::vector<std::uint8_t> gt;
   std::vector<std::int64_t> pred;
   std::int64_t labelled = 0, uncovered = 0;
-  std::vector<std::int64_t> truth_cells(C, 0), predicted_cells(C, 0);
+  std::vector<std::int64_t> truth_cells(C, 0), truth_covered(C, 0), predicted_cells(C, 0);
   for (std::size_t i = 0; i < truth.size(); ++i) {
     const std::uint8_t g = truth[i];
     if (g >= C) continue;
@@ -319,6 +323,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       continue;
     }
     ++predicted_cells[img.classes[i]];
+    ++truth_covered[g];
     gt.push_back(g);
     pred.push_back(img.classes[i]);
   }
@@ -328,7 +333,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["truth"] = truth_source;
   j["gsd"] = grid.gsd;
   j["cells"] = labelled;
-  j["surface"] = surface_text;
+  j["height"] = render.height;
+  j["class_from"] = render.class_from;
   j["min_views"] = min_views;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
@@ -339,11 +345,18 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     const std::string& name = run.scene.classes[c].name;
     per_class[name] = iou[c] < 0 ? nlohmann::json(nullptr) : nlohmann::json(iou[c]);
     nlohmann::json a;
+    // The error where the map says something (its nodata cells are neither class), and
+    // against the whole labelled area (nodata counting as missing).
     a["truth_m2"] = truth_cells[c] * cell_area;
+    a["truth_covered_m2"] = truth_covered[c] * cell_area;
     a["predicted_m2"] = predicted_cells[c] * cell_area;
     a["relative_error"] = nullptr;
+    a["relative_error_all"] = nullptr;
+    if (truth_covered[c] > 0) {
+      a["relative_error"] = double(predicted_cells[c] - truth_covered[c]) / truth_covered[c];
+    }
     if (truth_cells[c] > 0) {
-      a["relative_error"] = double(predicted_cells[c] - truth_cells[c]) / truth_cells[c];
+      a["relative_error_all"] = double(predicted_cells[c] - truth_cells[c]) / truth_cells[c];
     }
     area[name] = a;
   }
@@ -380,6 +393,50 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     for (int c = 0; c < C; ++c) dsm_class[run.scene.classes[c].name] = summary(errors[c]);
     dsm["per_class"] = dsm_class;
     j["dsm"] = dsm;
+  }
+  // Buildings as map objects: 8-connected regions of building cells (at least kMinObjectM2)
+  // against the world's standing buildings rasterised on the grid, matched at IoU >= 0.5.
+  int building = -1;
+  for (int c = 0; c < C; ++c) building = run.scene.classes[c].name == "building" ? c : building;
+  if (dsm_world && !true_heights.empty() && building >= 0) {
+    constexpr double kMinObjectM2 = 20;
+    const std::size_t n_cells = static_cast<std::size_t>(grid.width) * grid.height;
+    std::vector<int> truth_objects(n_cells, 0);
+    const auto footprints =
+        synth::groundFootprints(*dsm_world, static_cast<std::uint8_t>(building));
+    for (std::size_t f = 0; f < footprints.size(); ++f) {
+      const synth::ObjectFootprint& b = footprints[f];
+      const int i0 = std::max(0, static_cast<int>(std::ceil((b.x0 - grid.x0) / grid.gsd - 0.5)));
+      const int i1 =
+          std::min(grid.width - 1, static_cast<int>(std::floor((b.x1 - grid.x0) / grid.gsd - 0.5)));
+      const int j0 = std::max(0, static_cast<int>(std::ceil((grid.y0 - b.y1) / grid.gsd - 0.5)));
+      const int j1 = std::min(grid.height - 1,
+                              static_cast<int>(std::floor((grid.y0 - b.y0) / grid.gsd - 0.5)));
+      for (int jj = j0; jj <= j1; ++jj) {
+        for (int ii = i0; ii <= i1; ++ii) {
+          truth_objects[static_cast<std::size_t>(jj) * grid.width + ii] = static_cast<int>(f) + 1;
+        }
+      }
+    }
+    std::vector<std::uint8_t> mask(n_cells, 0);
+    for (std::size_t i = 0; i < n_cells; ++i)
+      mask[i] = img.covered[i] && img.classes[i] == building;
+    const eval::ObjectScores o = eval::scoreRasterObjects(
+        eval::connectedComponents(mask, grid.width, grid.height), truth_objects,
+        static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area)));
+    double best_sum = 0;
+    for (double v : o.best_iou) best_sum += v;
+    j["objects"] = {{"class", "building"},
+                    {"min_area_m2", kMinObjectM2},
+                    {"match_iou", 0.5},
+                    {"true", o.true_objects},
+                    {"predicted", o.predicted},
+                    {"matched", o.matched},
+                    {"precision", o.precision},
+                    {"recall", o.recall},
+                    {"f1", o.f1},
+                    {"mean_matched_iou", o.mean_matched_iou},
+                    {"mean_best_iou", o.true_objects ? best_sum / o.true_objects : 0.0}};
   }
   const std::string text = j.dump(2) + "\n";
   writeTextFile(run_dir + "/ortho_metrics.json", text);

@@ -133,9 +133,11 @@ gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off,
   return cam;
 }
 
-OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface surface, int min_views) {
+OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
+                                      OrthoSurface classes, int min_views) {
   OrthoRenderOptions o;
-  o.surface = surface;
+  o.height = height;
+  o.classes = classes;
   o.min_views = min_views;
   for (const io::View& v : scene.views) {
     if (v.train) o.cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
@@ -189,7 +191,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   out.classes.assign(pixels, 255);
   out.elevation.assign(pixels, 0.f);
   out.confidence.assign(pixels, 0.f);
-  const bool first = options.surface == OrthoSurface::kFirst;
+  const bool first_height = options.height == OrthoSurface::kFirst;
+  const bool first_class = options.classes == OrthoSurface::kFirst;
   const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
   int done = 0;
   std::vector<at::Tensor> surface_points, surface_cells;
@@ -201,24 +204,21 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       const gaussians::RenderResult r = trainer.renderCamera(camera);
       const at::Tensor rgb =
           r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
-      at::Tensor covered, depth, cls, conf;
-      at::Tensor features = r.features;
-      if (first) {
+      at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
+      at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
+      if (first_height || first_class) {
         const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5);
+        // The same cells: the transmittance falls below 0.5 where the alpha reaches 0.5.
         covered = layer.reached;
-        depth = layer.depth;
-        features = layer.features;
-      } else {
-        covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
-        depth = r.depth.to(at::kCPU, at::kFloat);
+        if (first_height) depth = layer.depth;
+        if (first_class) features = layer.features;
       }
       if (options.min_views > 0) {
-        const at::Tensor counts = gaussians::viewCounts(backProject(camera, depth), options.cameras)
-                                      .view({h, w})
-                                      .to(at::kCPU);
-        const at::Tensor few = covered & (counts < options.min_views);
-        out.few_views += few.sum().item<std::int64_t>();
-        covered = covered & ~few;
+        // The covered cells' surface points, counted against the photos after the last tile.
+        const at::Tensor cells = covered.reshape(-1).nonzero().reshape(-1);
+        surface_points.push_back(backProject(camera, depth).index_select(0, cells));
+        const at::Tensor ys = cells.div(w, "floor") + y_off, xs = cells.remainder(w) + x_off;
+        surface_cells.push_back(ys * grid.width + xs);
       }
       covered = covered.to(at::kByte).contiguous();
       depth = depth.contiguous();

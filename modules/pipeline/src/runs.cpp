@@ -254,11 +254,11 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     const int iteration = trainer.iteration();
     const double elapsed = seconds();
     // The archive holds tensor handles: copying the lambda shares the snapshot's storage.
-    checkpoint_writes.start([&o, &config, checkpoint, snapshot = trainer.checkpointSnapshot(),
-                             iteration, elapsed] {
-      gaussians::writeTensorArchive(checkpoint, snapshot);
-      writeRunJson(o.out, o.scene, o.scale, config.device, iteration, elapsed);
-    });
+    checkpoint_writes.start(
+        [&o, &config, checkpoint, snapshot = trainer.checkpointSnapshot(), iteration, elapsed] {
+          gaussians::writeTensorArchive(checkpoint, snapshot);
+          writeRunJson(o.out, o.scene, o.scale, config.device, iteration, elapsed);
+        });
     last_checkpoint = iteration;
   };
   const auto checkpointNow = [&] {
@@ -395,8 +395,7 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   checkpoint_writes.wait();
   if (o.progress) *o.progress << "\n";
   if (rendered_again > 0 && o.progress) {
-    *o.progress << "[tile lists] " << rendered_again
-                << (rendered_again == 1 ? " step" : " steps")
+    *o.progress << "[tile lists] " << rendered_again << (rendered_again == 1 ? " step" : " steps")
                 << " rendered again: a tile list sized from earlier renders was short "
                    "(tile_list_margin "
                 << config.tile_list_margin << ")\n";

@@ -30,8 +30,8 @@
 #include "sadsplat/io/colmap.h"
 #include "sadsplat/io/exif_orientation.h"
 #include "sadsplat/io/filesystem.h"
-#include "sadsplat/io/image_file.h"
 #include "sadsplat/io/georeference.h"
+#include "sadsplat/io/image_file.h"
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/imgcodecs.hpp>

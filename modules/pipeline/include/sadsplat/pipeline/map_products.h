@@ -40,7 +40,8 @@ struct OrthoRunOptions {
   std::optional<double>
       gsd;  ///< metres per pixel (> 0); none = the photos' median ground sample distance
   std::optional<std::array<double, 4>> bounds;  ///< xmin, ymin, xmax, ymax in the map CRS
-  std::string surface = "first";  ///< --surface first|blend (ortho_render.h, OrthoSurface)
+  std::string height = "first";      ///< --height first|blend (ortho_render.h, OrthoSurface)
+  std::string class_from = "blend";  ///< --class-from blend|first
   int min_views = 2;  ///< --min-views: cells fewer training photos see are nodata (0: off)
   std::ostream* progress = nullptr;
 };
@@ -53,10 +54,10 @@ std::string orthoRun(const OrthoRunOptions& options);
 
 /// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's
 /// ortho_truth.json (written by `sadsplat synth`) and scores it: mIoU, per-class IoU, and the
-/// area error per class. The map is rendered as `ortho` renders it with `surface` and
-/// `min_views` (OrthoRunOptions). Writes RUN/ortho_metrics.json and returns its text.
+/// area error per class. The map is rendered as `ortho` renders it with `render`'s height,
+/// class_from and min_views. Writes RUN/ortho_metrics.json and returns its text.
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json = "",
-                         const std::string& surface = "first", int min_views = 2);
+                         const OrthoRunOptions& render = {});
 
 }  // namespace pipeline
 }  // namespace sadsplat
