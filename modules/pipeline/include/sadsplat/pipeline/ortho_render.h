@@ -89,8 +89,9 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
                         const OrthoRenderOptions& options, std::ostream* progress = nullptr,
                         int tile = 1024);
 
-/// \brief The options for a scene: its training cameras, `surface` and `min_views`.
-OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface surface, int min_views);
+/// \brief The options for a scene: its training cameras, `height`, `classes` and `min_views`.
+OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
+                                      OrthoSurface classes, int min_views);
 
 /// \brief "first" or "blend" as an OrthoSurface.
 /// \throws sadsplat::Error naming `field` for any other text
