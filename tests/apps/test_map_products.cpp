@@ -241,11 +241,35 @@ TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
 TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   std::string out;
   const std::string dir = dir_->file("geo_ortho");
-  ASSERT_EQ(test::runCommand(kCli + " ortho " + geoRun() + " --gsd 2 --out " + dir, &out), 0)
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " ortho " + geoRun() + " --gsd 2 --vectors building,road --out " + dir, &out),
+      0)
       << out;
   const std::string info = gdalinfo(dir + "/classes.tif");
   EXPECT_NE(info.find("WGS 84 / UTM zone 15N"), std::string::npos) << info;
   EXPECT_NE(info.find("ID[\"EPSG\",32615]"), std::string::npos) << info;
+  // The polygons of two classes, read by OGR's ogrinfo (gdal-bin): in the same CRS, as many as
+  // ortho.json says, each named by its class, no larger in total than the classes' cells.
+  std::string vectors;
+  ASSERT_EQ(test::runCommand("ogrinfo -so -al " + dir + "/vectors.gpkg", &vectors), 0) << vectors;
+  EXPECT_NE(vectors.find("Layer name: classes"), std::string::npos) << vectors;
+  EXPECT_NE(vectors.find("UTM zone 15N"), std::string::npos) << vectors;
+  EXPECT_NE(vectors.find("area_m2: Real"), std::string::npos) << vectors;
+  const nlohmann::json ortho = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
+  const int polygons = ortho["vectors"]["polygons"].get<int>();
+  EXPECT_GT(polygons, 0);
+  EXPECT_NE(vectors.find("Feature Count: " + std::to_string(polygons)), std::string::npos)
+      << vectors;
+  std::string sums;
+  ASSERT_EQ(test::runCommand("ogrinfo -q -sql \"SELECT class, SUM(area_m2) AS a FROM classes "
+                             "GROUP BY class\" " +
+                                 dir + "/vectors.gpkg",
+                             &sums),
+            0)
+      << sums;
+  EXPECT_NE(sums.find("class (String) = building"), std::string::npos) << sums;
+  EXPECT_EQ(sums.find("class (String) = tree"), std::string::npos) << sums;
   // The grid holds the origin's UTM position (the scene's frame is centred near its origin).
   const auto origin_utm = geo::enuToUtm(
       io::georeferenceFromJson(test::readFile(geoRun() + "/georeference.json"), "g"), {{0, 0, 0}});
@@ -363,6 +387,7 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --height top --out " + dir_->file("x"), "--height");
   expectError("ortho " + run() + " --class-from top --out " + dir_->file("x"), "--class-from");
   expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
+  expectError("ortho " + run() + " --vectors roof --out " + dir_->file("x"), "roof");
   expectError("eval " + run() + " --ortho --height top", "--height");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");

@@ -10,6 +10,8 @@
 #include <cpl_string.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
+
+#include "gdal_support.h"
 #endif
 
 namespace sadsplat {
@@ -50,22 +52,9 @@ void Raster::check(const std::string& path) const {
 #if SADSPLAT_HAVE_GDAL
 namespace {
 
-struct DatasetCloser {
-  void operator()(GDALDataset* d) const { GDALClose(d); }
-};
-using Dataset = std::unique_ptr<GDALDataset, DatasetCloser>;
+using gdal::Dataset;
 
-void initGdal() {
-  static const bool once = [] {
-    GDALAllRegister();
-    CPLSetConfigOption("GDAL_PAM_ENABLED", "NO");  // no .aux.xml side files
-    // GDAL's (and, through it, PROJ's) messages are not printed: sadsplat's one-line error
-    // carries the last of them (CPLGetLastErrorMsg), instead of 15 lines before it on a full disk.
-    CPLSetErrorHandler(CPLQuietErrorHandler);
-    return true;
-  }();
-  (void)once;
-}
+void initGdal() { gdal::init(); }
 
 GDALDataType gdalType(Raster::Type t) {
   return t == Raster::Type::kByte     ? GDT_Byte
@@ -84,8 +73,7 @@ void* samples(const Raster& r) {
 }
 
 [[noreturn]] void gdalFailed(const std::string& path, const char* what) {
-  throw Error(path, what, "a file GDAL can write (an existing, writable directory)",
-              CPLGetLastErrorMsg()[0] ? CPLGetLastErrorMsg() : "GDAL failed");
+  gdal::failed(path, what);
 }
 
 void fill(GDALDataset* ds, const Raster& r, const std::string& path) {

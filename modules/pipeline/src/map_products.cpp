@@ -15,6 +15,7 @@
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/geo/raster_files.h"
+#include "sadsplat/geo/vector_files.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/output_set.h"
@@ -80,10 +81,28 @@ std::string orthoRun(const OrthoRunOptions& o) {
                 "a build without it");
   }
   // Written as a set: a failure leaves the previous set whole, a rerun replaces all of it.
-  io::OutputSet files(
-      o.out, {"orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png", "confidence.tif",
-              "confidence.png", "dsm.tif", "dsm.png", "classes.csv", "ortho.json"});
+  std::vector<std::string> outputs = {
+      "orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png", "confidence.tif",
+      "confidence.png", "dsm.tif",        "dsm.png",     "classes.csv", "ortho.json"};
+  if (!o.vectors.empty()) outputs.push_back("vectors.gpkg");
+  io::OutputSet files(o.out, outputs);
   OpenedRun run = openRun(o.run);
+  // The classes of --vectors, checked before the render.
+  geo::ClassPolygonOptions v;
+  std::vector<std::string> names;
+  for (const ClassInfo& c : run.scene.classes) names.push_back(c.name);
+  if (!o.vectors.empty() && run.trainer->numClasses() == 0) {
+    throw Error("<ortho>", "--vectors", "a semantic model (classes)", "no classes");
+  }
+  for (const std::string& name : o.vectors) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      std::string known;
+      for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw Error("<ortho>", "--vectors", "class names of the model (" + known + ")", name);
+    }
+    v.classes.push_back(static_cast<int>(it - names.begin()));
+  }
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
   if (o.progress) {
@@ -113,12 +132,18 @@ std::string orthoRun(const OrthoRunOptions& o) {
     covered += img.covered[i];
     if (img.classes[i] < classes.size()) ++pixels[img.classes[i]];
   }
+  std::size_t polygons = 0;
   if (semantic) {
     geo::Raster ids = geo::Raster::bytesOf(img.width, img.height, 1);
     ids.bytes = img.classes;
     ids.nodata = 255;
     for (const ClassInfo& c : classes) ids.palette.push_back(c.color);
     geo::writeGeoTiff(files.path("classes.tif"), ids, &map);
+    if (!o.vectors.empty()) {
+      v.simplify = grid.gsd;
+      v.min_area = 4 * grid.gsd * grid.gsd;
+      polygons = geo::writeClassPolygons(files.path("vectors.gpkg"), ids, map, names, v);
+    }
     geo::Raster preview = geo::Raster::bytesOf(img.width, img.height, 4);
     preview.last_band_is_alpha = true;
     for (std::size_t i = 0; i < n; ++i) {
@@ -213,6 +238,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["height_datum"] = grid.frame.georeferenced
                           ? "the photos' GPS altitude reference (origin altitude + local up)"
                           : "the scene frame's up axis";
+  if (!o.vectors.empty()) j["vectors"] = {{"file", "vectors.gpkg"}, {"polygons", polygons}};
   j["files"] = semantic ? nlohmann::json{"orthophoto.tif", "classes.tif", "dsm.tif",
                                          "confidence.tif", "classes.csv"}
                         : nlohmann::json{"orthophoto.tif", "dsm.tif", "classes.csv"};

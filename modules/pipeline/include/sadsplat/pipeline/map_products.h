@@ -43,13 +43,17 @@ struct OrthoRunOptions {
   std::string height = "first";      ///< --height first|blend (ortho_render.h, OrthoSurface)
   std::string class_from = "blend";  ///< --class-from blend|first
   int min_views = 2;  ///< --min-views: cells fewer training photos see are nodata (0: off)
+  /// --vectors: classes (names) whose regions go to OUT/vectors.gpkg as polygons (none: no file)
+  std::vector<std::string> vectors;
   std::ostream* progress = nullptr;
 };
 
 /// \brief Writes OUT/orthophoto.tif (RGBA), classes.tif (class ids with a colour table, 255 =
 /// nodata), dsm.tif (float32 height, -9999 = nodata), confidence.tif (float32, -1 = nodata),
 /// their PNG previews, classes.csv (pixels, area in m^2 and share per class) and ortho.json (the
-/// grid, CRS and fit). Returns a short summary for the terminal.
+/// grid, CRS and fit); with `vectors`, vectors.gpkg (geo/vector_files.h: the classes' regions as
+/// polygons simplified to one cell, those under four cells left out). Returns a short summary for
+/// the terminal.
 std::string orthoRun(const OrthoRunOptions& options);
 
 /// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's

@@ -1,0 +1,123 @@
+#include "sadsplat/geo/vector_files.h"
+
+#include <algorithm>
+#include <memory>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/io/atomic_file.h"
+
+#if SADSPLAT_HAVE_GDAL
+#include <gdal_alg.h>
+#include <ogr_api.h>
+#include <ogr_geometry.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
+
+#include "gdal_support.h"
+#endif
+
+namespace sadsplat {
+namespace geo {
+
+#if SADSPLAT_HAVE_GDAL
+
+std::size_t writeClassPolygons(const std::string& path, const Raster& classes, const MapGrid& grid,
+                               const std::vector<std::string>& names,
+                               const ClassPolygonOptions& o) {
+  if (classes.bands != 1 || classes.type != Raster::Type::kByte) {
+    throw Error(path, "class map", "a 1-band 8-bit raster of class ids", "another raster");
+  }
+  classes.check(path);
+  gdal::init();
+  // The class ids and a mask of the selected classes, in memory.
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  gdal::Dataset raster(mem->Create("", classes.width, classes.height, 2, GDT_Byte, nullptr));
+  if (!raster) gdal::failed(path, "polygonize");
+  double transform[6] = {grid.x0, grid.gsd, 0, grid.y0, 0, -grid.gsd};
+  raster->SetGeoTransform(transform);
+  std::vector<std::uint8_t> mask(classes.bytes.size(), 0);
+  for (std::size_t i = 0; i < mask.size(); ++i) {
+    mask[i] =
+        std::find(o.classes.begin(), o.classes.end(), int(classes.bytes[i])) != o.classes.end();
+  }
+  GDALRasterBand* ids = raster->GetRasterBand(1);
+  GDALRasterBand* selected = raster->GetRasterBand(2);
+  if (ids->RasterIO(GF_Write, 0, 0, classes.width, classes.height,
+                    const_cast<std::uint8_t*>(classes.bytes.data()), classes.width, classes.height,
+                    GDT_Byte, 0, 0, nullptr) != CE_None ||
+      selected->RasterIO(GF_Write, 0, 0, classes.width, classes.height, mask.data(), classes.width,
+                         classes.height, GDT_Byte, 0, 0, nullptr) != CE_None) {
+    gdal::failed(path, "polygonize");
+  }
+  OGRSpatialReference srs;
+  const bool has_srs = !grid.wkt.empty() && srs.importFromWkt(grid.wkt.c_str()) == OGRERR_NONE;
+  if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  // Polygonized into a memory layer first: then filtered, simplified and written.
+  GDALDriver* memory = GetGDALDriverManager()->GetDriverByName("Memory");
+  gdal::Dataset scratch(memory->Create("", 0, 0, 0, GDT_Unknown, nullptr));
+  if (!scratch) gdal::failed(path, "polygonize");
+  OGRLayer* raw = scratch->CreateLayer("raw", nullptr, wkbPolygon, nullptr);
+  OGRFieldDefn id_field("class_id", OFTInteger);
+  if (!raw || raw->CreateField(&id_field) != OGRERR_NONE) gdal::failed(path, "polygonize");
+  char eight[] = "8CONNECTED=8";
+  char* options[] = {eight, nullptr};
+  if (GDALPolygonize(ids, selected, raw, 0, options, nullptr, nullptr) != CE_None) {
+    gdal::failed(path, "polygonize");
+  }
+  std::size_t written = 0;
+  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
+    GDALDriver* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!gpkg) gdal::failed(path, "GeoPackage driver");
+    gdal::Dataset out(gpkg->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!out) gdal::failed(path, "create");
+    OGRLayer* layer =
+        out->CreateLayer(o.layer.c_str(), has_srs ? &srs : nullptr, wkbMultiPolygon, nullptr);
+    if (!layer) gdal::failed(path, "layer");
+    OGRFieldDefn class_id("class_id", OFTInteger), class_name("class", OFTString),
+        area("area_m2", OFTReal);
+    if (layer->CreateField(&class_id) != OGRERR_NONE ||
+        layer->CreateField(&class_name) != OGRERR_NONE ||
+        layer->CreateField(&area) != OGRERR_NONE) {
+      gdal::failed(path, "fields");
+    }
+    if (layer->StartTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    raw->ResetReading();
+    for (std::unique_ptr<OGRFeature> f(raw->GetNextFeature()); f; f.reset(raw->GetNextFeature())) {
+      const OGRGeometry* g = f->GetGeometryRef();
+      if (!g) continue;
+      std::unique_ptr<OGRGeometry> shape(o.simplify > 0 ? g->SimplifyPreserveTopology(o.simplify)
+                                                        : g->clone());
+      if (!shape || shape->IsEmpty()) continue;
+      const double a = OGR_G_Area(OGRGeometry::ToHandle(shape.get()));
+      if (a < o.min_area) continue;
+      const int id = f->GetFieldAsInteger(0);
+      OGRFeature feature(layer->GetLayerDefn());
+      feature.SetField("class_id", id);
+      feature.SetField("class", id >= 0 && id < static_cast<int>(names.size())
+                                    ? names[static_cast<std::size_t>(id)].c_str()
+                                    : "");
+      feature.SetField("area_m2", a);
+      feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
+      if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
+      ++written;
+    }
+    if (layer->CommitTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    CPLErrorReset();
+    GDALClose(out.release());
+    if (CPLGetLastErrorType() >= CE_Failure) gdal::failed(path, "close");
+  });
+  return written;
+}
+
+#else
+
+std::size_t writeClassPolygons(const std::string& path, const Raster&, const MapGrid&,
+                               const std::vector<std::string>&, const ClassPolygonOptions&) {
+  throw Error(path, "GeoPackage", "a sadsplat build with GDAL (Debian: libgdal-dev)",
+              "a build without it");
+}
+
+#endif
+
+}  // namespace geo
+}  // namespace sadsplat
