@@ -20,6 +20,7 @@
 #include "sadsplat/io/las.h"
 #include "sadsplat/io/scene.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/synth/world.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {
@@ -323,6 +324,48 @@ TEST_F(MapProducts, ExtractWritesOneClassAsLasWithAMapOverride) {
                              &out),
             1);
   EXPECT_NE(out.find("bad_map.json"), std::string::npos) << out;
+}
+
+// `synth --out` writes the world's truth for other tools: the true DSM on the map-truth grid,
+// the buildings' footprints (GDAL's ogrinfo reads them; one per standing building of the world)
+// and the top surface's samples with class and instance.
+TEST_F(MapProducts, SynthWritesTheWorldsTruthForOtherTools) {
+  const std::string scene = dir_->file("scene");
+  const std::string dsm = gdalinfo(scene + "/truth_dsm.tif");
+  EXPECT_NE(dsm.find("Size is 800, 800"), std::string::npos) << dsm;
+  EXPECT_NE(dsm.find("NoData Value=-9999"), std::string::npos) << dsm;
+  std::string buildings;
+  ASSERT_EQ(test::runCommand("ogrinfo -so -al " + scene + "/truth_buildings.gpkg", &buildings), 0)
+      << buildings;
+  const synth::World world(synth::SceneKind::kCity, 0);
+  const auto footprints = synth::groundFootprints(world, 0);
+  EXPECT_NE(buildings.find("Feature Count: " + std::to_string(footprints.size())),
+            std::string::npos)
+      << buildings;
+  EXPECT_NE(buildings.find("height_m: Real"), std::string::npos) << buildings;
+  std::ifstream ply(scene + "/truth_surface.ply");
+  std::string line;
+  std::size_t declared = 0, rows = 0;
+  bool body = false;
+  int buildings_seen = 0;
+  while (std::getline(ply, line)) {
+    if (body) {
+      ++rows;
+      std::istringstream f(line);
+      double x, y, z;
+      int cls, instance;
+      ASSERT_TRUE(f >> x >> y >> z >> cls >> instance) << line;
+      if (cls == 0) buildings_seen += instance >= 0;
+      ASSERT_TRUE(cls != 0 || instance >= 0) << line;  // a building sample names its object
+    } else if (line.rfind("element vertex ", 0) == 0) {
+      declared = std::stoul(line.substr(15));
+    } else if (line == "end_header") {
+      body = true;
+    }
+  }
+  EXPECT_EQ(rows, declared);
+  EXPECT_EQ(declared, 160000u);  // 200 m at 0.5 m, all in the labelled area
+  EXPECT_GT(buildings_seen, 1000);
 }
 
 TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {

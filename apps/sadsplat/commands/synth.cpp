@@ -3,7 +3,9 @@
 
 #include "commands.h"
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/map_frame.h"
 #include "sadsplat/io/scene_cache.h"
+#include "sadsplat/pipeline/world_truth.h"
 #include "sadsplat/synth/aerial_benchmark.h"
 #if SADSPLAT_HAVE_OPENCV
 #include "sadsplat/synth/scene_writer.h"
@@ -79,6 +81,8 @@ class SynthCommand : public Command {
       synth::writeScene(scene, out_,
                         colmap_binary_ ? synth::ColmapFormat::kBinary : synth::ColmapFormat::kText);
       if (preview_) synth::writeContactSheet(scene, out_ + "/preview.png");
+      // The world's truth for other tools (GDAL writes it: not in a build without GDAL).
+      if (geo::haveGdal()) std::cout << pipeline::writeWorldTruth(scene.world, out_);
 #else
       throw Error(out_, "--out", "a sadsplat build with OpenCV to write PNG scene directories",
                   "a build without it (use --cache)");

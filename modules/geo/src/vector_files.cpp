@@ -109,7 +109,59 @@ std::size_t writeClassPolygons(const std::string& path, const Raster& classes, c
   return written;
 }
 
+std::size_t writeLabelledPolygons(const std::string& path, const std::string& layer_name,
+                                  const std::string& wkt,
+                                  const std::vector<LabelledPolygon>& polygons) {
+  gdal::init();
+  OGRSpatialReference srs;
+  const bool has_srs = !wkt.empty() && srs.importFromWkt(wkt.c_str()) == OGRERR_NONE;
+  if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::size_t written = 0;
+  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
+    GDALDriver* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!gpkg) gdal::failed(path, "GeoPackage driver");
+    gdal::Dataset out(gpkg->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!out) gdal::failed(path, "create");
+    OGRLayer* layer =
+        out->CreateLayer(layer_name.c_str(), has_srs ? &srs : nullptr, wkbPolygon, nullptr);
+    if (!layer) gdal::failed(path, "layer");
+    OGRFieldDefn id("id", OFTInteger), name("class", OFTString), height("height_m", OFTReal),
+        area("area_m2", OFTReal);
+    for (OGRFieldDefn* f : {&id, &name, &height, &area}) {
+      if (layer->CreateField(f) != OGRERR_NONE) gdal::failed(path, "fields");
+    }
+    if (layer->StartTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    for (const LabelledPolygon& p : polygons) {
+      if (p.ring.size() < 3) continue;
+      auto ring = std::make_unique<OGRLinearRing>();
+      for (const auto& v : p.ring) ring->addPoint(v[0], v[1]);
+      ring->closeRings();
+      OGRPolygon polygon;
+      polygon.addRingDirectly(ring.release());
+      OGRFeature feature(layer->GetLayerDefn());
+      feature.SetField("id", p.id);
+      feature.SetField("class", p.class_name.c_str());
+      feature.SetField("height_m", p.height);
+      feature.SetField("area_m2", polygon.get_Area());
+      feature.SetGeometry(&polygon);
+      if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
+      ++written;
+    }
+    if (layer->CommitTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    CPLErrorReset();
+    GDALClose(out.release());
+    if (CPLGetLastErrorType() >= CE_Failure) gdal::failed(path, "close");
+  });
+  return written;
+}
+
 #else
+
+std::size_t writeLabelledPolygons(const std::string& path, const std::string&, const std::string&,
+                                  const std::vector<LabelledPolygon>&) {
+  throw Error(path, "GeoPackage", "a sadsplat build with GDAL (Debian: libgdal-dev)",
+              "a build without it");
+}
 
 std::size_t writeClassPolygons(const std::string& path, const Raster&, const MapGrid&,
                                const std::vector<std::string>&, const ClassPolygonOptions&) {

@@ -4,6 +4,7 @@
 /// GeoPackage (GDALPolygonize, 8-connected; simplified with OGR's topology-preserving
 /// Douglas-Peucker), in the map's CRS, with class and area attributes. Written atomically.
 
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -28,6 +29,21 @@ struct ClassPolygonOptions {
 std::size_t writeClassPolygons(const std::string& path, const Raster& classes, const MapGrid& grid,
                                const std::vector<std::string>& names,
                                const ClassPolygonOptions& options);
+
+/// \brief A polygon with an id, a class name and a height (e.g. a building's footprint).
+struct LabelledPolygon {
+  std::vector<std::array<double, 2>> ring;  ///< outer ring, not closed (first != last)
+  int id = 0;
+  std::string class_name;
+  double height = 0;
+};
+
+/// \brief Writes `polygons` to a GeoPackage layer `layer` (fields id, class, height_m, area_m2)
+/// in the CRS `wkt` (empty: none). Returns the number written.
+/// \throws sadsplat::Error naming `path` when it cannot be written (or without GDAL)
+std::size_t writeLabelledPolygons(const std::string& path, const std::string& layer,
+                                  const std::string& wkt,
+                                  const std::vector<LabelledPolygon>& polygons);
 
 }  // namespace geo
 }  // namespace sadsplat
