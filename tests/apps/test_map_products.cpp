@@ -221,6 +221,11 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   EXPECT_NEAR(by_default + few_default, all, 1e-9);
   EXPECT_EQ(none, 0.0);
   EXPECT_NEAR(few_none, all, 1e-9);
+  // One-sided views: a spread no set of photos reaches (360 degrees: the unit vectors would have
+  // to cancel exactly) leaves nothing; a small one keeps a subset of the default's cells.
+  double few_spread = 0;
+  EXPECT_EQ(covered("--min-spread 360", &few_spread), 0.0);
+  EXPECT_LE(covered("--min-spread 30", &few_spread), by_default);
   // The blend through the Gaussians is still there on request.
   double few_blend = 0;
   EXPECT_GT(covered("--height blend --class-from first --min-views 0", &few_blend), 0.1);
@@ -430,6 +435,7 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --height top --out " + dir_->file("x"), "--height");
   expectError("ortho " + run() + " --class-from top --out " + dir_->file("x"), "--class-from");
   expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
+  expectError("ortho " + run() + " --min-spread 400 --out " + dir_->file("x"), "--min-spread");
   expectError("ortho " + run() + " --vectors roof --out " + dir_->file("x"), "roof");
   expectError("eval " + run() + " --ortho --height top", "--height");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");

@@ -38,6 +38,10 @@ class OrthoCommand : public Command {
     c->add_option("--min-views", o_.min_views,
                   "cells whose surface fewer training photos see are nodata (0: keep all)")
         ->default_val(2);
+    c->add_option("--min-spread", o_.min_spread,
+                  "cells whose photos all look from one side (horizontal directions spread less "
+                  "than this many degrees) are nodata too (default 0: off)")
+        ->default_val(0);
     c->add_option("--vectors", o_.vectors,
                   "classes (names, comma-separated) whose regions are also written as polygons "
                   "to OUT/vectors.gpkg (GeoPackage: class, area_m2; the map's CRS)")

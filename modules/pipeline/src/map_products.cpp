@@ -76,6 +76,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
   if (o.min_views < 0) {
     throw Error("<ortho>", "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
   }
+  if (!(o.min_spread >= 0 && o.min_spread <= 360)) {
+    throw Error("<ortho>", "--min-spread", "degrees in [0, 360]", std::to_string(o.min_spread));
+  }
   if (!geo::haveGdal()) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
@@ -109,9 +112,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
     *o.progress << "ortho: " << grid.width << " x " << grid.height << " pixels at " << gsd << " m, "
                 << grid.frame.crs_name << "\n";
   }
-  const OrthoImages img =
-      renderOrtho(*run.trainer, grid,
-                  orthoRenderOptions(run.scene, height, class_from, o.min_views), o.progress);
+  const OrthoImages img = renderOrtho(
+      *run.trainer, grid,
+      orthoRenderOptions(run.scene, height, class_from, o.min_views, o.min_spread), o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
 
@@ -217,6 +220,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["height"] = o.height;
   j["class_from"] = o.class_from;
   j["min_views"] = o.min_views;
+  j["min_spread_degrees"] = o.min_spread;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
@@ -332,7 +336,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
   const OrthoImages img =
-      renderOrtho(*run.trainer, grid, orthoRenderOptions(run.scene, height, class_from, min_views));
+      renderOrtho(*run.trainer, grid,
+                  orthoRenderOptions(run.scene, height, class_from, min_views, render.min_spread));
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
   std::vector<std::uint8_t> gt;
@@ -362,6 +367,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["height"] = render.height;
   j["class_from"] = render.class_from;
   j["min_views"] = min_views;
+  j["min_spread_degrees"] = render.min_spread;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();

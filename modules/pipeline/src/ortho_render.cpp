@@ -134,8 +134,10 @@ gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off,
 }
 
 OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
-                                      OrthoSurface classes, int min_views) {
+                                      OrthoSurface classes, int min_views,
+                                      double min_spread_degrees) {
   OrthoRenderOptions o;
+  o.min_spread_degrees = min_spread_degrees;
   o.height = height;
   o.classes = classes;
   o.min_views = min_views;
@@ -178,7 +180,7 @@ at::Tensor backProject(const gaussians::RasterCamera& cam, const at::Tensor& dep
 
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
                         const OrthoRenderOptions& options, std::ostream* progress, int tile) {
-  if (options.min_views > 0 && options.cameras.empty()) {
+  if ((options.min_views > 0 || options.min_spread_degrees > 0) && options.cameras.empty()) {
     throw Error("<ortho>", "cameras", "the training cameras (to count the views of each cell)",
                 "none");
   }
@@ -251,15 +253,32 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     }
   }
   if (progress && tiles_x * tiles_y > 1) *progress << "\n";
-  if (options.min_views > 0 && !surface_points.empty()) {
+  if ((options.min_views > 0 || options.min_spread_degrees > 0) && !surface_points.empty()) {
     const at::Tensor device_probe = trainer.parameters().means;
     const at::Tensor points = at::cat(surface_points).to(device_probe.device());
     const at::Tensor cells = at::cat(surface_cells);
     at::Tensor counts = at::zeros({points.size(0)}, points.options().dtype(at::kInt));
+    // The horizontal directions to the photos that see each point, summed as unit vectors: their
+    // resultant's length over the count says how one-sided the views are.
+    const auto& L = grid.frame.scene_to_local;
+    const at::Tensor to_local =
+        at::tensor(std::vector<double>(L.begin(), L.end()), points.options()).view({3, 3});
+    at::Tensor directions = at::zeros({points.size(0), 2}, points.options());
     int seen_by = 0;
     for (const gaussians::RasterCamera& c : options.cameras) {
       const gaussians::RenderResult r = trainer.renderDepth(c);
-      counts += gaussians::seenUnoccluded(points, c, r.depth, r.alpha).to(at::kInt);
+      const at::Tensor seen = gaussians::seenUnoccluded(points, c, r.depth, r.alpha);
+      counts += seen.to(at::kInt);
+      if (options.min_spread_degrees > 0) {
+        const std::array<double, 3> centre = c.centre();
+        const at::Tensor towards =
+            (at::tensor(std::vector<double>(centre.begin(), centre.end()), points.options()) -
+             points)
+                .matmul(to_local.t())
+                .narrow(1, 0, 2);
+        directions += towards / towards.norm(2, 1, true).clamp_min(1e-9) *
+                      seen.unsqueeze(1).to(points.scalar_type());
+      }
       if (progress &&
           (++seen_by % 10 == 0 || seen_by == static_cast<int>(options.cameras.size()))) {
         *progress << "\r  ortho: cells seen from " << seen_by << "/" << options.cameras.size()
@@ -267,8 +286,15 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       }
     }
     if (progress) *progress << "\n";
-    const at::Tensor few =
-        cells.index_select(0, (counts < options.min_views).to(at::kCPU).nonzero().reshape(-1));
+    at::Tensor unsupported = counts < options.min_views;
+    if (options.min_spread_degrees > 0) {
+      // Spread = 2 acos(resultant length / count): 2a for photos within +-a of one azimuth.
+      const at::Tensor resultant =
+          (directions.norm(2, 1) / counts.clamp_min(1).to(points.scalar_type())).clamp(0, 1);
+      const at::Tensor spread = at::acos(resultant) * (360.0 / M_PI);
+      unsupported = unsupported | (spread < options.min_spread_degrees);
+    }
+    const at::Tensor few = cells.index_select(0, unsupported.to(at::kCPU).nonzero().reshape(-1));
     const auto* pf = few.data_ptr<std::int64_t>();
     for (std::int64_t i = 0; i < few.numel(); ++i) {
       out.covered[pf[i]] = 0;

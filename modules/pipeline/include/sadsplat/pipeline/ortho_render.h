@@ -66,6 +66,11 @@ struct OrthoRenderOptions {
   /// photo sees has no depth from the photos (the survey's edges), one no photo sees (an alley
   /// between tall buildings) is a guess. 0: every covered cell is kept.
   int min_views = 2;
+  /// Not on by default (measured on one CPU model only): a covered cell is also nodata when the
+  /// photos that see it do so from one side: the spread of their horizontal viewing directions
+  /// (2 acos of the mean resultant length of the unit vectors: 2a for photos within +-a of one
+  /// azimuth, 180 for two opposite ones) is below this many degrees. 0: off.
+  double min_spread_degrees = 0;
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
 };
 
@@ -91,7 +96,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
 
 /// \brief The options for a scene: its training cameras, `height`, `classes` and `min_views`.
 OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
-                                      OrthoSurface classes, int min_views);
+                                      OrthoSurface classes, int min_views,
+                                      double min_spread_degrees = 0);
 
 /// \brief "first" or "blend" as an OrthoSurface.
 /// \throws sadsplat::Error naming `field` for any other text
