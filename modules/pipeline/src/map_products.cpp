@@ -271,6 +271,9 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   if (min_views < 0) {
     throw Error("<eval>", "--min-views", "a number of photos >= 0", std::to_string(min_views));
   }
+  if (!(render.min_spread >= 0 && render.min_spread <= 360)) {
+    throw Error("<eval>", "--min-spread", "degrees in [0, 360]", std::to_string(render.min_spread));
+  }
   OpenedRun run = openRun(run_dir);
   if (run.trainer->numClasses() == 0) {
     throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
