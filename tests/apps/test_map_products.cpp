@@ -198,7 +198,7 @@ TEST_F(MapProducts, OrthoWritesGeoTiffsGdalReadsWithTheGridAndLocalCrs) {
 }
 
 // Nodata where too few photos see the surface: a count no cell reaches leaves the map empty,
-// and every cell it took is counted; 0 keeps every covered cell, the default (2) a subset.
+// and every cell it took is counted; 0 (the default) keeps every covered cell, 2 a subset.
 TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   const auto covered = [&](const std::string& args, double* few) {
     std::string out;
@@ -212,8 +212,8 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
     return j["covered_share"].get<double>();
   };
   double few_all = 0, few_default = 0, few_none = 0;
-  const double all = covered("--min-views 0", &few_all);
-  const double by_default = covered("", &few_default);
+  const double all = covered("", &few_all);  // the default: 0, every covered cell
+  const double by_default = covered("--min-views 2", &few_default);
   const double none = covered("--min-views 100000", &few_none);
   EXPECT_EQ(few_all, 0.0);
   EXPECT_GT(all, 0.1);
@@ -222,10 +222,10 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   EXPECT_EQ(none, 0.0);
   EXPECT_NEAR(few_none, all, 1e-9);
   // One-sided views: a spread no set of photos reaches (360 degrees: the unit vectors would have
-  // to cancel exactly) leaves nothing; a small one keeps a subset of the default's cells.
+  // to cancel exactly) leaves nothing; a small one with two views keeps a subset of those two views keep.
   double few_spread = 0;
   EXPECT_EQ(covered("--min-spread 360", &few_spread), 0.0);
-  EXPECT_LE(covered("--min-spread 30", &few_spread), by_default);
+  EXPECT_LE(covered("--min-views 2 --min-spread 30", &few_spread), by_default);
   // The blend through the Gaussians is still there on request.
   double few_blend = 0;
   EXPECT_GT(covered("--height blend --class-from first --min-views 0", &few_blend), 0.1);
@@ -389,7 +389,7 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_TRUE(j["dsm"]["per_class"]["building"].contains("rmse_m")) << out;
   EXPECT_EQ(j["height"], "first");
   EXPECT_EQ(j["class_from"], "blend");
-  EXPECT_EQ(j["min_views"], 2);
+  EXPECT_EQ(j["min_views"], 0);
 }
 
 TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {

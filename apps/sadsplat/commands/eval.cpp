@@ -28,7 +28,7 @@ class EvalCommand : public Command {
     c->add_option("--min-spread", ortho_options_.min_spread, "--ortho: as `ortho --min-spread`")
         ->default_val(0);
     c->add_option("--min-views", ortho_options_.min_views, "--ortho: as `ortho --min-views`")
-        ->default_val(2);
+        ->default_val(0);
     c->add_flag("--3d", cloud_,
                 "score the per-class cloud in 3D instead: every Gaussian's class against the "
                 "nearest true surface of a `sadsplat synth` scene's world, distances to it, "

@@ -36,8 +36,12 @@ class OrthoCommand : public Command {
                   "first = of the Gaussians in front of the first surface")
         ->default_val("blend");
     c->add_option("--min-views", o_.min_views,
-                  "cells whose surface fewer training photos see are nodata (0: keep all)")
-        ->default_val(2);
+                  "cells whose surface fewer training photos see unoccluded are nodata (default 0: keep all)")
+        ->default_val(0);
+    c->add_option("--depth-tolerance", o_.depth_tolerance,
+                  "--min-views: a photo sees a cell when the depth it renders there agrees within "
+                  "this share of the cell's depth")
+        ->default_val(0.02);
     c->add_option("--min-spread", o_.min_spread,
                   "cells whose photos all look from one side (horizontal directions spread less "
                   "than this many degrees) are nodata too (default 0: off)")

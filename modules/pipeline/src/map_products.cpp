@@ -79,6 +79,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
   if (!(o.min_spread >= 0 && o.min_spread <= 360)) {
     throw Error("<ortho>", "--min-spread", "degrees in [0, 360]", std::to_string(o.min_spread));
   }
+  if (!(o.depth_tolerance > 0 && o.depth_tolerance <= 1)) {
+    throw Error("<ortho>", "--depth-tolerance", "a share of the depth in (0, 1]",
+                std::to_string(o.depth_tolerance));
+  }
   if (!geo::haveGdal()) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
@@ -112,9 +116,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
     *o.progress << "ortho: " << grid.width << " x " << grid.height << " pixels at " << gsd << " m, "
                 << grid.frame.crs_name << "\n";
   }
-  const OrthoImages img = renderOrtho(
-      *run.trainer, grid,
-      orthoRenderOptions(run.scene, height, class_from, o.min_views, o.min_spread), o.progress);
+  OrthoRenderOptions render_options =
+      orthoRenderOptions(run.scene, height, class_from, o.min_views, o.min_spread);
+  render_options.depth_tolerance = o.depth_tolerance;
+  const OrthoImages img = renderOrtho(*run.trainer, grid, render_options, o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
 
@@ -221,6 +226,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["class_from"] = o.class_from;
   j["min_views"] = o.min_views;
   j["min_spread_degrees"] = o.min_spread;
+  j["depth_tolerance"] = o.depth_tolerance;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
@@ -338,9 +344,10 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     }
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
-  const OrthoImages img =
-      renderOrtho(*run.trainer, grid,
-                  orthoRenderOptions(run.scene, height, class_from, min_views, render.min_spread));
+  OrthoRenderOptions render_options =
+      orthoRenderOptions(run.scene, height, class_from, min_views, render.min_spread);
+  render_options.depth_tolerance = render.depth_tolerance;
+  const OrthoImages img = renderOrtho(*run.trainer, grid, render_options);
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
   std::vector<std::uint8_t> gt;
@@ -371,6 +378,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["class_from"] = render.class_from;
   j["min_views"] = min_views;
   j["min_spread_degrees"] = render.min_spread;
+  j["depth_tolerance"] = render.depth_tolerance;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();

@@ -215,7 +215,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
         if (first_height) depth = layer.depth;
         if (first_class) features = layer.features;
       }
-      if (options.min_views > 0) {
+      if (options.min_views > 0 || options.min_spread_degrees > 0) {
         // The covered cells' surface points, counted against the photos after the last tile.
         const at::Tensor cells = covered.reshape(-1).nonzero().reshape(-1);
         surface_points.push_back(backProject(camera, depth).index_select(0, cells));
@@ -267,7 +267,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     int seen_by = 0;
     for (const gaussians::RasterCamera& c : options.cameras) {
       const gaussians::RenderResult r = trainer.renderDepth(c);
-      const at::Tensor seen = gaussians::seenUnoccluded(points, c, r.depth, r.alpha);
+      const at::Tensor seen =
+          gaussians::seenUnoccluded(points, c, r.depth, r.alpha, options.depth_tolerance);
       counts += seen.to(at::kInt);
       if (options.min_spread_degrees > 0) {
         const std::array<double, 3> centre = c.centre();

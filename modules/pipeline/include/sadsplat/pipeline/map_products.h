@@ -42,8 +42,9 @@ struct OrthoRunOptions {
   std::optional<std::array<double, 4>> bounds;  ///< xmin, ymin, xmax, ymax in the map CRS
   std::string height = "first";      ///< --height first|blend (ortho_render.h, OrthoSurface)
   std::string class_from = "blend";  ///< --class-from blend|first
-  int min_views = 2;      ///< --min-views: cells fewer training photos see are nodata (0: off)
+  int min_views = 0;      ///< --min-views: cells fewer training photos see are nodata (0: off)
   double min_spread = 0;  ///< --min-spread DEG (OrthoRenderOptions::min_spread_degrees)
+  double depth_tolerance = 0.02;  ///< --depth-tolerance (OrthoRenderOptions::depth_tolerance)
   /// --vectors: classes (names) whose regions go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;
   std::ostream* progress = nullptr;
