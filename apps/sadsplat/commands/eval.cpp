@@ -25,6 +25,9 @@ class EvalCommand : public Command {
         ->default_val("first");
     c->add_option("--class-from", ortho_options_.class_from, "--ortho: as `ortho --class-from`")
         ->default_val("blend");
+    c->add_option("--depth-tolerance", ortho_options_.depth_tolerance,
+                  "--ortho: as `ortho --depth-tolerance`")
+        ->default_val(0.02);
     c->add_option("--min-spread", ortho_options_.min_spread, "--ortho: as `ortho --min-spread`")
         ->default_val(0);
     c->add_option("--min-views", ortho_options_.min_views, "--ortho: as `ortho --min-views`")

@@ -64,6 +64,28 @@ double roundToSignificant(double v, int digits) {
   return std::round(v * p) / p;
 }
 
+// The render options `ortho` and `eval --ortho` share, checked before any file is read (errors
+// name `what`, the command, and the flag); the cameras come with the scene.
+OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what) {
+  OrthoRenderOptions r;
+  r.height = parseOrthoSurface(o.height, "--height");
+  r.classes = parseOrthoSurface(o.class_from, "--class-from");
+  if (o.min_views < 0) {
+    throw Error(what, "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
+  }
+  if (!(o.min_spread >= 0 && o.min_spread <= 360)) {
+    throw Error(what, "--min-spread", "degrees in [0, 360]", std::to_string(o.min_spread));
+  }
+  if (!(o.depth_tolerance > 0 && o.depth_tolerance <= 1)) {
+    throw Error(what, "--depth-tolerance", "a share of the depth in (0, 1]",
+                std::to_string(o.depth_tolerance));
+  }
+  r.min_views = o.min_views;
+  r.min_spread_degrees = o.min_spread;
+  r.depth_tolerance = o.depth_tolerance;
+  return r;
+}
+
 }  // namespace
 
 std::string orthoRun(const OrthoRunOptions& o) {
@@ -71,18 +93,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     throw Error("<ortho>", "--gsd", "a ground sample distance > 0 (metres per pixel)",
                 std::to_string(*o.gsd));
   }
-  const OrthoSurface height = parseOrthoSurface(o.height, "--height");
-  const OrthoSurface class_from = parseOrthoSurface(o.class_from, "--class-from");
-  if (o.min_views < 0) {
-    throw Error("<ortho>", "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
-  }
-  if (!(o.min_spread >= 0 && o.min_spread <= 360)) {
-    throw Error("<ortho>", "--min-spread", "degrees in [0, 360]", std::to_string(o.min_spread));
-  }
-  if (!(o.depth_tolerance > 0 && o.depth_tolerance <= 1)) {
-    throw Error("<ortho>", "--depth-tolerance", "a share of the depth in (0, 1]",
-                std::to_string(o.depth_tolerance));
-  }
+  OrthoRenderOptions render_options = checkedRenderOptions(o, "<ortho>");
   if (!geo::haveGdal()) {
     throw Error("<ortho>", "build", "a sadsplat build with GDAL (Debian: libgdal-dev)",
                 "a build without it");
@@ -116,9 +127,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     *o.progress << "ortho: " << grid.width << " x " << grid.height << " pixels at " << gsd << " m, "
                 << grid.frame.crs_name << "\n";
   }
-  OrthoRenderOptions render_options =
-      orthoRenderOptions(run.scene, height, class_from, o.min_views, o.min_spread);
-  render_options.depth_tolerance = o.depth_tolerance;
+  render_options.cameras = trainingCameras(run.scene);
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options, o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
@@ -271,15 +280,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
 
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in,
                          const OrthoRunOptions& render) {
-  const OrthoSurface height = parseOrthoSurface(render.height, "--height");
-  const OrthoSurface class_from = parseOrthoSurface(render.class_from, "--class-from");
-  const int min_views = render.min_views;
-  if (min_views < 0) {
-    throw Error("<eval>", "--min-views", "a number of photos >= 0", std::to_string(min_views));
-  }
-  if (!(render.min_spread >= 0 && render.min_spread <= 360)) {
-    throw Error("<eval>", "--min-spread", "degrees in [0, 360]", std::to_string(render.min_spread));
-  }
+  OrthoRenderOptions render_options = checkedRenderOptions(render, "<eval>");
   OpenedRun run = openRun(run_dir);
   if (run.trainer->numClasses() == 0) {
     throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
@@ -344,9 +345,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     }
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
-  OrthoRenderOptions render_options =
-      orthoRenderOptions(run.scene, height, class_from, min_views, render.min_spread);
-  render_options.depth_tolerance = render.depth_tolerance;
+  render_options.cameras = trainingCameras(run.scene);
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options);
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
@@ -376,7 +375,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["cells"] = labelled;
   j["height"] = render.height;
   j["class_from"] = render.class_from;
-  j["min_views"] = min_views;
+  j["min_views"] = render.min_views;
   j["min_spread_degrees"] = render.min_spread;
   j["depth_tolerance"] = render.depth_tolerance;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;

@@ -133,18 +133,12 @@ gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off,
   return cam;
 }
 
-OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
-                                      OrthoSurface classes, int min_views,
-                                      double min_spread_degrees) {
-  OrthoRenderOptions o;
-  o.min_spread_degrees = min_spread_degrees;
-  o.height = height;
-  o.classes = classes;
-  o.min_views = min_views;
+std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene) {
+  std::vector<gaussians::RasterCamera> cameras;
   for (const io::View& v : scene.views) {
-    if (v.train) o.cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+    if (v.train) cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
   }
-  return o;
+  return cameras;
 }
 
 OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field) {

@@ -100,10 +100,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
                         const OrthoRenderOptions& options, std::ostream* progress = nullptr,
                         int tile = 1024);
 
-/// \brief The options for a scene: its training cameras, `height`, `classes` and `min_views`.
-OrthoRenderOptions orthoRenderOptions(const io::Scene& scene, OrthoSurface height,
-                                      OrthoSurface classes, int min_views,
-                                      double min_spread_degrees = 0);
+/// \brief The scene's training cameras (OrthoRenderOptions::cameras).
+std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene);
 
 /// \brief "first" or "blend" as an OrthoSurface.
 /// \throws sadsplat::Error naming `field` for any other text
