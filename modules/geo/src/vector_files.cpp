@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <utility>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
@@ -20,6 +21,44 @@ namespace sadsplat {
 namespace geo {
 
 #if SADSPLAT_HAVE_GDAL
+
+namespace {
+
+// Writes one GeoPackage layer atomically: the layer in the CRS `wkt` (none when empty or not
+// readable), its `fields`, then fill(layer) inside one transaction; returns what fill counted.
+template <typename Fill>
+std::size_t writeGeoPackageLayer(const std::string& path, const std::string& layer_name,
+                                 const std::string& wkt, OGRwkbGeometryType geometry,
+                                 const std::vector<std::pair<const char*, OGRFieldType>>& fields,
+                                 Fill fill) {
+  gdal::init();
+  OGRSpatialReference srs;
+  const bool has_srs = !wkt.empty() && srs.importFromWkt(wkt.c_str()) == OGRERR_NONE;
+  if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::size_t written = 0;
+  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
+    GDALDriver* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!gpkg) gdal::failed(path, "GeoPackage driver");
+    gdal::Dataset out(gpkg->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!out) gdal::failed(path, "create");
+    OGRLayer* layer =
+        out->CreateLayer(layer_name.c_str(), has_srs ? &srs : nullptr, geometry, nullptr);
+    if (!layer) gdal::failed(path, "layer");
+    for (const auto& [name, type] : fields) {
+      OGRFieldDefn field(name, type);
+      if (layer->CreateField(&field) != OGRERR_NONE) gdal::failed(path, "fields");
+    }
+    if (layer->StartTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    written = fill(layer);
+    if (layer->CommitTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
+    CPLErrorReset();
+    GDALClose(out.release());
+    if (CPLGetLastErrorType() >= CE_Failure) gdal::failed(path, "close");
+  });
+  return written;
+}
+
+}  // namespace
 
 std::size_t writeClassPolygons(const std::string& path, const Raster& classes, const MapGrid& grid,
                                const std::vector<std::string>& names,
@@ -49,9 +88,6 @@ std::size_t writeClassPolygons(const std::string& path, const Raster& classes, c
                          classes.height, GDT_Byte, 0, 0, nullptr) != CE_None) {
     gdal::failed(path, "polygonize");
   }
-  OGRSpatialReference srs;
-  const bool has_srs = !grid.wkt.empty() && srs.importFromWkt(grid.wkt.c_str()) == OGRERR_NONE;
-  if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   // Polygonized into a memory layer first: then filtered, simplified and written.
   GDALDriver* memory = GetGDALDriverManager()->GetDriverByName("Memory");
   gdal::Dataset scratch(memory->Create("", 0, 0, 0, GDT_Unknown, nullptr));
@@ -64,95 +100,61 @@ std::size_t writeClassPolygons(const std::string& path, const Raster& classes, c
   if (GDALPolygonize(ids, selected, raw, 0, options, nullptr, nullptr) != CE_None) {
     gdal::failed(path, "polygonize");
   }
-  std::size_t written = 0;
-  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
-    GDALDriver* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
-    if (!gpkg) gdal::failed(path, "GeoPackage driver");
-    gdal::Dataset out(gpkg->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    if (!out) gdal::failed(path, "create");
-    OGRLayer* layer =
-        out->CreateLayer(o.layer.c_str(), has_srs ? &srs : nullptr, wkbMultiPolygon, nullptr);
-    if (!layer) gdal::failed(path, "layer");
-    OGRFieldDefn class_id("class_id", OFTInteger), class_name("class", OFTString),
-        area("area_m2", OFTReal);
-    if (layer->CreateField(&class_id) != OGRERR_NONE ||
-        layer->CreateField(&class_name) != OGRERR_NONE ||
-        layer->CreateField(&area) != OGRERR_NONE) {
-      gdal::failed(path, "fields");
-    }
-    if (layer->StartTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
-    raw->ResetReading();
-    for (std::unique_ptr<OGRFeature> f(raw->GetNextFeature()); f; f.reset(raw->GetNextFeature())) {
-      const OGRGeometry* g = f->GetGeometryRef();
-      if (!g) continue;
-      std::unique_ptr<OGRGeometry> shape(o.simplify > 0 ? g->SimplifyPreserveTopology(o.simplify)
-                                                        : g->clone());
-      if (!shape || shape->IsEmpty()) continue;
-      const double a = OGR_G_Area(OGRGeometry::ToHandle(shape.get()));
-      if (a < o.min_area) continue;
-      const int id = f->GetFieldAsInteger(0);
-      OGRFeature feature(layer->GetLayerDefn());
-      feature.SetField("class_id", id);
-      feature.SetField("class", id >= 0 && id < static_cast<int>(names.size())
-                                    ? names[static_cast<std::size_t>(id)].c_str()
-                                    : "");
-      feature.SetField("area_m2", a);
-      feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
-      if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
-      ++written;
-    }
-    if (layer->CommitTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
-    CPLErrorReset();
-    GDALClose(out.release());
-    if (CPLGetLastErrorType() >= CE_Failure) gdal::failed(path, "close");
-  });
-  return written;
+  return writeGeoPackageLayer(
+      path, o.layer, grid.wkt, wkbMultiPolygon,
+      {{"class_id", OFTInteger}, {"class", OFTString}, {"area_m2", OFTReal}}, [&](OGRLayer* layer) {
+        std::size_t written = 0;
+        raw->ResetReading();
+        for (std::unique_ptr<OGRFeature> f(raw->GetNextFeature()); f;
+             f.reset(raw->GetNextFeature())) {
+          const OGRGeometry* g = f->GetGeometryRef();
+          if (!g) continue;
+          std::unique_ptr<OGRGeometry> shape(
+              o.simplify > 0 ? g->SimplifyPreserveTopology(o.simplify) : g->clone());
+          if (!shape || shape->IsEmpty()) continue;
+          const double a = OGR_G_Area(OGRGeometry::ToHandle(shape.get()));
+          if (a < o.min_area) continue;
+          const int id = f->GetFieldAsInteger(0);
+          OGRFeature feature(layer->GetLayerDefn());
+          feature.SetField("class_id", id);
+          feature.SetField("class", id >= 0 && id < static_cast<int>(names.size())
+                                        ? names[static_cast<std::size_t>(id)].c_str()
+                                        : "");
+          feature.SetField("area_m2", a);
+          feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
+          if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
+          ++written;
+        }
+        return written;
+      });
 }
 
 std::size_t writeLabelledPolygons(const std::string& path, const std::string& layer_name,
                                   const std::string& wkt,
                                   const std::vector<LabelledPolygon>& polygons) {
-  gdal::init();
-  OGRSpatialReference srs;
-  const bool has_srs = !wkt.empty() && srs.importFromWkt(wkt.c_str()) == OGRERR_NONE;
-  if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  std::size_t written = 0;
-  io::writeViaTemporaryPath(path, [&](const std::string& tmp) {
-    GDALDriver* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
-    if (!gpkg) gdal::failed(path, "GeoPackage driver");
-    gdal::Dataset out(gpkg->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    if (!out) gdal::failed(path, "create");
-    OGRLayer* layer =
-        out->CreateLayer(layer_name.c_str(), has_srs ? &srs : nullptr, wkbPolygon, nullptr);
-    if (!layer) gdal::failed(path, "layer");
-    OGRFieldDefn id("id", OFTInteger), name("class", OFTString), height("height_m", OFTReal),
-        area("area_m2", OFTReal);
-    for (OGRFieldDefn* f : {&id, &name, &height, &area}) {
-      if (layer->CreateField(f) != OGRERR_NONE) gdal::failed(path, "fields");
-    }
-    if (layer->StartTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
-    for (const LabelledPolygon& p : polygons) {
-      if (p.ring.size() < 3) continue;
-      auto ring = std::make_unique<OGRLinearRing>();
-      for (const auto& v : p.ring) ring->addPoint(v[0], v[1]);
-      ring->closeRings();
-      OGRPolygon polygon;
-      polygon.addRingDirectly(ring.release());
-      OGRFeature feature(layer->GetLayerDefn());
-      feature.SetField("id", p.id);
-      feature.SetField("class", p.class_name.c_str());
-      feature.SetField("height_m", p.height);
-      feature.SetField("area_m2", polygon.get_Area());
-      feature.SetGeometry(&polygon);
-      if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
-      ++written;
-    }
-    if (layer->CommitTransaction() != OGRERR_NONE) gdal::failed(path, "transaction");
-    CPLErrorReset();
-    GDALClose(out.release());
-    if (CPLGetLastErrorType() >= CE_Failure) gdal::failed(path, "close");
-  });
-  return written;
+  return writeGeoPackageLayer(
+      path, layer_name, wkt, wkbPolygon,
+      {{"id", OFTInteger}, {"class", OFTString}, {"height_m", OFTReal}, {"area_m2", OFTReal}},
+      [&](OGRLayer* layer) {
+        std::size_t written = 0;
+        for (const LabelledPolygon& p : polygons) {
+          if (p.ring.size() < 3) continue;
+          auto ring = std::make_unique<OGRLinearRing>();
+          for (const auto& v : p.ring) ring->addPoint(v[0], v[1]);
+          ring->closeRings();
+          OGRPolygon polygon;
+          polygon.addRingDirectly(ring.release());
+          OGRFeature feature(layer->GetLayerDefn());
+          feature.SetField("id", p.id);
+          feature.SetField("class", p.class_name.c_str());
+          feature.SetField("height_m", p.height);
+          feature.SetField("area_m2", polygon.get_Area());
+          feature.SetGeometry(&polygon);
+          if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
+          ++written;
+        }
+        return written;
+      });
 }
 
 #else
