@@ -126,20 +126,9 @@ std::string evalCloudRun(const std::string& run_dir) {
     }
     const eval::ObjectScoreOptions object_options;
     const eval::ObjectScores o = eval::scoreObjects(centres, truth_footprints, object_options);
-    double best_sum = 0;
-    for (double v : o.best_iou) best_sum += v;
-    j["objects"] = {{"class", "building"},
-                    {"cluster_tolerance_m", object_options.tolerance},
-                    {"min_points", object_options.min_points},
-                    {"match_iou", object_options.match_iou},
-                    {"true", o.true_objects},
-                    {"predicted", o.predicted},
-                    {"matched", o.matched},
-                    {"precision", o.precision},
-                    {"recall", o.recall},
-                    {"f1", o.f1},
-                    {"mean_matched_iou", o.mean_matched_iou},
-                    {"mean_best_iou", o.true_objects ? best_sum / o.true_objects : 0.0}};
+    j["objects"] = buildingObjectsJson(o, {{"cluster_tolerance_m", object_options.tolerance},
+                                           {"min_points", object_options.min_points},
+                                           {"match_iou", object_options.match_iou}});
   }
   const std::string text = j.dump(2) + "\n";
   io::writeFileAtomically(run_dir + "/metrics_3d.json", [&](std::ostream& out) { out << text; });

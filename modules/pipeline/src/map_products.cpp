@@ -466,19 +466,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     const eval::ObjectScores o = eval::scoreRasterObjects(
         eval::connectedComponents(mask, grid.width, grid.height), truth_objects,
         static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area)));
-    double best_sum = 0;
-    for (double v : o.best_iou) best_sum += v;
-    j["objects"] = {{"class", "building"},
-                    {"min_area_m2", kMinObjectM2},
-                    {"match_iou", 0.5},
-                    {"true", o.true_objects},
-                    {"predicted", o.predicted},
-                    {"matched", o.matched},
-                    {"precision", o.precision},
-                    {"recall", o.recall},
-                    {"f1", o.f1},
-                    {"mean_matched_iou", o.mean_matched_iou},
-                    {"mean_best_iou", o.true_objects ? best_sum / o.true_objects : 0.0}};
+    j["objects"] = buildingObjectsJson(o, {{"min_area_m2", kMinObjectM2}, {"match_iou", 0.5}});
   }
   const std::string text = j.dump(2) + "\n";
   writeTextFile(run_dir + "/ortho_metrics.json", text);
