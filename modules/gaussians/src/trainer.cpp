@@ -457,9 +457,12 @@ at::Tensor Trainer::classCosines(const at::Tensor& features) const {
   return d / d.norm(2, 2, true).clamp_min(1e-12);
 }
 
-SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level) const {
+SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level,
+                                    bool features) const {
   c10::AutoGradMode no_grad(false);
-  return renderSurfaceLayer(state_->evaluationGaussians(), camera, level);
+  GaussianParams g = state_->evaluationGaussians();
+  if (!features) g.features = at::Tensor();
+  return renderSurfaceLayer(g, camera, level);
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }

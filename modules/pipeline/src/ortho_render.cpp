@@ -203,7 +203,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
       at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
       if (first_height || first_class) {
-        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5);
+        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5, first_class);
         // The same cells: the transmittance falls below 0.5 where the alpha reaches 0.5.
         covered = layer.reached;
         if (first_height) depth = layer.depth;

@@ -116,8 +116,10 @@ class Trainer {
   at::Tensor classCosines(const at::Tensor& features) const;
   /// \brief The first surface of the current Gaussians through an orthographic camera: where
   /// the transmittance falls below `level` (surface_layer.h), the Gaussians as renderCamera
-  /// draws them. On the CPU.
-  SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5) const;
+  /// draws them. On the CPU. `features` false: SurfaceLayer::features has 0 channels (the
+  /// compositing skips them).
+  SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5,
+                             bool features = true) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 
