@@ -52,7 +52,7 @@ TrainConfig guardConfig() {
 }
 
 std::unique_ptr<DropState> guardOf(const TrainConfig& c) {
-  auto state = std::make_unique<DropState>(c);
+  auto state = std::make_unique<DropState>(c, c, c);
   state->setStrategy(std::make_shared<EventsEvery>(c.drop_interval, c.iterations));
   state->initialise(3, at::TensorOptions().dtype(at::kFloat));
   return state;

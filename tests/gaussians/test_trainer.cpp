@@ -10,6 +10,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/densification.h"
+#include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/gaussians/view_coverage.h"
@@ -808,27 +809,27 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
 TEST(TrainConfigSchedule, DensificationEndsAtTwoSeventhsAndAShortRunDensifiesForHalf) {
   TrainConfig c;  // 7000 iterations, reset every 3000
   EXPECT_EQ(c.densify_until, -1);
-  EXPECT_EQ(c.densifyUntilResolved(), 2000);
+  EXPECT_EQ(densifyUntilResolved(c), 2000);
   TrainConfig resolved = c;
-  resolved.densify_until = c.densifyUntilResolved();
+  resolved.densify_until = densifyUntilResolved(c);
   EXPECT_FALSE(resetsOpacitiesAfter(resolved, 3000));
   resolved.densify_until = 3500;  // the old default: a reset 500 iterations before the end
   EXPECT_TRUE(resetsOpacitiesAfter(resolved, 3000));
-  EXPECT_EQ(c.shortRunSchedule({}).densify_until, -1);  // 7000 is not a short run
+  EXPECT_EQ(shortRunSchedule(c, {}).densify_until, -1);  // 7000 is not a short run
   c.iterations = 30000;
-  EXPECT_EQ(c.densifyUntilResolved(), 8571);
+  EXPECT_EQ(densifyUntilResolved(c), 8571);
   c.densify_until = 3500;
-  EXPECT_EQ(c.densifyUntilResolved(), 3500);
+  EXPECT_EQ(densifyUntilResolved(c), 3500);
 
   TrainConfig s;
   s.iterations = 600;
   std::vector<std::string> changed;
-  const TrainConfig short_run = s.shortRunSchedule({}, &changed);
+  const TrainConfig short_run = shortRunSchedule(s, {}, &changed);
   EXPECT_EQ(short_run.densify_until, 300);
   EXPECT_NE(std::find(changed.begin(), changed.end(), "densify_until -1 -> 300"), changed.end());
-  EXPECT_EQ(s.shortRunSchedule({"densify_until"}).densifyUntilResolved(), 171);  // kept: -1
+  EXPECT_EQ(densifyUntilResolved(shortRunSchedule(s, {"densify_until"})), 171);  // kept: -1
   s.densify_until = 100;
-  EXPECT_EQ(s.shortRunSchedule({}).densify_until, 100);
+  EXPECT_EQ(shortRunSchedule(s, {}).densify_until, 100);
 }
 
 // The trainer runs (and a run's config.json records) the resolved end, not -1.
@@ -948,27 +949,27 @@ TEST_F(TrainerTest, MaskedPixelsOfAMovingObjectLeaveNoGhost) {
 TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKeys) {
   TrainConfig c;
   std::vector<std::string> changed;
-  const TrainConfig net1 = c.longSchedule({}, &changed);
+  const TrainConfig net1 = longSchedule(c, {}, &changed);
   EXPECT_EQ(net1.iterations, 30000);
   EXPECT_EQ(net1.densify_until, 7500);  // the first quarter
   EXPECT_EQ(net1.lambda_l0_from, 0);    // no drop: no gate keys
   EXPECT_EQ(net1.recovery_iterations, 0);
   EXPECT_EQ(changed.size(), 2u);
   c.drop = "full";
-  const TrainConfig full = c.longSchedule({});
+  const TrainConfig full = longSchedule(c, {});
   EXPECT_EQ(full.densify_until, 7500);
   EXPECT_EQ(full.lambda_l0_from, 7500);  // after the densification
   EXPECT_EQ(full.recovery_iterations, 5000);
   full.check();
   c.iterations = 12000;
   c.recovery_iterations = 100;
-  const TrainConfig given = c.longSchedule({"iterations", "recovery_iterations"});
+  const TrainConfig given = longSchedule(c, {"iterations", "recovery_iterations"});
   EXPECT_EQ(given.iterations, 12000);
   EXPECT_EQ(given.densify_until, 3000);
   EXPECT_EQ(given.lambda_l0_from, 3000);
   EXPECT_EQ(given.recovery_iterations, 100);
   c.densify_until = 4000;  // a densification end the user set holds, and the gates follow it
-  const TrainConfig own = c.longSchedule({"iterations", "densify_until"});
+  const TrainConfig own = longSchedule(c, {"iterations", "densify_until"});
   EXPECT_EQ(own.densify_until, 4000);
   EXPECT_EQ(own.lambda_l0_from, 4000);
 }
@@ -977,7 +978,7 @@ TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRat
   TrainConfig c;  // defaults: 7000 iterations, densify 500 / 100, reset 3000, drop 500
   c.densify_until = -1;
   c.checkpoint_interval = 0;
-  const TrainConfig b = c.forGlobalBatch(4);
+  const TrainConfig b = forGlobalBatch(c, 4);
   EXPECT_EQ(b.iterations, 1750);
   EXPECT_EQ(b.densify_from, 125);
   EXPECT_EQ(b.densify_interval, 25);
@@ -993,9 +994,9 @@ TEST(TrainConfigBatch, ASchedulePerGlobalBatchSeesAsManyViewsWithSqrtLearningRat
   EXPECT_EQ(b.seed, c.seed);
   // Intervals never reach 0; one view per step is the configuration itself.
   c.densify_interval = 3;
-  EXPECT_EQ(c.forGlobalBatch(8).densify_interval, 1);
-  EXPECT_EQ(c.forGlobalBatch(1).toJson(), c.toJson());
-  EXPECT_THROW(c.forGlobalBatch(0), Error);
+  EXPECT_EQ(forGlobalBatch(c, 8).densify_interval, 1);
+  EXPECT_EQ(forGlobalBatch(c, 1).toJson(), c.toJson());
+  EXPECT_THROW(forGlobalBatch(c, 0), Error);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "sadsplat/distributed/rank_group.h"
 #include "sadsplat/gaussians/cpu_threads.h"
+#include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/train_options.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/pipeline/runs.h"
@@ -105,23 +106,6 @@ class TrainCommand : public Command {
       gaussians::setOptionFromText(*option, is_flag ? "true" : values_[option], config,
                                    "<command line>");
     }
-    if (!resume_ && schedule_ == "long") {
-      std::vector<std::string> changed;
-      config = config.longSchedule(given, &changed);
-      std::cout << "long schedule:";
-      for (const auto& c : changed) std::cout << " " << c << ";";
-      std::cout << " (set a key to keep its value)\n";
-      config.check("--schedule long");
-    }
-    if (!resume_) {
-      std::vector<std::string> changed;
-      config = config.shortRunSchedule(given, &changed);
-      if (!changed.empty()) {
-        std::cout << "schedule of a run of " << config.iterations << " iterations:";
-        for (const auto& c : changed) std::cout << " " << c << ";";
-        std::cout << " (set a key to keep its value)\n";
-      }
-    }
     // --nproc N starts ranks 1..N-1 as copies of this command (they see RANK and start none).
     std::optional<distributed::LocalRanks> local_ranks;
     if (nproc_ > 0 && std::getenv("RANK") == nullptr) {
@@ -132,9 +116,9 @@ class TrainCommand : public Command {
     const auto rank_env = distributed::RankEnvironment::fromProcessEnvironment();
     const bool quiet_rank = rank_env && rank_env->rank != 0;
     pipeline::TrainRunOptions options;
-    if (batch_schedule_) {
-      config = config.forGlobalBatch(config.views_per_step * (rank_env ? rank_env->world_size : 1));
-    }
+    options.schedule.kind = gaussians::parseScheduleKind(schedule_);
+    options.schedule.given = given;
+    if (batch_schedule_) options.schedule.batch_ranks = rank_env ? rank_env->world_size : 1;
     if (rank_env) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
       if (config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);

@@ -20,8 +20,9 @@ double logit(double p) { return std::log(p / (1 - p)); }
 
 class DefaultDensification : public DensificationStrategy {
  public:
-  DefaultDensification(const TrainConfig& config, double extent)
-      : config_(config), extent_(extent) {}
+  DefaultDensification(const DensificationOptions& options, const ScheduleOptions& schedule,
+                       double extent)
+      : config_{options, schedule}, extent_(extent) {}
 
   void initialise(std::int64_t rows, const at::TensorOptions& options) override {
     grad_accum_ = at::zeros({rows}, options);
@@ -56,7 +57,7 @@ class DefaultDensification : public DensificationStrategy {
   void stepPostUpdate(int done, ParameterStore& params,
                       const std::function<at::Tensor()>& effective_opacity,
                       const Resize& resize) override {
-    const TrainConfig& c = config_;
+    const Settings& c = config_;
     if (c.scale_limit > 0 && done >= c.scale_limit_from) {
       if (done == c.scale_limit_from) splitAbove(params, c.scale_limit * extent_, done, resize);
       // A projection onto the bound (Adam's moments stay as they are). 1e-6 below it, so that
@@ -75,7 +76,7 @@ class DefaultDensification : public DensificationStrategy {
     if (done > c.densify_from && done % c.densify_interval == 0) {
       densifyAndPrune(params, effective_opacity, done > c.opacity_reset_interval, done, resize);
     }
-    if (resetsOpacitiesAfter(c, done)) {
+    if (resetsOpacitiesAfter(c, c, done)) {
       Parameter& o = params["opacity"];
       o.value.clamp_max_(logit(0.01));
       o.m.zero_();
@@ -110,7 +111,7 @@ class DefaultDensification : public DensificationStrategy {
  private:
   void densifyAndPrune(ParameterStore& params, const std::function<at::Tensor()>& effective_opacity,
                        bool prune_big, int iteration, const Resize& resize) {
-    const TrainConfig& c = config_;
+    const Settings& c = config_;
     const at::Tensor avg = grad_accum_ / denom_.clamp_min(1);
     const at::Tensor scales = params["scales"].value.detach().exp();
     const at::Tensor max_scale = std::get<0>(scales.max(1));
@@ -145,7 +146,7 @@ class DefaultDensification : public DensificationStrategy {
   std::map<std::string, at::Tensor> splitRows(ParameterStore& params, const at::Tensor& idx,
                                               const at::Tensor& scales, int iteration,
                                               std::uint64_t salt) const {
-    const TrainConfig& c = config_;
+    const Settings& c = config_;
     const at::Tensor s = scales.index_select(0, idx).repeat({2, 1});
     at::Generator gen = seededGenerator(c.seed, salt, static_cast<std::uint64_t>(iteration));
     const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(s.device()) * s;
@@ -218,7 +219,9 @@ class DefaultDensification : public DensificationStrategy {
     max_radii_.zero_();
   }
 
-  TrainConfig config_;
+  // The strategy's own group and the schedule it runs in (iterations, seed).
+  struct Settings : DensificationOptions, ScheduleOptions {};
+  Settings config_;
   double extent_;
   at::Tensor grad_accum_, denom_, max_radii_;
   at::Tensor step_grad_, step_denom_;  // a step's sums, apart while they are all-reduced
@@ -228,16 +231,16 @@ class DefaultDensification : public DensificationStrategy {
 // third of the reset interval (1000 of 3000; from logit(0.01) an opacity needs ~150 Adam steps at
 // 3DGS's learning rate to reach 0.9). Without it, densify_until = iterations with an interval
 // that divides it reset every opacity to 0.01 after the last step: a model that renders nothing.
-std::int64_t lastResetAllowed(const TrainConfig& c) {
-  return std::min<std::int64_t>(c.densify_until,
-                                std::int64_t{c.iterations} - c.opacity_reset_interval / 3);
+std::int64_t lastResetAllowed(const DensificationOptions& d, const ScheduleOptions& s) {
+  return std::min<std::int64_t>(d.densify_until,
+                                std::int64_t{s.iterations} - d.opacity_reset_interval / 3);
 }
 
 }  // namespace
 
-bool resetsOpacitiesAfter(const TrainConfig& c, int done) {
-  return c.opacity_reset_interval > 0 && done <= lastResetAllowed(c) &&
-         done % c.opacity_reset_interval == 0;
+bool resetsOpacitiesAfter(const DensificationOptions& d, const ScheduleOptions& s, int done) {
+  return d.opacity_reset_interval > 0 && done <= lastResetAllowed(d, s) &&
+         done % d.opacity_reset_interval == 0;
 }
 
 std::string describeDefaultDensification(const TrainConfig& c) {
@@ -255,7 +258,7 @@ std::string describeDefaultDensification(const TrainConfig& c) {
   // Resets after the multiples of opacity_reset_interval up to lastResetAllowed
   // (resetsOpacitiesAfter). Counted, not walked (64 bits: any interval, any length).
   const std::int64_t interval = c.opacity_reset_interval;
-  const std::int64_t last_done = lastResetAllowed(c);
+  const std::int64_t last_done = lastResetAllowed(c, c);
   const std::int64_t resets = interval > 0 && last_done > 0 ? last_done / interval : 0;
   s << "; opacity reset ";
   if (resets == 0) {
@@ -272,8 +275,10 @@ std::string describeDefaultDensification(const TrainConfig& c) {
   return s.str();
 }
 
-DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent) {
-  return std::make_shared<DefaultDensification>(config, extent);
+DensificationStrategy::Ptr makeDefaultDensification(const DensificationOptions& options,
+                                                    const ScheduleOptions& schedule,
+                                                    double extent) {
+  return std::make_shared<DefaultDensification>(options, schedule, extent);
 }
 
 }  // namespace gaussians

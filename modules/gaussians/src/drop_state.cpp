@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <vector>
 #include <tuple>
+#include <vector>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
@@ -26,8 +26,8 @@ void DropState::initialise(std::int64_t rows, const at::TensorOptions& options) 
 }
 
 int DropState::recoveryStart() const {
-  return config_.recovery_iterations > 0 ? config_.iterations - config_.recovery_iterations
-                                         : config_.iterations + 1;
+  return options_.recovery_iterations > 0 ? schedule_.iterations - options_.recovery_iterations
+                                          : schedule_.iterations + 1;
 }
 
 at::Tensor DropState::evaluationGate(const ParameterStore& params, int iteration) const {
@@ -48,17 +48,17 @@ at::Tensor DropState::effectiveOpacity(const ParameterStore& params, int iterati
 at::Tensor DropState::regularisation(const ParameterStore& params, int it) const {
   if (!gated(it) || balanced()) return at::Tensor();
   return drop_->regularisation(params["log_alpha"].value, it,
-                               config_.l0_importance > 0 ? l0_weights_ : at::Tensor());
+                               options_.l0_importance > 0 ? l0_weights_ : at::Tensor());
 }
 
 void DropState::addL0Gradient(ParameterStore& params, int it) const {
   if (!gated(it) || !balanced()) return;
   // The L0 schedule (lambda_l0_from, lambda_l0_ramp) applies to the strength as to lambda_l0.
-  if (it < config_.lambda_l0_from) return;
-  double strength = config_.l0_strength * guard_[0];
-  if (config_.lambda_l0_ramp > 0) {
-    strength *= std::min(1.0, static_cast<double>(it - config_.lambda_l0_from + 1) /
-                                  config_.lambda_l0_ramp);
+  if (it < options_.lambda_l0_from) return;
+  double strength = options_.l0_strength * guard_[0];
+  if (options_.lambda_l0_ramp > 0) {
+    strength *= std::min(
+        1.0, static_cast<double>(it - options_.lambda_l0_from + 1) / options_.lambda_l0_ramp);
   }
   Parameter& la = params["log_alpha"];
   at::Tensor grad = la.value.grad();
@@ -71,20 +71,20 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
   const at::Tensor opacity_grad = params["opacity"].value.grad();
   if (!opacity_grad.defined()) return;
   addBalancedL0Force(grad, direction, opacity_grad,
-                     config_.l0_importance > 0 ? l0_weights_ : at::Tensor(), strength);
+                     options_.l0_importance > 0 ? l0_weights_ : at::Tensor(), strength);
 }
 
 bool DropState::guardProbeDue(int done) const {
   // Drop events of the balanced rule start with the L0 force (dropIfDue).
-  return drop_ && balanced() && config_.drop_guard > 0 && done < recoveryStart() &&
-         done >= config_.lambda_l0_from && drop_->dropNow(done);
+  return drop_ && balanced() && options_.drop_guard > 0 && done < recoveryStart() &&
+         done >= options_.lambda_l0_from && drop_->dropNow(done);
 }
 
 bool DropState::openedByReset(int from, int to) const {
   // A reset after iteration r comes after the drop event of r and so after its reading: the
   // resets between the readings of `from` and `to` are those after from .. to - 1.
   for (int r = from; r < to; ++r) {
-    if (resetsOpacitiesAfter(config_, r)) return true;
+    if (resetsOpacitiesAfter(densification_, schedule_, r)) return true;
   }
   return false;
 }
@@ -94,14 +94,15 @@ void DropState::observeGuardProbe(int done, double probe_mse) {
   // The reference is the lowest reading since the last opacity reset: a drop whose cost the
   // training has not won back by the next event halves the pressure again.
   const bool fresh = guard_[1] < 0 || openedByReset(static_cast<int>(guard_[2]), done);
-  if (!fresh && probe_mse > guard_[1] * (1 + config_.drop_guard)) guard_[0] *= 0.5;
+  if (!fresh && probe_mse > guard_[1] * (1 + options_.drop_guard)) guard_[0] *= 0.5;
   guard_[1] = fresh ? probe_mse : std::min(guard_[1], probe_mse);
   guard_[2] = done;
 }
 
 bool DropState::refreshesL0Weights(int it) const {
-  return gated(it) && config_.l0_importance > 0 && config_.drop_interval > 0 &&
-         it >= config_.lambda_l0_from && (it - config_.lambda_l0_from) % config_.drop_interval == 0;
+  return gated(it) && options_.l0_importance > 0 && options_.drop_interval > 0 &&
+         it >= options_.lambda_l0_from &&
+         (it - options_.lambda_l0_from) % options_.drop_interval == 0;
 }
 
 void DropState::refreshL0Weights(const ParameterStore& params, const TrainingViews& views,
@@ -109,7 +110,7 @@ void DropState::refreshL0Weights(const ParameterStore& params, const TrainingVie
   GaussianParams g = params.gaussians();
   g.opacity_gate = evaluationGate(params, iteration);
   l0_weights_ = inverseContributionWeights(blendingWeightSums(g, views.trainingCameras()),
-                                           config_.l0_importance);
+                                           options_.l0_importance);
 }
 
 DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
@@ -120,11 +121,11 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
   // The balanced rule prunes late when asked: no drop event (and no guard reading) before the L0
   // force starts, so that densification, opacity resets and the semantic factor alone remove
   // nothing before it (the paper's rule drops from the start).
-  if (balanced() && done < config_.lambda_l0_from) return decision;
+  if (balanced() && done < options_.lambda_l0_from) return decision;
   DropInputs in;
   if (balanced()) {
     in.max_removed = static_cast<std::int64_t>(
-        std::floor(config_.drop_max_fraction * guard_[0] * static_cast<double>(params.rows())));
+        std::floor(options_.drop_max_fraction * guard_[0] * static_cast<double>(params.rows())));
   }
   in.means = params["means"].value.detach();
   in.opacities = at::sigmoid(params["opacity"].value.detach());
@@ -160,10 +161,10 @@ std::pair<std::int64_t, std::int64_t> DropState::settleGates(ParameterStore& par
     la.m.zero_();
     la.v.zero_();
   }
-  if (config_.recovery_prune > 0 && params.rows() > 0) {
+  if (options_.recovery_prune > 0 && params.rows() > 0) {
     const at::Tensor score = blendingWeightSums(params.gaussians(), views.trainingCameras());
     const std::int64_t count = static_cast<std::int64_t>(
-        std::floor(config_.recovery_prune * static_cast<double>(params.rows())));
+        std::floor(options_.recovery_prune * static_cast<double>(params.rows())));
     if (count > 0) {
       // The `count` lowest scores go (ties by index: a stable sort keeps this deterministic).
       const at::Tensor order = std::get<1>(score.sort(/*stable=*/true, 0, false));

@@ -24,7 +24,11 @@ class DropState {
  public:
   using Resize = DensificationStrategy::Resize;
 
-  explicit DropState(const TrainConfig& config) : config_(config) {}
+  // The drop's own options; the schedule and the densification's only for the run's length and
+  // its opacity resets (the guard's reference starts afresh after one).
+  DropState(const DropOptions& options, const ScheduleOptions& schedule,
+            const DensificationOptions& densification)
+      : options_(options), schedule_(schedule), densification_(densification) {}
   void setStrategy(std::shared_ptr<const DropStrategy> strategy) { drop_ = std::move(strategy); }
   void initialise(std::int64_t rows, const at::TensorOptions& options);
 
@@ -82,8 +86,7 @@ class DropState {
                                                     const Resize& resize);
   // After the last iteration: Gaussians whose evaluation gate is closed (z = 0) render nothing;
   // removing them changes no render. Returns how many went.
-  std::int64_t removeClosedGates(const ParameterStore& params, int iteration,
-                                 const Resize& resize);
+  std::int64_t removeClosedGates(const ParameterStore& params, int iteration, const Resize& resize);
 
   const at::Tensor& confidence() const { return confidence_; }
   void resized(const RowChange& change);
@@ -92,11 +95,13 @@ class DropState {
   void checkRows(std::int64_t rows) const;
 
  private:
-  TrainConfig config_;
+  DropOptions options_;
+  ScheduleOptions schedule_;
+  DensificationOptions densification_;
   std::shared_ptr<const DropStrategy> drop_;
   at::Tensor confidence_;  // [N] last semantic confidence computed by the drop (0 before)
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
-  bool balanced() const { return config_.drop_rule == "balanced"; }
+  bool balanced() const { return options_.drop_rule == "balanced"; }
   bool openedByReset(int from, int to) const;
   // guard_[3] of the guard's present state (checkpoints written before the fixed probe views held
   // a count of training-loss readings >= 0 there, and start a fresh reading).

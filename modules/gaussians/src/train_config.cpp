@@ -64,36 +64,6 @@ double real(const nlohmann::json& d, const char* key, const std::string& origin)
 
 }  // namespace
 
-TrainConfig TrainConfig::forGlobalBatch(int views) const {
-  if (views < 1)
-    throw Error("<config>", "global batch", ">= 1 views per step", std::to_string(views));
-  TrainConfig c = *this;
-  if (views == 1) return c;
-  // Counts round to the nearest step, intervals stay >= 1 (0 and -1 keep their meaning).
-  const auto steps = [views](int count) {
-    return count <= 0 ? count : std::max(1, static_cast<int>(std::lround(double(count) / views)));
-  };
-  c.iterations = steps(iterations);
-  c.sh_increase_interval = steps(sh_increase_interval);
-  c.densify_from = steps(densify_from);
-  c.densify_until = steps(densify_until);
-  c.densify_interval = steps(densify_interval);
-  c.opacity_reset_interval = steps(opacity_reset_interval);
-  c.checkpoint_interval = steps(checkpoint_interval);
-  c.drop_interval = steps(drop_interval);
-  c.recovery_iterations = steps(recovery_iterations);
-  c.lambda_l0_from = steps(lambda_l0_from);
-  c.lambda_l0_ramp = steps(lambda_l0_ramp);
-  c.scale_limit_from = steps(scale_limit_from);
-  const double lr = std::sqrt(static_cast<double>(views));
-  for (double* rate :
-       {&c.lr_position_init, &c.lr_position_final, &c.lr_sh_dc, &c.lr_sh_rest, &c.lr_opacity,
-        &c.lr_scaling, &c.lr_rotation, &c.lr_feature, &c.lr_decoder, &c.lr_log_alpha}) {
-    *rate *= lr;
-  }
-  return c;
-}
-
 namespace {
 
 using C = TrainConfig;
@@ -323,66 +293,6 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
                 std::string("a ") + reference.type_name(), value.type_name());
   }
   setFromJson(option, value, config, origin);
-}
-
-namespace {
-
-// A schedule's change of one key: `member` becomes `value` unless the user gave `key`; each
-// change is noted in `changed` (if not null) as "key old -> new".
-class ScheduleKeys {
- public:
-  ScheduleKeys(const std::vector<std::string>& given, std::vector<std::string>* changed)
-      : given_(given), changed_(changed) {}
-  void set(const char* key, int& member, int value) const {
-    if (std::find(given_.begin(), given_.end(), key) != given_.end() || member == value) return;
-    if (changed_) {
-      changed_->push_back(std::string(key) + " " + std::to_string(member) + " -> " +
-                          std::to_string(value));
-    }
-    member = value;
-  }
-
- private:
-  const std::vector<std::string>& given_;
-  std::vector<std::string>* changed_;
-};
-
-}  // namespace
-
-TrainConfig TrainConfig::shortRunSchedule(const std::vector<std::string>& given,
-                                          std::vector<std::string>* changed) const {
-  TrainConfig c = *this;
-  if (iterations >= 7000) return c;
-  const ScheduleKeys keys(given, changed);
-  keys.set("sh_increase_interval", c.sh_increase_interval,
-           std::min(sh_increase_interval, std::max(1, iterations / 4)));
-  keys.set("densify_from", c.densify_from, std::min(densify_from, iterations / 10));
-  keys.set("opacity_reset_interval", c.opacity_reset_interval,
-           std::max(iterations, opacity_reset_interval));
-  keys.set("drop_interval", c.drop_interval, std::min(drop_interval, std::max(1, iterations / 4)));
-  if (c.densify_until < 0) keys.set("densify_until", c.densify_until, iterations / 2);
-  return c;
-}
-
-int TrainConfig::densifyUntilResolved() const {
-  if (densify_until >= 0) return densify_until;
-  return static_cast<int>(std::int64_t{iterations} * 2 / 7);
-}
-
-TrainConfig TrainConfig::longSchedule(const std::vector<std::string>& given,
-                                      std::vector<std::string>* changed) const {
-  TrainConfig c = *this;
-  const ScheduleKeys keys(given, changed);
-  keys.set("iterations", c.iterations, 30000);
-  // Densify for the first quarter, then refine (city 0, 30000 iterations: until 7500 gave more
-  // PSNR than until 15000, 3DGS's half, with and without a drop; docs/measurements/
-  // gpu_long_schedule).
-  keys.set("densify_until", c.densify_until, c.iterations / 4);
-  if (c.drop != "none") {
-    keys.set("lambda_l0_from", c.lambda_l0_from, c.densifyUntilResolved());
-    keys.set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
-  }
-  return c;
 }
 
 void TrainConfig::check(const std::string& origin) const {

@@ -19,6 +19,7 @@
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
 #include "sadsplat/gaussians/parameter_store.h"
+#include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/semantic_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/tile_list_capacity.h"
@@ -47,13 +48,6 @@ void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
                     std::min(log_extent + kSpan, io::kMaxAbsLogScale - 1.0));
 }
 
-// The keys whose -1 means "from the number of iterations", resolved.
-TrainConfig withScheduleResolved(TrainConfig c) {
-  c.densify_until = c.densifyUntilResolved();
-  if (c.scale_limit_from < 0) c.scale_limit_from = c.iterations - c.iterations / 7;
-  return c;
-}
-
 }  // namespace
 
 // The trainer composes the units that do the work (gsplat's shape): the parameters with their
@@ -62,7 +56,8 @@ TrainConfig withScheduleResolved(TrainConfig c) {
 // -> render -> losses -> backward -> statistics -> optimiser -> drop -> densification.
 struct Trainer::State {
   // The drop state sees the schedule as the trainer runs it (its guard needs the opacity resets).
-  explicit State(const TrainConfig& c) : config(withScheduleResolved(c)), drop(config) {}
+  explicit State(const TrainConfig& c)
+      : config(resolveDerivedKeys(c)), drop(config, config, config) {}
 
   TrainConfig config;
   at::Device device{at::kCPU};
@@ -190,7 +185,7 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   p.add("log_alpha", at::full({p.rows()}, config.log_alpha_init, t.means.options()),
         config.lr_log_alpha);
   const auto fopts = at::TensorOptions().dtype(at::kFloat).device(s.device);
-  s.densification = makeDefaultDensification(s.config, s.extent);
+  s.densification = makeDefaultDensification(s.config, s.config, s.extent);
   s.densification->initialise(p.rows(), fopts);
   s.drop.initialise(p.rows(), fopts);
 }
@@ -457,8 +452,7 @@ at::Tensor Trainer::classCosines(const at::Tensor& features) const {
   return d / d.norm(2, 2, true).clamp_min(1e-12);
 }
 
-SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level,
-                                    bool features) const {
+SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level, bool features) const {
   c10::AutoGradMode no_grad(false);
   GaussianParams g = state_->evaluationGaussians();
   if (!features) g.features = at::Tensor();

@@ -170,19 +170,22 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   const bool writer = !o.collective || o.collective->rank() == 0;
   if (writer) makeDirectory(o.out);
   const std::string checkpoint = o.out + "/checkpoint.bin";
-  gaussians::TrainConfig config = config_in;
+  const gaussians::ResolvedSchedule schedule = gaussians::resolveSchedule(config_in, o.schedule);
+  gaussians::TrainConfig config = schedule.config;
   double previous_seconds = 0;
   if (o.resume) {
     if (!pathExists(checkpoint))
       throw Error(checkpoint, "file", "a checkpoint to resume from", "missing");
-    // The run's own configuration wins: resuming continues the same run.
+    // The run's own configuration wins: resuming continues the same run (to the iterations asked).
     config = gaussians::TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"),
                                               o.out + "/config.json");
-    config.iterations = config_in.iterations;
+    config.iterations = schedule.config.iterations;
     const auto run = readRunJson(o.out);
     previous_seconds = run.contains("train_seconds") && run["train_seconds"].is_number()
                            ? run["train_seconds"].get<double>()
                            : 0.0;
+  } else if (o.progress) {
+    for (const std::string& note : schedule.notes) *o.progress << note << "\n";
   }
   const io::Scene scene = loadScene(o.scene, o.scale, o.progress);
   if (o.progress && scene.classes.empty()) {
@@ -214,6 +217,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
                 << (config.init == "random" ? "" : " (the scene has no sparse points)") << "\n";
   }
   gaussians::Trainer trainer(scene, config);
+  // What the trainer runs is what the loop counts, the log prints and config.json records.
+  config = trainer.config();
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   trainer.setCollective(o.collective);
   if (o.resume) trainer.loadCheckpoint(checkpoint);
@@ -511,7 +516,6 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
   gaussians::TrainConfig config;
   config.iterations = iterations;
   if (!baseline) config.drop = "full";
-  config = config.shortRunSchedule({});
   TrainRunOptions o;
   o.scene = train_scene;
   o.out = out_dir + "/run";

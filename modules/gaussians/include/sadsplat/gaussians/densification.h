@@ -59,14 +59,21 @@ class DensificationStrategy {
   virtual void checkRows(std::int64_t rows) const = 0;
 };
 
-/// \brief The 3DGS strategy with TrainConfig's densify_* / percent_dense / min_opacity /
-/// opacity_reset_interval / max_screen_radius / max_gaussians; `extent` is the scene's.
-DensificationStrategy::Ptr makeDefaultDensification(const TrainConfig& config, double extent);
+/// \brief The 3DGS strategy with its options (densify_* / percent_dense / min_opacity /
+/// opacity_reset_interval / max_screen_radius / max_gaussians / large splits) in the run's
+/// `schedule` (iterations, seed); `extent` is the scene's.
+DensificationStrategy::Ptr makeDefaultDensification(const DensificationOptions& options,
+                                                    const ScheduleOptions& schedule, double extent);
 
 /// \brief Whether the default strategy resets the opacities after iteration `done`: a multiple of
 /// opacity_reset_interval up to densify_until (resolved, not -1), and none in the last third of
 /// an interval before the end of the run (the opacities would have no time to recover).
-bool resetsOpacitiesAfter(const TrainConfig& config, int done);
+bool resetsOpacitiesAfter(const DensificationOptions& options, const ScheduleOptions& schedule,
+                          int done);
+/// \brief resetsOpacitiesAfter for a whole configuration.
+inline bool resetsOpacitiesAfter(const TrainConfig& config, int done) {
+  return resetsOpacitiesAfter(config, config, done);
+}
 
 /// \brief One line of what the default strategy does over the run of `config` (densify_until
 /// and scale_limit_from resolved, not -1), e.g. "7000 iterations; densification after 500

@@ -11,13 +11,21 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief Every training parameter, with the defaults of the paper / 3DGS. Each field is listed
-/// once more, in the option table (train_options.h), which gives its key, help and range.
-struct TrainConfig {
+/// \brief The length of the run and the intervals that are not a strategy's own (SH degree, views
+/// per step, checkpoints, the random seed).
+struct ScheduleOptions {
   int iterations = 7000;  ///< paper: 7000
-  int feature_dim = 32;   ///< paper: semantic dimension 32
-  int max_sh_degree = 3;
   int sh_increase_interval = 1000;
+  /// Training views rendered per step (and, on semantic steps, as many labelled views); the loss
+  /// is their mean. With N data-parallel ranks each rank renders this many, so N ranks with 1
+  /// view each train like one process with N views per step.
+  int views_per_step = 1;
+  int checkpoint_interval = 1000;  ///< 0 = none
+  std::uint64_t seed = 42;
+};
+
+/// \brief The training loss: the weights of its terms and how they are computed.
+struct LossOptions {
   double lambda_ssim = 0.2;  ///< paper: lambda_SSIM = 0.2
   /// The SSIM loss in fused passes on CPU and CUDA (gaussians::ssim); false: the reference
   /// composition of convolutions (gaussians::ssimReference), the same value, slower (for
@@ -26,11 +34,6 @@ struct TrainConfig {
   /// On CUDA, the semantic loss in fused kernels (gaussians::semanticLoss); false: the reference
   /// composition of ATen operations (gaussians::semanticLossReference), for comparisons.
   bool fused_semantic_loss = true;
-  /// On CUDA, each training render's (Gaussian, tile) list is sized from earlier renders' counts
-  /// (this margin times the largest) and checked after the backward pass, the step rendered
-  /// again when one was short (gaussians/tile_list_capacity.h): the host does not wait for the
-  /// GPU once per render. The same values; 0: lists sized by each render's count (waiting).
-  double tile_list_margin = 1.25;
   double lambda_rgb = 1.0;
   double lambda_semantic = 1.0;
   /// Not the paper: weight of a flatness loss, the mean over the Gaussians of their smallest
@@ -41,10 +44,6 @@ struct TrainConfig {
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;
-  /// Training views rendered per step (and, on semantic steps, as many labelled views); the loss
-  /// is their mean. With N data-parallel ranks each rank renders this many, so N ranks with 1
-  /// view each train like one process with N views per step.
-  int views_per_step = 1;
   /// Supervise the unlabelled training views with the scene's kept pseudo-labels (written by
   /// `sadsplat pseudo-labels`; without them this does nothing). Ground truth always wins.
   bool use_pseudo_labels = true;
@@ -54,6 +53,10 @@ struct TrainConfig {
   /// space) learns from ground truth alone, so the class mix of the kept pseudo-labels (mostly the
   /// easy classes) cannot shift the decoder's class prior.
   bool pseudo_labels_train_decoder = true;
+};
+
+/// \brief The Adam learning rates (3DGS's; the positions' decay with the scene extent).
+struct OptimiserOptions {
   double lr_position_init = 1.6e-4;   ///< times the scene extent
   double lr_position_final = 1.6e-6;  ///< times the scene extent
   double lr_sh_dc = 2.5e-3;
@@ -63,8 +66,15 @@ struct TrainConfig {
   double lr_rotation = 1e-3;
   double lr_feature = 2.5e-3;
   double lr_decoder = 1e-3;
+  double lr_log_alpha = 0.01;
+};
+
+/// \brief The densification strategy's options (3DGS's adaptive density control, the split of
+/// large Gaussians, the scale limit and the floater removal); gaussians/densification.h reads
+/// only these.
+struct DensificationOptions {
   int densify_from = 500;
-  /// -1: densifyUntilResolved() (2/7 of the iterations).
+  /// -1: densifyUntilResolved (schedule.h) (2/7 of the iterations).
   int densify_until = -1;
   int densify_interval = 100;
   double densify_grad_threshold = 2e-4;  ///< on the NDC-space gradient, as in 3DGS
@@ -72,15 +82,6 @@ struct TrainConfig {
   double min_opacity = 0.005;
   int opacity_reset_interval = 3000;
   int max_screen_radius = 20;
-  int checkpoint_interval = 1000;  ///< 0 = none
-  std::uint64_t seed = 42;
-  /// Initial Gaussians (gaussians/initialization.h): "auto" = the scene's sparse points, or
-  /// init_random_count random points in the cameras' common view when it has fewer than 4;
-  /// "points"; "random".
-  std::string init = "auto";
-  int init_random_count = 100000;  ///< 3DGS's random initialisation of synthetic scenes
-  std::array<float, 3> background{0, 0, 0};
-  std::string device = "cpu";   ///< "cpu" or "cuda"
   int max_gaussians = 3000000;  ///< densification stops growing past this
   /// After the last iteration remove the floaters: Gaussians whose centre fewer than
   /// floater_min_views training views see, or whose largest scale exceeds floater_max_scale x
@@ -106,8 +107,11 @@ struct TrainConfig {
   int scale_limit_from = -1;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
-  // The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these, the
-  // strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
+};
+
+/// \brief The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these,
+/// the strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
+struct DropOptions {
   std::string drop = "none";  ///< none | semantic | structure | full
   double p_base = 1.0;        ///< paper: P_base = 1.0
   int drop_interval = 500;    ///< paper: every N = 500 iterations
@@ -128,7 +132,6 @@ struct TrainConfig {
   /// training views (gaussians/contribution.h), recomputed from lambda_l0_from on every
   /// drop_interval iterations. 0 = the paper's plain mean.
   double l0_importance = 0.0;
-  double lr_log_alpha = 0.01;
   double log_alpha_init = 3.0;  ///< gates start open: P(z > 0) = 0.99
   /// Not the paper: the last `recovery_iterations` iterations train without gates, L0 term and
   /// drops. At their start, with a drop, the Gaussians whose deterministic gate is closed go and
@@ -160,43 +163,31 @@ struct TrainConfig {
   /// (RenderSettings::closed_gate_gradients) through a clamp that passes it below 0
   /// (semantic_drop::sampleGate) — so that a closed gate the views need can open again.
   bool closed_gate_gradients = false;
+};
 
-  /// \brief densify_until as the trainer runs it: a set value, or for -1 2/7 of the iterations
-  /// (2000 of 7000). Not 3DGS's half: at 7000 iterations half puts the opacity reset at 3000
-  /// 500 iterations before the densification ends, and that reset cost Net-1 1.2-2.3 dB on the
-  /// benchmark scenes and 0.5-0.8 dB on a real survey; stopping at 2000 recovered it and halved
-  /// the real survey's dropped model (docs/measurements/gpu_shorter_densification).
-  int densifyUntilResolved() const;
-
-  /// \brief The same training for a global batch of `views` training views per step (ranks x
-  /// views_per_step): every iteration count of the schedule (iterations, densification, opacity
-  /// reset, SH increase, drop, checkpoints) divided by `views`, so that the run sees as many
-  /// views as this one, and every learning rate times sqrt(views) (the square-root rule for
-  /// Adam that Grendel uses for batched 3DGS). views = 1 returns this configuration.
-  /// \throws sadsplat::Error when views < 1
-  TrainConfig forGlobalBatch(int views) const;
-
-  /// \brief The schedule of a run shorter than the paper's 7000 iterations: the SH degree rises
-  /// every iterations / 4, densification starts by iterations / 10 and (densify_until -1) lasts
-  /// half the run, no opacity reset falls inside the run, drops come every iterations / 4 at most;
-  /// each only where the default would not fit and the key is not in `given` (keys the user set).
-  /// Returns this configuration for longer runs.
-  /// \param[out] changed if not null, "key default -> value" for each key it changed
-  TrainConfig shortRunSchedule(const std::vector<std::string>& given,
-                               std::vector<std::string>* changed = nullptr) const;
-
-  /// \brief The long schedule (`sadsplat train --schedule long`, not the paper), for scenes whose
-  /// densification levels off (on a real survey whose densifier grows to max_gaussians it gives
-  /// larger models than the paper schedule; docs/measurements/gpu_long_schedule): 30000
-  /// iterations, densification in the first quarter (densify_until = iterations / 4; 3DGS
-  /// densifies for half); with a drop, the gates are pushed shut only after the densification
-  /// (lambda_l0_from = densify_until) and the last iterations / 6 refine the model without gates
-  /// (recovery_iterations): prune, then refine, as the pruning work that reaches >= 10x does.
-  /// Each key only where it is not in `given` (keys the user set; a given `iterations` sets the
-  /// length the others follow).
-  /// \param[out] changed if not null, "key default -> value" for each key it changed
-  TrainConfig longSchedule(const std::vector<std::string>& given,
-                           std::vector<std::string>* changed = nullptr) const;
+/// \brief Every training parameter, with the defaults of the paper / 3DGS, in groups that the
+/// trainer's parts receive alone (the densification its DensificationOptions, the drop its
+/// DropOptions). Each field is listed once more, in the option table (train_options.h), which
+/// gives its key, help and range; the table, JSON and flags see one flat set of keys.
+struct TrainConfig : ScheduleOptions,
+                     LossOptions,
+                     OptimiserOptions,
+                     DensificationOptions,
+                     DropOptions {
+  int feature_dim = 32;  ///< paper: semantic dimension 32
+  int max_sh_degree = 3;
+  /// On CUDA, each training render's (Gaussian, tile) list is sized from earlier renders' counts
+  /// (this margin times the largest) and checked after the backward pass, the step rendered
+  /// again when one was short (gaussians/tile_list_capacity.h): the host does not wait for the
+  /// GPU once per render. The same values; 0: lists sized by each render's count (waiting).
+  double tile_list_margin = 1.25;
+  /// Initial Gaussians (gaussians/initialization.h): "auto" = the scene's sparse points, or
+  /// init_random_count random points in the cameras' common view when it has fewer than 4;
+  /// "points"; "random".
+  std::string init = "auto";
+  int init_random_count = 100000;  ///< 3DGS's random initialisation of synthetic scenes
+  std::array<float, 3> background{0, 0, 0};
+  std::string device = "cpu";  ///< "cpu" or "cuda"
 
   /// \brief Checks every option against its range in the option table (train_options.h) and
   /// the rules between options (recovery_iterations below iterations).

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/scene.h"
 
@@ -33,6 +34,9 @@ struct TrainRunOptions {
   std::string out;      ///< run directory (created)
   double scale = 0.5;   ///< import scale for scene directories (paper: half resolution)
   bool resume = false;  ///< continue from out/checkpoint.bin
+  /// The schedule's rules (gaussians::resolveSchedule), applied once to the configuration given
+  /// to trainRun; a resumed run keeps its config.json and takes only the resolved iterations.
+  gaussians::ScheduleRequest schedule;
   std::ostream* progress = nullptr;  ///< live progress line (carriage returns), or none
   /// Set (e.g. by a SIGINT / SIGTERM handler) to stop after the current iteration: the run
   /// writes its checkpoint and run.json, then throws TrainingInterrupted.
@@ -57,7 +61,8 @@ class TrainingInterrupted : public Error {
   int iteration_;
 };
 
-/// \brief Trains and writes the run directory. Returns the training time in seconds.
+/// \brief Resolves the schedule of `config` (options.schedule, said on `progress`), trains and
+/// writes the run directory. Returns the training time in seconds.
 ///
 /// Faults lose nothing: the checkpoint, model and logs are written atomically; a non-finite loss
 /// stops the run with an error naming the iteration, before the next checkpoint, so the last

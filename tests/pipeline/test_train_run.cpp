@@ -1,0 +1,116 @@
+// pipeline::trainRun resolves the schedule once: what it prints, what config.json records, what
+// run.json and the train log say the trainer ran, and gaussians::resolveSchedule agree.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "sadsplat/gaussians/densification.h"
+#include "sadsplat/gaussians/schedule.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/train_log.h"
+#include "sadsplat/pipeline/runs.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+using gaussians::ScheduleKind;
+using gaussians::TrainConfig;
+
+const std::string kCache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";
+
+struct Case {
+  const char* name;
+  int iterations;
+  ScheduleKind kind;
+  std::vector<std::string> given;
+  int views_per_step;
+  int batch_ranks;
+  bool run_to_end;  // the default and long schedules stop before their first step here
+};
+
+class ScheduleAgreement : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ScheduleAgreement, PrintedRecordedAndRunScheduleAreOne) {
+  const Case& k = GetParam();
+  test::TempDir dir;
+  TrainConfig asked;
+  asked.iterations = k.iterations;
+  asked.views_per_step = k.views_per_step;
+  asked.drop = "full";
+  pipeline::TrainRunOptions o;
+  o.scene = kCache;
+  o.out = dir.file("run");
+  o.schedule.kind = k.kind;
+  o.schedule.given = k.given;
+  o.schedule.batch_ranks = k.batch_ranks;
+  std::ostringstream progress;
+  o.progress = &progress;
+  std::atomic<bool> stop{!k.run_to_end};
+  o.stop = &stop;
+  bool interrupted = false;
+  try {
+    pipeline::trainRun(o, asked);
+  } catch (const pipeline::TrainingInterrupted& e) {
+    interrupted = true;
+    EXPECT_EQ(e.iteration(), 0);
+  }
+  EXPECT_EQ(interrupted, !k.run_to_end);
+
+  const TrainConfig recorded =
+      TrainConfig::fromJson(io::readWholeFile(o.out + "/config.json"), o.out + "/config.json");
+  const TrainConfig resolved = gaussians::resolveSchedule(asked, o.schedule).config;
+  EXPECT_EQ(recorded.toJson(), resolved.toJson());
+  EXPECT_GE(recorded.densify_until, 0);
+  EXPECT_GE(recorded.scale_limit_from, 0);
+  const std::string printed = progress.str();
+  const std::string line = "schedule: " + gaussians::describeDefaultDensification(recorded) + "\n";
+  EXPECT_NE(printed.find(line), std::string::npos) << printed;
+  if (!k.run_to_end) return;
+  const auto run = nlohmann::json::parse(io::readWholeFile(o.out + "/run.json"));
+  EXPECT_EQ(run["iterations"].get<int>(), recorded.iterations);
+  const auto log = io::readTrainLog(o.out + "/train_log.jsonl");
+  ASSERT_FALSE(log.empty());
+  EXPECT_EQ(log.back().iteration, recorded.iterations);
+  const std::string last =
+      "[" + std::to_string(recorded.iterations) + "/" + std::to_string(recorded.iterations) + "]";
+  EXPECT_NE(printed.find(last), std::string::npos) << printed;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Schedules, ScheduleAgreement,
+    ::testing::Values(Case{"paper", 7000, ScheduleKind::kPaper, {}, 1, 0, false},
+                      Case{"short", 24, ScheduleKind::kPaper, {}, 1, 0, true},
+                      Case{"long", 7000, ScheduleKind::kLong, {}, 1, 0, false},
+                      Case{"long_given", 36, ScheduleKind::kLong, {"iterations"}, 1, 0, true},
+                      Case{"batched", 40, ScheduleKind::kPaper, {}, 2, 1, true}),
+    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// The batch rule divides what the short-run rules set (they run first), and a resolved
+// configuration resolves to itself.
+TEST(ResolveSchedule, RulesApplyInOrderAndOnce) {
+  TrainConfig c;
+  c.iterations = 40;
+  c.views_per_step = 2;
+  gaussians::ScheduleRequest request;
+  request.batch_ranks = 1;
+  const gaussians::ResolvedSchedule r = gaussians::resolveSchedule(c, request);
+  EXPECT_EQ(r.config.iterations, 20);
+  EXPECT_EQ(r.config.drop_interval, 5);   // short: 40 / 4 = 10, then / 2
+  EXPECT_EQ(r.config.densify_until, 10);  // short: half of 40, then / 2
+  EXPECT_EQ(r.config.scale_limit_from, 20 - 20 / 7);
+  ASSERT_EQ(r.notes.size(), 2u);
+  EXPECT_EQ(r.notes[1].rfind("global batch of 2 views per step", 0), 0u) << r.notes[1];
+  EXPECT_EQ(gaussians::resolveDerivedKeys(r.config).toJson(), r.config.toJson());
+  EXPECT_EQ(gaussians::resolveSchedule(TrainConfig{}).config.densify_until, 2000);
+  EXPECT_EQ(gaussians::resolveSchedule(TrainConfig{}).config.scale_limit_from, 6000);
+  EXPECT_TRUE(gaussians::resolveSchedule(TrainConfig{}).notes.empty());
+  EXPECT_THROW(gaussians::parseScheduleKind("short"), Error);
+}
+
+}  // namespace
+}  // namespace sadsplat
