@@ -9,7 +9,7 @@
 #include "commands/commands.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/cpu_threads.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/train_run.h"
 
 namespace sadsplat {
 namespace cli {

@@ -12,7 +12,7 @@
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/train_log.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/train_run.h"
 #include "test_support/test_support.h"
 
 namespace sadsplat {

@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "commands.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/demo.h"
 
 namespace sadsplat {
 namespace cli {

@@ -5,7 +5,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/pipeline/cloud_eval.h"
 #include "sadsplat/pipeline/map_products.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/opened_run.h"
 
 namespace sadsplat {
 namespace cli {

@@ -8,6 +8,7 @@
 #include "sadsplat/geo/las_export.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 
@@ -48,14 +49,15 @@ class ExtractCommand : public Command {
   int run(const Invocation&) override {
     std::string in = in_, classes = classes_;
     if (io::isDirectory(in)) {  // a run directory: its model and its class list
+      const io::RunDirectory run(in);
       if (classes.empty()) {
-        classes = in + "/classes.json";
-        if (!io::pathExists(classes) && io::pathExists(in + "/run.json")) {
+        classes = run.classes();
+        if (!io::pathExists(classes) && io::pathExists(run.runJson())) {
           throw Error(classes, "file", "a run trained with classes",
                       "none (its scene had no classes.json: the model has no classes to extract)");
         }
       }
-      in += "/model.ply";
+      in = run.model();
     }
     const std::uint32_t id = classId(classes);
     const bool las = io::lowerExtension(out_) == ".las";

@@ -18,7 +18,7 @@
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/train_options.h"
 #include "sadsplat/io/atomic_file.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/train_run.h"
 
 namespace sadsplat {
 namespace cli {

@@ -17,6 +17,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/run_directory.h"
 
 namespace sadsplat {
 namespace eval {
@@ -105,7 +106,7 @@ std::vector<ExperimentRun> readExperimentRuns(const std::string& results_dir) {
                   scene);
     }
     for (const std::string& run : subdirectories(results_dir + "/" + scene)) {
-      const std::string file = results_dir + "/" + scene + "/" + run + "/metrics.json";
+      const std::string file = io::RunDirectory(results_dir + "/" + scene + "/" + run).metrics();
       if (!io::isRegularFile(file)) continue;
       const std::size_t seed_at = run.rfind("_t");
       char* end = nullptr;

@@ -10,6 +10,7 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/las.h"
+#include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene.h"
 
 namespace sadsplat {
@@ -110,11 +111,12 @@ LasExportOptions lasOptionsBeside(const std::string& model_path,
   }
   LasExportOptions o;
   o.classification_map = classification_map;
-  if (io::optionalFileExists(dir + "/classes.json"))
-    o.classes = io::readClassesJson(dir + "/classes.json");
-  if (io::optionalFileExists(dir + "/georeference.json")) {
-    o.georeference = io::georeferenceFromJson(io::readWholeFile(dir + "/georeference.json"),
-                                              dir + "/georeference.json");
+  // A model's run directory (or any folder holding a model with these files beside it).
+  const io::RunDirectory run(dir);
+  if (io::optionalFileExists(run.classes())) o.classes = io::readClassesJson(run.classes());
+  if (io::optionalFileExists(run.georeference())) {
+    o.georeference =
+        io::georeferenceFromJson(io::readWholeFile(run.georeference()), run.georeference());
   }
   return o;
 }

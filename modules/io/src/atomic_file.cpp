@@ -38,6 +38,10 @@ std::string temporaryPathFor(const std::string& path) {
 
 }  // namespace
 
+void writeTextFileAtomically(const std::string& path, const std::string& text) {
+  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
 void writeViaTemporaryPath(const std::string& path,
                            const std::function<void(const std::string& tmp_path)>& write) {
   // An output path names what the user wants; its missing parent directories are made here, so

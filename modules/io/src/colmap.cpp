@@ -350,10 +350,6 @@ void validateModel(const ColmapModel& model, const std::string& dir) {
   }
 }
 
-void writeText(const std::string& path, const std::string& text) {
-  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
-}
-
 template <typename T>
 void put(std::string& out, const T& v) {
   out.append(reinterpret_cast<const char*>(&v), sizeof(T));
@@ -439,7 +435,7 @@ void writeColmapText(const std::string& dir, const ColmapModel& model) {
     for (double p : c.params) cams << " " << p;
     cams << "\n";
   }
-  writeText(dir + "/cameras.txt", cams.str());
+  writeTextFileAtomically(dir + "/cameras.txt", cams.str());
 
   std::ostringstream ims;
   ims << std::setprecision(17);
@@ -458,7 +454,7 @@ void writeColmapText(const std::string& dir, const ColmapModel& model) {
     }
     ims << "\n";
   }
-  writeText(dir + "/images.txt", ims.str());
+  writeTextFileAtomically(dir + "/images.txt", ims.str());
 
   std::ostringstream pts;
   pts << std::setprecision(17);
@@ -471,7 +467,7 @@ void writeColmapText(const std::string& dir, const ColmapModel& model) {
     for (const auto& t : p.track) pts << " " << t.first << " " << t.second;
     pts << "\n";
   }
-  writeText(dir + "/points3D.txt", pts.str());
+  writeTextFileAtomically(dir + "/points3D.txt", pts.str());
 }
 
 void writeColmapBinary(const std::string& dir, const ColmapModel& model) {
@@ -484,7 +480,7 @@ void writeColmapBinary(const std::string& dir, const ColmapModel& model) {
     put<std::uint64_t>(cams, c.height);
     for (double p : c.params) put<double>(cams, p);
   }
-  writeText(dir + "/cameras.bin", cams);
+  writeTextFileAtomically(dir + "/cameras.bin", cams);
 
   std::string ims;
   put<std::uint64_t>(ims, model.images.size());
@@ -503,7 +499,7 @@ void writeColmapBinary(const std::string& dir, const ColmapModel& model) {
                                                : static_cast<std::uint64_t>(p.point3d_id));
     }
   }
-  writeText(dir + "/images.bin", ims);
+  writeTextFileAtomically(dir + "/images.bin", ims);
 
   std::string pts;
   put<std::uint64_t>(pts, model.points.size());
@@ -518,7 +514,7 @@ void writeColmapBinary(const std::string& dir, const ColmapModel& model) {
       put<std::uint32_t>(pts, t.second);
     }
   }
-  writeText(dir + "/points3D.bin", pts);
+  writeTextFileAtomically(dir + "/points3D.bin", pts);
 }
 
 }  // namespace io

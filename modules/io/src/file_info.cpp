@@ -16,6 +16,7 @@
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/las.h"
 #include "sadsplat/io/pcd.h"
+#include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/io/splat_formats.h"
@@ -219,14 +220,15 @@ void describeScene(std::ostream& out, const Scene& scene) {
   if (pseudo_views > 0) {
     std::ostringstream share;
     share << std::fixed << std::setprecision(1) << 100.0 * kept / pixels;
-    out << "pseudo-labels: " << pseudo_views << " views (" << printable(backend) << "), " << kept_targets
-        << " of " << targets << " targets kept, " << share.str() << " % of their pixels labelled\n";
+    out << "pseudo-labels: " << pseudo_views << " views (" << printable(backend) << "), "
+        << kept_targets << " of " << targets << " targets kept, " << share.str()
+        << " % of their pixels labelled\n";
   }
   out << "classes: " << scene.classes.size() << "\n";
   for (std::size_t i = 0; i < scene.classes.size(); ++i) {
     const auto& c = scene.classes[i];
-    out << "  " << i << " " << printable(c.name) << " rgb(" << int(c.color[0]) << "," << int(c.color[1]) << ","
-        << int(c.color[2]) << ") \"" << printable(c.prompt) << "\"";
+    out << "  " << i << " " << printable(c.name) << " rgb(" << int(c.color[0]) << ","
+        << int(c.color[1]) << "," << int(c.color[2]) << ") \"" << printable(c.prompt) << "\"";
     if (pseudo_views > 0) out << ", " << kept_pixels[i] << " pseudo-labelled pixels";
     out << "\n";
   }
@@ -242,16 +244,17 @@ std::string describeFile(const std::string& path) {
     if (ext == ".ply" || ext == ".pcd" || ext == ".splat" || ext == ".spz" || ext == ".sog") {
       throw Error(path, "file", "a " + ext + " file", "a directory");
     }
-    if (pathExists(path + "/run.json") && pathExists(path + "/model.ply")) {
+    if (RunDirectory::isRun(path)) {
       // A run directory: its model, and the frame it is in.
+      const RunDirectory run(path);
       out << path << ": run directory (model.ply below)\n";
-      if (optionalFileExists(path + "/georeference.json")) {
-        describeGeoreference(out, georeferenceFromJson(readWholeFile(path + "/georeference.json"),
-                                                       path + "/georeference.json"));
+      if (optionalFileExists(run.georeference())) {
+        describeGeoreference(
+            out, georeferenceFromJson(readWholeFile(run.georeference()), run.georeference()));
       } else {
         out << "georeference: none (the scene's SfM frame)\n";
       }
-      out << describeFile(path + "/model.ply");
+      out << describeFile(run.model());
       return out.str();
     }
     out << path << ": scene directory\n";
@@ -334,8 +337,8 @@ std::string describeCameras(const std::string& path) {
   out << "name,width,height,fx,fy,cx,cy,qw,qx,qy,qz,tx,ty,tz,role\n";
   for (const View& v : scene.views) {
     const PinholeCamera& c = v.camera;
-    out << printable(v.name) << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy << "," << c.cx
-        << "," << c.cy;
+    out << printable(v.name) << "," << c.width << "," << c.height << "," << c.fx << "," << c.fy
+        << "," << c.cx << "," << c.cy;
     for (double q : c.qvec) out << "," << q;
     for (double t : c.tvec) out << "," << t;
     out << "," << (v.test ? "test" : v.train ? "train" : "none") << "\n";

@@ -48,8 +48,7 @@ std::vector<ClassInfo> readClassesJson(const std::string& path) {
   }
   const auto& list = doc.at("classes");
   if (list.empty() || list.size() > 255) {
-    throw Error(path, "classes",
-                "1 to 255 classes (a scene without classes has no classes.json)",
+    throw Error(path, "classes", "1 to 255 classes (a scene without classes has no classes.json)",
                 std::to_string(list.size()));
   }
   std::vector<ClassInfo> classes;
@@ -118,14 +117,14 @@ void writeClassesJson(const std::string& path, const std::vector<ClassInfo>& cla
                     {"prompt", c.prompt}});
   }
   const std::string text = nlohmann::json{{"classes", list}}.dump(2) + "\n";
-  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+  writeTextFileAtomically(path, text);
 }
 
 void writeSplitJson(const std::string& path, const SplitInfo& split) {
   const nlohmann::json doc = {
       {"train", split.train}, {"test", split.test}, {"labelled", split.labelled}};
   const std::string text = doc.dump(2) + "\n";
-  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+  writeTextFileAtomically(path, text);
 }
 
 }  // namespace io

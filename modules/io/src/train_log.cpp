@@ -40,7 +40,7 @@ TrainLogWriter::TrainLogWriter(const std::string& path, int resume_iteration) : 
       }
     }
   }
-  writeFileAtomically(path, [&](std::ostream& out) { out << kept; });
+  writeTextFileAtomically(path, kept);
   out_.open(path, std::ios::app);
   if (!out_) throw Error(path, "open for appending", "a writable file", std::strerror(errno));
 }

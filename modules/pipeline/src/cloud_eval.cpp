@@ -9,7 +9,7 @@
 #include "sadsplat/eval/cloud_scores.h"
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/io/atomic_file.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/synth/aerial_benchmark.h"
 #include "truth_world.h"
 
@@ -131,7 +131,7 @@ std::string evalCloudRun(const std::string& run_dir) {
                                            {"match_iou", object_options.match_iou}});
   }
   const std::string text = j.dump(2) + "\n";
-  io::writeFileAtomically(run_dir + "/metrics_3d.json", [&](std::ostream& out) { out << text; });
+  io::writeTextFileAtomically(run_dir + "/metrics_3d.json", text);
   return text;
 }
 

@@ -19,8 +19,8 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/output_set.h"
+#include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/ortho_render.h"
-#include "sadsplat/pipeline/runs.h"
 #include "sadsplat/synth/aerial_benchmark.h"
 #include "truth_world.h"
 
@@ -29,10 +29,6 @@ namespace pipeline {
 namespace {
 
 using Vec3 = std::array<double, 3>;
-
-void writeTextFile(const std::string& path, const std::string& text) {
-  io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
-}
 
 // Median over the training views of (camera height above the model's median ground) / focal
 // length: the photos' ground sample distance at the imported resolution, in scene units.
@@ -218,7 +214,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   }
   csv << "255,nodata," << (static_cast<std::int64_t>(n) - covered) << "," << std::setprecision(2)
       << (static_cast<std::int64_t>(n) - covered) * cell_area << ",\n";
-  writeTextFile(files.path("classes.csv"), csv.str());
+  io::writeTextFileAtomically(files.path("classes.csv"), csv.str());
 
   nlohmann::json j;
   j["run"] = o.run;
@@ -261,7 +257,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["files"] = semantic ? nlohmann::json{"orthophoto.tif", "classes.tif", "dsm.tif",
                                          "confidence.tif", "classes.csv"}
                         : nlohmann::json{"orthophoto.tif", "dsm.tif", "classes.csv"};
-  writeTextFile(files.path("ortho.json"), j.dump(2) + "\n");
+  io::writeTextFileAtomically(files.path("ortho.json"), j.dump(2) + "\n");
   files.commit();
 
   std::ostringstream s;
@@ -469,7 +465,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     j["objects"] = buildingObjectsJson(o, {{"min_area_m2", kMinObjectM2}, {"match_iou", 0.5}});
   }
   const std::string text = j.dump(2) + "\n";
-  writeTextFile(run_dir + "/ortho_metrics.json", text);
+  io::writeTextFileAtomically(run_dir + "/ortho_metrics.json", text);
   return text;
 }
 

@@ -9,7 +9,7 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/scene_cache.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pseudo_labels/quality_report.h"
 #include "sadsplat/pseudo_labels/torchscript_scorer.h"
 

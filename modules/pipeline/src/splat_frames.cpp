@@ -11,7 +11,8 @@
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
-#include "sadsplat/pipeline/runs.h"
+#include "sadsplat/io/run_directory.h"
+#include "sadsplat/pipeline/opened_run.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -48,15 +49,13 @@ struct SplatFrames::State {
 SplatFrames::SplatFrames(const std::string& path, const std::string& device) : state_(new State) {
   State& s = *state_;
   if (device == "cuda") s.device = at::Device(at::kCUDA, 0);
-  namespace fs = std::filesystem;
-  if (io::isDirectory(path) && io::isRegularFile(path + "/run.json") &&
-      io::isRegularFile(path + "/checkpoint.bin")) {
+  if (io::RunDirectory::hasCheckpoint(path)) {
     s.run = std::make_unique<OpenedRun>(openRun(path));
     s.cloud = s.run->trainer->toCloud();
     s.params = s.run->trainer->parameters();
     return;
   }
-  const std::string model = io::isDirectory(path) ? (fs::path(path) / "model.ply").string() : path;
+  const std::string model = io::isDirectory(path) ? io::RunDirectory(path).model() : path;
   s.cloud = io::readGaussians(model);
   const gaussians::GaussianTensors t = gaussians::fromCloud(s.cloud, s.device, /*feature_dim=*/0);
   s.params.means = t.means;

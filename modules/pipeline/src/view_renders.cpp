@@ -16,8 +16,8 @@
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/output_set.h"
+#include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/ortho_render.h"
-#include "sadsplat/pipeline/runs.h"
 
 namespace sadsplat {
 namespace pipeline {

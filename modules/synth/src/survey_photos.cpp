@@ -119,7 +119,7 @@ int writeSurveyPhotos(const SynthScene& scene, const SurveyPhotoOptions& o,
       ++written;
     }
   }
-  io::writeFileAtomically(dir + "/gcp_list.txt", [&](std::ostream& out) { out << text.str(); });
+  io::writeTextFileAtomically(dir + "/gcp_list.txt", text.str());
   return written;
 }
 

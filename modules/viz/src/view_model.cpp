@@ -14,6 +14,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
+#include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 
 namespace sadsplat {
@@ -49,11 +50,12 @@ ViewModel loadViewModel(const std::string& path) {
   std::string model = path;
   std::string classes_json;
   if (io::isDirectory(path)) {
-    model = (fs::path(path) / "model.ply").string();
+    const io::RunDirectory run(path);
+    model = run.model();
     if (!io::isRegularFile(model)) {
       throw Error(path, "run directory", "a training run with model.ply", "no model.ply");
     }
-    const std::string run_json = (fs::path(path) / "run.json").string();
+    const std::string run_json = run.runJson();
     if (io::isRegularFile(run_json)) {
       const auto run = parseOrDiscard(io::readWholeFile(run_json));
       if (!run.is_discarded() && run.contains("scene") && run["scene"].is_string()) {

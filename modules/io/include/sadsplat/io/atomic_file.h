@@ -17,6 +17,9 @@ namespace io {
 /// \param[in] write callback that writes the whole content to the stream (binary mode)
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// \brief writeFileAtomically of a text (or any bytes) held in memory.
+void writeTextFileAtomically(const std::string& path, const std::string& text);
+
 /// \brief Same guarantee for writers that take a file name (PCL's, OpenCV's): `write` writes
 /// the temporary path it is given, which is then renamed over `path`. `write` reports failure
 /// by throwing or by leaving no file at the temporary path.

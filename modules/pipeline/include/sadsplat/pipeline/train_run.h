@@ -1,16 +1,9 @@
 #pragma once
-/// \file runs.h
-/// \brief The jobs behind `sadsplat train`, `sadsplat eval` and `sadsplat demo`.
-///
-/// A run directory holds: config.json (the exact configuration), run.json (scene path, device,
-/// iterations done, training seconds), checkpoint.bin (latest training state, written every
-/// checkpoint_interval iterations and at the end), model.ply (3DGS PLY with semantic
-/// properties), model.pcd (the same Gaussians as PCD), model_semantic.pcd and model_semantic.ply
-/// (the plain semantic cloud: centre, class colour, class id), classes.json, and after evaluation
-/// metrics.json and panels/*.png.
+/// \file train_run.h
+/// \brief The job behind `sadsplat train`: the schedule resolved once, the training loop with
+/// checkpoints, progress and the train log, and the run directory written (io::RunDirectory).
 
 #include <atomic>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -19,14 +12,9 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/trainer.h"
-#include "sadsplat/io/scene.h"
 
 namespace sadsplat {
 namespace pipeline {
-
-/// \brief Loads a scene directory (imported at `scale`, needs OpenCV; said on `progress` when
-/// not null) or a scene cache file.
-io::Scene loadScene(const std::string& path, double scale = 0.5, std::ostream* progress = nullptr);
 
 /// \brief Options of a training run.
 struct TrainRunOptions {
@@ -71,40 +59,6 @@ class TrainingInterrupted : public Error {
 /// \throws sadsplat::Error on bad input, a diverged training or no GPU memory;
 /// TrainingInterrupted when `stop` was set
 double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& config);
-
-/// \brief A trained run opened for rendering: its scene, configuration and model (the trainer
-/// restored from checkpoint.bin).
-struct OpenedRun {
-  std::string dir;
-  std::string scene_path;  ///< the scene the run trained on (or the override)
-  double scale = 0.5;      ///< the import scale of a scene directory
-  double train_seconds = 0;
-  io::Scene scene;
-  gaussians::TrainConfig config;
-  std::unique_ptr<gaussians::Trainer> trainer;
-};
-
-/// \brief Opens a run directory (run.json, config.json, checkpoint.bin) on its scene or on
-/// `scene_override`.
-/// \throws sadsplat::Error naming the run's file and field
-OpenedRun openRun(const std::string& run_dir, const std::string& scene_override = "",
-                  double scale = 0.5);
-
-/// \brief The scene directory a run's scene was imported from (its images/ hold the photos at
-/// their imported-from size), or "" when there is none: the run's scene itself, or a cache's
-/// recorded source (a relative source is looked for from the folders above the cache).
-std::string sceneDirectoryOf(const OpenedRun& run);
-
-/// \brief Evaluates a run directory on its scene (or `scene_override`): writes metrics.json and
-/// panels/, returns the metrics.json text.
-std::string evalRun(const std::string& run_dir, const std::string& scene_override = "",
-                    double scale = 0.5);
-
-/// \brief `sadsplat demo`: generates the small city scene, writes its pseudo-labels (built-in
-/// backend, report in OUT/pseudo_labels), trains on CPU with the full semantic-aware drop,
-/// evaluates, prints a table to `out`. `baseline` skips pseudo-labels and drop (the paper's
-/// Net-1). Returns 0 on success.
-int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool baseline = false);
 
 }  // namespace pipeline
 }  // namespace sadsplat
