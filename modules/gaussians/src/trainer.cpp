@@ -48,6 +48,20 @@ void holdLogScalesNearExtent(at::Tensor& log_scales, double extent) {
                     std::min(log_extent + kSpan, io::kMaxAbsLogScale - 1.0));
 }
 
+// What one step's passes share: its views, render settings and Gaussians, the losses and the
+// renders that the densification statistics read.
+struct StepPass {
+  std::vector<int> views;
+  int ranks = 1;
+  int batch = 1;
+  bool read_losses = false;
+  RenderSettings settings;
+  GaussianParams g;
+  at::Tensor total, rgb_sum, sem_sum;
+  std::vector<RenderResult> renders;
+  std::vector<RasterCamera> cameras;
+};
+
 }  // namespace
 
 // The trainer composes the units that do the work (gsplat's shape): the parameters with their
@@ -133,7 +147,165 @@ struct Trainer::State {
   at::Tensor decode(const at::Tensor& features) const {
     return at::linear(features, params["decoder_w"].value, params["decoder_b"].value);
   }
+
+  // The parts of Trainer::step, in its order (views -> render -> losses -> backward ->
+  // statistics -> optimiser -> drop -> densification).
+  void renderLossesBackward(StepPass& pass, int it, TileListCapacity* tile_capacity);
+  at::Tensor viewLoss(StepPass& pass, int v);
+  void reduceAndUpdate(const StepPass& pass, const StepViews& step_views, int it);
+  void afterUpdate(int done, bool gated, StepStats& stats);
+  void readLossValues(const StepPass& pass, StepStats& stats) const;
 };
+
+// The step's renders, losses and backward pass; again (the same gates: counter-based noise) when
+// a render's tile list was short.
+void Trainer::State::renderLossesBackward(StepPass& pass, int it, TileListCapacity* tile_capacity) {
+  const TrainConfig& c = config;
+  pass.total = pass.rgb_sum = pass.sem_sum = at::Tensor();
+  pass.renders.clear();
+  pass.cameras.clear();
+  pass.settings.tile_capacity = tile_capacity;
+  // Counter-based noise: a second pass samples the same gates (the first one's graph is gone).
+  pass.g.opacity_gate = drop.trainingGate(params, it);  // undefined when not gated
+  for (int v : pass.views) {
+    const at::Tensor loss = viewLoss(pass, v);
+    pass.total = pass.total.defined() ? pass.total + loss : loss;
+  }
+  // The mean over the global batch (one draw: the sum of its training and labelled views'
+  // losses).
+  if (pass.batch > 1) pass.total = pass.total / pass.batch;
+  const at::Tensor reg = drop.regularisation(params, it);
+  if (reg.defined()) {
+    pass.total = pass.total + (pass.ranks > 1 ? reg / pass.ranks : reg);  // once over all ranks
+  }
+  if (c.lambda_flatten > 0) {
+    const at::Tensor flat = std::get<0>(params["scales"].value.exp().min(1)).mean() *
+                            (c.lambda_flatten / extent / pass.ranks);
+    pass.total = pass.total + flat;
+  }
+  enterPhase(profile.get(), "backward");
+  pass.total.backward();
+}
+
+// One view's render and loss (RGB, and the semantic loss where the view's role asks for it).
+at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
+  const TrainConfig& c = config;
+  StepProfile* p = profile.get();
+  // Loss values stay on the device until the end of the step: one host synchronisation per step.
+  const auto accumulate = [&pass](at::Tensor& sum, const at::Tensor& value) {
+    if (!pass.read_losses) return;  // nobody reads them: two operations per render saved
+    sum = sum.defined() ? sum + value.detach() : value.detach();
+  };
+  enterPhase(p, "render forward");
+  const ViewRole role = views.role(v, c);
+  // Training uses no depth, and features only where a semantic loss reads them.
+  pass.settings.features = role.semantic;
+  pass.settings.depth = false;
+  RenderResult r = render(pass.g, views.cameras[v], pass.settings);
+  r.means2d.retain_grad();
+  enterPhase(p, "losses forward");
+  // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
+  // operations for the host to issue and for the autograd engine to run backwards.
+  const at::Tensor& gt = views.images[v];
+  const bool masked = !views.mask_is_full[v];
+  const at::Tensor mask = masked ? views.masks[v].unsqueeze(2) : at::Tensor();
+  const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
+  // Unmasked with the fused SSIM: rgbLoss (on CUDA one autograd node; elsewhere this very
+  // composition).
+  const at::Tensor rgb_loss =
+      !masked && c.fused_ssim
+          ? rgbLoss(r.rgb, gt, c.lambda_ssim)
+          : (1 - c.lambda_ssim) * masking((r.rgb - gt).abs()).mean() +
+                c.lambda_ssim * (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
+                                                   : ssimReference(masking(r.rgb), masking(gt))));
+  at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
+  accumulate(pass.rgb_sum, rgb_loss);
+  if (role.semantic) {
+    // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
+    // class-score space of the built-in backend), averaged over supervised pixels only.
+    const at::Tensor& w = params["decoder_w"].value;
+    const at::Tensor& b = params["decoder_b"].value;
+    const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
+    const at::Tensor& labels = views.labels[v];
+    const at::Tensor sem = role.decoder_learns
+                               ? loss_of(r.features, labels, w, b)
+                               : loss_of(r.features, labels, w.detach(), b.detach());
+    const double weight = views.semantic_weight[v];
+    loss = loss + (weight == 1 ? sem : weight * sem);
+    accumulate(pass.sem_sum, sem);
+  }
+  pass.renders.push_back(r);
+  pass.cameras.push_back(views.cameras[v]);
+  return loss;
+}
+
+// After the backward: the densification's statistics, the group's all-reduce, the balanced
+// rule's L0 force, the optimiser.
+void Trainer::State::reduceAndUpdate(const StepPass& pass, const StepViews& step_views, int it) {
+  StepProfile* p = profile.get();
+  enterPhase(p, "densification statistics");
+  const std::vector<at::Tensor*> sums =
+      densification->stepPostBackward(pass.renders, pass.cameras, pass.batch, collective.get());
+  if (collective) {
+    enterPhase(p, "all-reduce");
+    params.allReduceGradients(
+        *collective,
+        [&](const Parameter& q) {
+          if (q.name == "features") return step_views.features_anywhere;
+          if (q.name == "decoder_w" || q.name == "decoder_b") return step_views.decoder_anywhere;
+          return q.value.grad().defined();
+        },
+        sums);
+    densification->reduced(*collective);
+  }
+  drop.addL0Gradient(params, it);  // the balanced rule's L0 force (else a no-op)
+  enterPhase(p, "optimiser");
+  params.adamStep();
+  holdLogScalesNearExtent(params["scales"].value, extent);
+}
+
+// After the update of iteration `done`: the drop's guard and event, the recovery's start, the
+// end-of-training removals, then densification, pruning and the opacity reset.
+void Trainer::State::afterUpdate(int done, bool gated, StepStats& stats) {
+  const TrainConfig& c = config;
+  enterPhase(profile.get(), "drop");
+  if (gated && drop.guardProbeDue(done)) drop.observeGuardProbe(done, guardProbeError());
+  if (gated) stats.drop = drop.dropIfDue(done, params, views, resizer(), &stats.dropped);
+  if (done == drop.recoveryStart()) {
+    std::tie(stats.recovery_closed_gates, stats.recovery_pruned) =
+        drop.settleGates(params, views, resizer());
+  }
+  if (done == c.iterations) {
+    stats.removed_closed_gates = drop.removeClosedGates(params, done, resizer());
+    if (c.prune_floaters) {
+      // Floaters: seen by too few training views, or far larger than the scene's detail.
+      const at::Tensor keep =
+          floaterMask(params["means"].value, params["scales"].value, views.trainingCameras(),
+                      c.floater_min_views, c.floater_max_scale * extent)
+              .logical_not();
+      stats.removed_floaters = params.rows() - keep.sum().item<std::int64_t>();
+      if (stats.removed_floaters > 0) resize(keep, {});
+    }
+  }
+  enterPhase(profile.get(), "densify, prune, reset");
+  densification->stepPostUpdate(
+      done, params, [&] { return drop.effectiveOpacity(params, done); }, resizer());
+}
+
+// The step's loss values, read to the host (summed over the group's ranks).
+void Trainer::State::readLossValues(const StepPass& pass, StepStats& stats) const {
+  enterPhase(profile.get(), "loss values to host");
+  const at::Tensor zero = at::zeros({}, pass.total.options());
+  at::Tensor values =
+      at::stack({pass.total.detach(), pass.rgb_sum, pass.sem_sum.defined() ? pass.sem_sum : zero,
+                 at::full({}, static_cast<double>(pass.views.size()), pass.total.options())});
+  if (collective) collective->sum(values);
+  values = values.to(at::kDouble).cpu();
+  const double* value = values.data_ptr<double>();
+  stats.rgb_loss = value[1] / value[3];
+  stats.semantic_loss = value[2] / pass.batch;
+  stats.loss = value[0];
+}
 
 Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State(config)) {
   State& s = *state_;
@@ -222,97 +394,23 @@ StepStats Trainer::step(bool read_losses) {
 
   // This iteration's views (this rank's share of the global batch) and which of the features'
   // and the decoder's gradients any rank of the group has this step.
-  const int ranks = s.collective ? s.collective->size() : 1;
-  const int batch = c.views_per_step * ranks;
+  StepPass pass;
+  pass.ranks = s.collective ? s.collective->size() : 1;
+  pass.batch = c.views_per_step * pass.ranks;
+  pass.read_losses = read_losses;
   const StepViews step_views = drawStepViews(
-      s.views, c, it, s.collective ? s.collective->rank() : 0, ranks, s.collective != nullptr);
-  const std::vector<int>& views = step_views.views;
-
-  RenderSettings settings;
-  settings.sh_degree = s.shDegree();
-  settings.background = c.background;
-  GaussianParams g = s.params.gaussians();
+      s.views, c, it, s.collective ? s.collective->rank() : 0, pass.ranks, s.collective != nullptr);
+  pass.views = step_views.views;
+  pass.settings.sh_degree = s.shDegree();
+  pass.settings.background = c.background;
+  pass.g = s.params.gaussians();
   const bool gated = s.drop.gated(it);
-  settings.closed_gate_gradients = gated && c.closed_gate_gradients;
+  pass.settings.closed_gate_gradients = gated && c.closed_gate_gradients;
   if (s.drop.refreshesL0Weights(it)) {
     enterPhase(profile, "L0 weights");
     s.drop.refreshL0Weights(s.params, s.views, s.iteration);
   }
-  at::Tensor total;
-  // Loss values stay on the device until the end of the step: one host synchronisation per step.
-  at::Tensor rgb_sum, sem_sum;
-  auto accumulate = [read_losses](at::Tensor& sum, const at::Tensor& value) {
-    if (!read_losses) return;  // nobody reads them: two operations per render saved
-    sum = sum.defined() ? sum + value.detach() : value.detach();
-  };
-  std::vector<RenderResult> renders;
-  std::vector<RasterCamera> cameras;
-  // The step's renders, losses and backward pass; again when a render's tile list was short.
-  const auto render_losses_backward = [&](TileListCapacity* tile_capacity) {
-    total = rgb_sum = sem_sum = at::Tensor();
-    renders.clear();
-    cameras.clear();
-    settings.tile_capacity = tile_capacity;
-    // Counter-based noise: a second pass samples the same gates (the first one's graph is gone).
-    g.opacity_gate = s.drop.trainingGate(s.params, it);  // undefined when not gated
-    for (int v : views) {
-      enterPhase(profile, "render forward");
-      const ViewRole role = s.views.role(v, c);
-      // Training uses no depth, and features only where a semantic loss reads them.
-      settings.features = role.semantic;
-      settings.depth = false;
-      RenderResult r = render(g, s.views.cameras[v], settings);
-      r.means2d.retain_grad();
-      enterPhase(profile, "losses forward");
-      // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
-      // operations for the host to issue and for the autograd engine to run backwards.
-      const at::Tensor& gt = s.views.images[v];
-      const bool masked = !s.views.mask_is_full[v];
-      const at::Tensor mask = masked ? s.views.masks[v].unsqueeze(2) : at::Tensor();
-      const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
-      // Unmasked with the fused SSIM: rgbLoss (on CUDA one autograd node; elsewhere this very
-      // composition).
-      const at::Tensor rgb_loss =
-          !masked && c.fused_ssim
-              ? rgbLoss(r.rgb, gt, c.lambda_ssim)
-              : (1 - c.lambda_ssim) * masking((r.rgb - gt).abs()).mean() +
-                    c.lambda_ssim *
-                        (1 - (c.fused_ssim ? ssim(masking(r.rgb), masking(gt))
-                                           : ssimReference(masking(r.rgb), masking(gt))));
-      at::Tensor loss = c.lambda_rgb == 1 ? rgb_loss : c.lambda_rgb * rgb_loss;
-      accumulate(rgb_sum, rgb_loss);
-      if (role.semantic) {
-        // Paper, "Training Loss": 1 - cosine similarity to the class embedding (one-hot in the
-        // class-score space of the built-in backend), averaged over supervised pixels only.
-        const at::Tensor& w = s.params["decoder_w"].value;
-        const at::Tensor& b = s.params["decoder_b"].value;
-        const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
-        const at::Tensor& labels = s.views.labels[v];
-        const at::Tensor sem = role.decoder_learns
-                                   ? loss_of(r.features, labels, w, b)
-                                   : loss_of(r.features, labels, w.detach(), b.detach());
-        const double weight = s.views.semantic_weight[v];
-        loss = loss + (weight == 1 ? sem : weight * sem);
-        accumulate(sem_sum, sem);
-      }
-      total = total.defined() ? total + loss : loss;
-      renders.push_back(r);
-      cameras.push_back(s.views.cameras[v]);
-    }
-    // The mean over the global batch (one draw: the sum of its training and labelled views'
-    // losses).
-    if (batch > 1) total = total / batch;
-    const at::Tensor reg = s.drop.regularisation(s.params, it);
-    if (reg.defined()) total = total + (ranks > 1 ? reg / ranks : reg);  // once over all ranks
-    if (c.lambda_flatten > 0) {
-      const at::Tensor flat = std::get<0>(s.params["scales"].value.exp().min(1)).mean() *
-                              (c.lambda_flatten / s.extent / ranks);
-      total = total + flat;
-    }
-    enterPhase(profile, "backward");
-    total.backward();
-  };
-  render_losses_backward(s.tile_capacity.get());
+  s.renderLossesBackward(pass, it, s.tile_capacity.get());
   StepStats stats;
   if (s.tile_capacity) {
     enterPhase(profile, "tile list check");  // where the host may wait for the GPU
@@ -321,74 +419,20 @@ StepStats Trainer::step(bool read_losses) {
       // and gradients miss pairs. Again with lists sized by the exact counts (rare: a jump in
       // the count past the capacity's margin).
       for (Parameter& p : s.params.all()) p.value.mutable_grad() = at::Tensor();
-      render_losses_backward(nullptr);
+      s.renderLossesBackward(pass, it, nullptr);
       stats.rendered_again = true;
     }
   }
   {
     c10::AutoGradMode no_grad(false);
-    enterPhase(profile, "densification statistics");
-    const std::vector<at::Tensor*> sums =
-        s.densification->stepPostBackward(renders, cameras, batch, s.collective.get());
-    if (s.collective) {
-      enterPhase(profile, "all-reduce");
-      s.params.allReduceGradients(
-          *s.collective,
-          [&](const Parameter& q) {
-            if (q.name == "features") return step_views.features_anywhere;
-            if (q.name == "decoder_w" || q.name == "decoder_b") {
-              return step_views.decoder_anywhere;
-            }
-            return q.value.grad().defined();
-          },
-          sums);
-      s.densification->reduced(*s.collective);
-    }
-    s.drop.addL0Gradient(s.params, it);  // the balanced rule's L0 force (else a no-op)
-    enterPhase(profile, "optimiser");
-    s.params.adamStep();
-    holdLogScalesNearExtent(s.params["scales"].value, s.extent);
+    s.reduceAndUpdate(pass, step_views, it);
     s.iteration = it + 1;
-    const int done = s.iteration;
-    enterPhase(profile, "drop");
-    if (gated && s.drop.guardProbeDue(done)) s.drop.observeGuardProbe(done, s.guardProbeError());
-    if (gated) {
-      stats.drop = s.drop.dropIfDue(done, s.params, s.views, s.resizer(), &stats.dropped);
-    }
-    if (done == s.drop.recoveryStart()) {
-      std::tie(stats.recovery_closed_gates, stats.recovery_pruned) =
-          s.drop.settleGates(s.params, s.views, s.resizer());
-    }
-    if (done == c.iterations) {
-      stats.removed_closed_gates = s.drop.removeClosedGates(s.params, done, s.resizer());
-      if (c.prune_floaters) {
-        // Floaters: seen by too few training views, or far larger than the scene's detail.
-        const at::Tensor keep = floaterMask(s.params["means"].value, s.params["scales"].value,
-                                            s.views.trainingCameras(), c.floater_min_views,
-                                            c.floater_max_scale * s.extent)
-                                    .logical_not();
-        stats.removed_floaters = s.params.rows() - keep.sum().item<std::int64_t>();
-        if (stats.removed_floaters > 0) s.resize(keep, {});
-      }
-    }
-    enterPhase(profile, "densify, prune, reset");
-    s.densification->stepPostUpdate(
-        done, s.params, [&] { return s.drop.effectiveOpacity(s.params, done); }, s.resizer());
+    s.afterUpdate(s.iteration, gated, stats);
   }
   stats.iteration = s.iteration;
   stats.losses_read = read_losses;
   if (read_losses) {
-    enterPhase(profile, "loss values to host");
-    const at::Tensor zero = at::zeros({}, total.options());
-    at::Tensor values =
-        at::stack({total.detach(), rgb_sum, sem_sum.defined() ? sem_sum : zero,
-                   at::full({}, static_cast<double>(views.size()), total.options())});
-    if (s.collective) s.collective->sum(values);
-    values = values.to(at::kDouble).cpu();
-    const double* value = values.data_ptr<double>();
-    stats.rgb_loss = value[1] / value[3];
-    stats.semantic_loss = value[2] / batch;
-    stats.loss = value[0];
+    s.readLossValues(pass, stats);
   } else {
     stats.loss = stats.rgb_loss = stats.semantic_loss = std::numeric_limits<double>::quiet_NaN();
   }
