@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/geodesy.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/cloud_files.h"
@@ -44,7 +45,7 @@ class MapProducts : public ::testing::Test {
     test::copyTree(scene, dir_->file("geo_scene"));
     io::Georeference g;
     g.origin = {46.843, -91.994, 200.0};
-    g.epsg_utm = io::utmEpsg(g.origin);
+    g.epsg_utm = geo::utmEpsg(g.origin);
     test::writeFile(dir_->file("geo_scene/georeference.json"), io::georeferenceToJson(g));
   }
   static void TearDownTestSuite() {
@@ -222,7 +223,8 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   EXPECT_EQ(none, 0.0);
   EXPECT_NEAR(few_none, all, 1e-9);
   // One-sided views: a spread no set of photos reaches (360 degrees: the unit vectors would have
-  // to cancel exactly) leaves nothing; a small one with two views keeps a subset of those two views keep.
+  // to cancel exactly) leaves nothing; a small one with two views keeps a subset of those two views
+  // keep.
   double few_spread = 0;
   EXPECT_EQ(covered("--min-spread 360", &few_spread), 0.0);
   EXPECT_LE(covered("--min-views 2 --min-spread 30", &few_spread), by_default);

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/geodesy.h"
 #include "sadsplat/geo/gps_georeference.h"
 
 namespace sadsplat {
@@ -113,7 +114,7 @@ TEST(GpsGeoreference, ANadirFlightWithCameraGpsComesOutLevelAndInScale) {
   // degrees: the test's noise is the kind that broke it.
   std::vector<Vec3> centres, targets;
   for (const auto& p : f.photos) centres.push_back(p.centre), targets.push_back(*p.gps);
-  const io::Similarity old = io::fitSimilarity(centres, targets, 5.0);
+  const io::Similarity old = geo::fitSimilarity(centres, targets, 5.0);
   EXPECT_GT(frameError(f, old).tilt, 2.0);
 }
 

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/geodesy.h"
 #include "sadsplat/geo/ground_control.h"
 #include "sadsplat/geo/map_frame.h"
 #include "test_support/test_support.h"
@@ -126,7 +127,7 @@ TEST(GroundControl, ControlPointsFixTheFrameAndCheckPointsMeasureIt) {
   }
   EXPECT_EQ(checks, 2);
   // Through PROJ and back: the WGS84 position is the one the ENU point came from (1 mm).
-  const auto enu = io::toEnu(list.points[0].wgs84, kOrigin);
+  const auto enu = geo::toEnu(list.points[0].wgs84, kOrigin);
   EXPECT_NEAR(enu[0], -50, 1e-3);
   EXPECT_NEAR(enu[1], -10, 1e-3);
   EXPECT_NEAR(enu[2], 2, 1e-3);

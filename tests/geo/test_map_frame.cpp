@@ -8,6 +8,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/geo/geodesy.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/filesystem.h"
@@ -20,7 +21,7 @@ namespace {
 io::Georeference brighton() {
   io::Georeference g;
   g.origin = {46.843, -91.994, 198.6};
-  g.epsg_utm = io::utmEpsg(g.origin);
+  g.epsg_utm = geo::utmEpsg(g.origin);
   return g;
 }
 

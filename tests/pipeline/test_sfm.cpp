@@ -17,6 +17,7 @@
 #include <random>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/geodesy.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/colmap.h"
@@ -77,7 +78,7 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
     const synth::SynthView& v = scene.views[i];
     const Eigen::Vector3d c = centre(v.camera.qvec, v.camera.tvec);
     const std::string name = "photo_" + std::to_string(100 + i) + ".jpg";
-    writePhoto(photos + "/" + name, v, io::fromEnu({c.x(), c.y(), c.z()}, place));
+    writePhoto(photos + "/" + name, v, geo::fromEnu({c.x(), c.y(), c.z()}, place));
     true_centres[name] = c;
     true_rotations[name] = rotation(v.camera.qvec);
   }
@@ -120,7 +121,7 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
     // Where the camera must be in the scene's frame: its GPS in east-north-up around the
     // recovered origin.
     const Eigen::Vector3d t = true_centres.at(im.name);
-    const auto expected = io::toEnu(io::fromEnu({t.x(), t.y(), t.z()}, place), g.origin);
+    const auto expected = geo::toEnu(geo::fromEnu({t.x(), t.y(), t.z()}, place), g.origin);
     const Eigen::Vector3d c = centre(im.qvec, im.tvec);
     worst_position = std::max(worst_position,
                               (c - Eigen::Vector3d(expected[0], expected[1], expected[2])).norm());
@@ -153,7 +154,7 @@ TEST(Sfm, SyntheticPhotosWithGpsComeBackInMetresWithTheirCameras) {
   // different samples of the same surfaces; measured 2.5 m apart).
   std::vector<double> z_true, z_rec;
   for (const auto& p : scene.points) {
-    z_true.push_back(io::toEnu(io::fromEnu({p.xyz[0], p.xyz[1], p.xyz[2]}, place), g.origin)[2]);
+    z_true.push_back(geo::toEnu(geo::fromEnu({p.xyz[0], p.xyz[1], p.xyz[2]}, place), g.origin)[2]);
   }
   for (const auto& p : model.points) z_rec.push_back(p.xyz[2]);
   std::nth_element(z_true.begin(), z_true.begin() + z_true.size() / 2, z_true.end());
@@ -171,7 +172,7 @@ struct FrameError {
 };
 FrameError frameError(const std::vector<std::array<double, 3>>& truth,
                       const std::vector<std::array<double, 3>>& fitted) {
-  const io::Similarity s = io::fitSimilarity(truth, fitted, 1e12);
+  const io::Similarity s = geo::fitSimilarity(truth, fitted, 1e12);
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = s.rotation[3 * r + c];
@@ -224,7 +225,7 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
     // COLMAP's prior. Without it a nadir flight over flat ground leaves the focal length free
     // (seen: 596 px for the true 554, every height 7.6 % too large).
     writePhoto(photos + "/" + v.name.substr(0, v.name.size() - 4) + ".jpg", v,
-               io::fromEnu(gps, place),
+               geo::fromEnu(gps, place),
                static_cast<int>(std::lround(36.0 * v.camera.fx / v.camera.width)));
   }
   // 12 ground control points: sparse points of the synthetic world on the ground near a 4 x 3
@@ -307,7 +308,7 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
   for (const auto& im : model.images) {
     const int i = std::stoi(im.name.substr(5, 3));
     const auto& t = true_centres[i];
-    truth.push_back(io::toEnu(io::fromEnu(t, place), final_frame.origin));
+    truth.push_back(geo::toEnu(geo::fromEnu(t, place), final_frame.origin));
     const Eigen::Vector3d c = centre(im.qvec, im.tvec);
     by_gcp.push_back({c.x(), c.y(), c.z()});
     colmap_frame.push_back(inverse(final_frame.sfm_to_local, by_gcp.back()));
@@ -332,9 +333,9 @@ TEST(Sfm, ANadirSurveyWithCameraGpsComesOutLevelAndGroundControlPointsAreChecked
     for (std::size_t k = 0; k < model.images.size(); ++k) {
       const auto loc = io::readExifGps(photos + "/" + model.images[k].name);
       ASSERT_TRUE(loc.has_value());
-      targets.push_back(io::toEnu(*loc, final_frame.origin));
+      targets.push_back(geo::toEnu(*loc, final_frame.origin));
     }
-    const io::Similarity old = io::fitSimilarity(colmap_frame, targets, 5.0);
+    const io::Similarity old = geo::fitSimilarity(colmap_frame, targets, 5.0);
     std::vector<std::array<double, 3>> by_old;
     for (const auto& c : colmap_frame) by_old.push_back(old.apply(c));
     const FrameError o3 = frameError(truth, by_old);

@@ -1,4 +1,5 @@
 #include "sadsplat/geo/gps_georeference.h"
+#include "sadsplat/geo/geodesy.h"
 
 #include <Eigen/Dense>
 
@@ -169,7 +170,7 @@ GpsFit fitGpsGeoreference(const std::vector<GpsPhoto>& photos,
   GpsFit fit;
   io::Georeference& g = fit.georeference;
   g.origin = origin;
-  g.epsg_utm = io::utmEpsg(origin);
+  g.epsg_utm = geo::utmEpsg(origin);
   g.photos_with_gps = n;
   g.gps_accuracy_metres = accuracy;
 
@@ -286,7 +287,7 @@ GpsFit fitGpsGeoreference(const std::vector<GpsPhoto>& photos,
         "dominant plane): the tilt comes from the GPS altitudes");
     bool consensus = false;
     g.sfm_to_local =
-        io::fitSimilarity(centres, targets, kInlierSigmas * accuracy, &inlier, &consensus);
+        geo::fitSimilarity(centres, targets, kInlierSigmas * accuracy, &inlier, &consensus);
     g.inlier_metres = kInlierSigmas * accuracy;
     g.gps_noise_metres = accuracy;
     if (!consensus) doubts.push_back("no 3 photos' GPS agree with the reconstruction");

@@ -1,4 +1,5 @@
 #include "sadsplat/geo/ground_control.h"
+#include "sadsplat/geo/geodesy.h"
 
 #include <Eigen/Dense>
 
@@ -282,7 +283,7 @@ GcpFit fitGcpGeoreference(const io::ColmapModel& model, const GcpList& gcps,
       fit.skipped.push_back(p.name + ": " + t.why);
       continue;
     }
-    placed.push_back({&p, t, io::toEnu(p.wgs84, origin)});
+    placed.push_back({&p, t, geo::toEnu(p.wgs84, origin)});
     if (!p.check) from.push_back(t.sfm), to.push_back(placed.back().enu);
   }
   if (from.size() < 3) {
@@ -292,11 +293,11 @@ GcpFit fitGcpGeoreference(const io::ColmapModel& model, const GcpList& gcps,
   }
   io::Georeference& g = fit.georeference;
   g.origin = origin;
-  g.epsg_utm = io::utmEpsg(origin);
+  g.epsg_utm = geo::utmEpsg(origin);
   g.up_source = "ground control points";
   // Least squares over every control point: surveyed points are trusted, their residuals shown.
   bool consensus = false;
-  g.sfm_to_local = io::fitSimilarity(from, to, 1e12, nullptr, &consensus);
+  g.sfm_to_local = geo::fitSimilarity(from, to, 1e12, nullptr, &consensus);
   double ch2 = 0, cv2 = 0, kh2 = 0, kv2 = 0;
   for (const auto& p : placed) {
     const auto x = g.sfm_to_local.apply(p.t.sfm);

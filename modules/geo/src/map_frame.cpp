@@ -1,4 +1,5 @@
 #include "sadsplat/geo/map_frame.h"
+#include "sadsplat/geo/geodesy.h"
 
 #include <cmath>
 #include <cstdio>
@@ -194,7 +195,7 @@ std::vector<Vec3> enuToUtm(const io::Georeference& g, const std::vector<Vec3>& e
   const Transform t = wgs84ToUtm(g.epsg_utm);
   std::vector<double> x(enu.size()), y(enu.size()), z(enu.size());
   for (std::size_t i = 0; i < enu.size(); ++i) {
-    const io::GeoPosition p = io::fromEnu(enu[i], g.origin);
+    const io::GeoPosition p = geo::fromEnu(enu[i], g.origin);
     x[i] = p.longitude;
     y[i] = p.latitude;
     z[i] = p.altitude;

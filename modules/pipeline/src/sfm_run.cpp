@@ -1,4 +1,5 @@
 #include "sadsplat/pipeline/sfm_run.h"
+#include "sadsplat/geo/geodesy.h"
 
 #include <nlohmann/json.hpp>
 
@@ -263,7 +264,7 @@ std::optional<io::Georeference> georeferenceModel(
   origin.horizontal_accuracy = 0;
   for (auto& photo : gps_photos) {
     const auto it = gps.find(photo.name);
-    if (it != gps.end()) photo.gps = io::toEnu(it->second, origin);
+    if (it != gps.end()) photo.gps = geo::toEnu(it->second, origin);
   }
   std::vector<std::array<double, 3>> points;
   for (const auto& p : model.points) points.push_back(p.xyz);

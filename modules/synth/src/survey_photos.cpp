@@ -1,4 +1,5 @@
 #include "sadsplat/synth/survey_photos.h"
+#include "sadsplat/geo/geodesy.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -60,7 +61,7 @@ int writeSurveyPhotos(const SynthScene& scene, const SurveyPhotoOptions& o,
     // The 35 mm equivalent focal length as COLMAP reads it (35 mm across the longest side).
     const int focal_35mm = static_cast<int>(
         std::lround(35.0 * v.camera.fx / std::max(v.camera.width, v.camera.height)));
-    const auto bytes = io::jpegWithExifGps(jpeg, io::fromEnu(gps, o.place), focal_35mm);
+    const auto bytes = io::jpegWithExifGps(jpeg, geo::fromEnu(gps, o.place), focal_35mm);
     io::writeFileAtomically(dir + "/" + photoStem(v.name) + ".jpg", [&](std::ostream& out) {
       out.write(reinterpret_cast<const char*>(bytes.data()),
                 static_cast<std::streamsize>(bytes.size()));
@@ -90,7 +91,7 @@ int writeSurveyPhotos(const SynthScene& scene, const SurveyPhotoOptions& o,
       }
       if (best == nullptr) continue;
       const io::GeoPosition where =
-          io::fromEnu({best->xyz[0], best->xyz[1], best->xyz[2]}, o.place);
+          geo::fromEnu({best->xyz[0], best->xyz[1], best->xyz[2]}, o.place);
       const std::string name = "gcp-" + std::to_string(10 + written);
       int marks = 0;
       std::ostringstream lines;

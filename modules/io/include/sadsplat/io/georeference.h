@@ -39,11 +39,6 @@ bool haveExif();
 std::vector<unsigned char> jpegWithExifGps(const std::vector<unsigned char>& jpeg,
                                            const GeoPosition& gps, int focal_length_35mm = 0);
 
-/// \brief Local east-north-up metres around `origin` (WGS84 ellipsoid, exact through ECEF).
-std::array<double, 3> toEnu(const GeoPosition& p, const GeoPosition& origin);
-/// \brief The inverse of toEnu.
-GeoPosition fromEnu(const std::array<double, 3>& enu, const GeoPosition& origin);
-
 /// \brief EPSG code of the WGS84 / UTM zone that holds `p` (326zz north, 327zz south; the
 /// standard 6-degree zones, without the Norway / Svalbard exceptions).
 int utmEpsg(const GeoPosition& p);
@@ -56,25 +51,13 @@ struct Similarity {
   std::array<double, 3> apply(const std::array<double, 3>& x) const;
 };
 
-/// \brief The similarity from `from` to `to` (point pairs) with the least squared error (Umeyama
-/// 1991), robust to outliers: RANSAC over triples, inliers within `inlier_metres` of their target,
-/// refit on the largest inlier set. When no 3 pairs agree within `inlier_metres` (no consensus),
-/// the least-squares fit of all pairs.
-/// \param[out] inliers if not null, which pairs lie within `inlier_metres` under the returned fit
-/// \param[out] consensus if not null, whether the fit is the refit of >= 3 agreeing pairs (false:
-///   the fit of all pairs, whose residuals can be far above `inlier_metres`)
-/// \throws sadsplat::Error when there are fewer than 3 pairs or they are degenerate
-Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
-                         const std::vector<std::array<double, 3>>& to, double inlier_metres,
-                         std::vector<bool>* inliers = nullptr, bool* consensus = nullptr);
-
 /// \brief A scene's georeference: its frame is east-north-up metres around `origin`.
 struct Georeference {
   GeoPosition origin;
-  int epsg_utm = 0;          ///< the UTM zone of the origin, for GIS outputs
-  Similarity sfm_to_local;   ///< how the SfM frame was taken into the local frame
-  int photos_with_gps = 0;   ///< photos whose GPS took part in the fit
-  int inliers = 0;           ///< of those, within the inlier distance under the fit
+  int epsg_utm = 0;         ///< the UTM zone of the origin, for GIS outputs
+  Similarity sfm_to_local;  ///< how the SfM frame was taken into the local frame
+  int photos_with_gps = 0;  ///< photos whose GPS took part in the fit
+  int inliers = 0;          ///< of those, within the inlier distance under the fit
   /// whether >= 3 photos agreed within the inlier distance; false: the fit of all photos' GPS,
   /// which can be off by its RMS (the reconstruction and the GPS disagree)
   bool consensus = true;
