@@ -23,6 +23,7 @@
 #include "sadsplat/gaussians/cpu_threads.h"
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/device.h"
 
 namespace {
 
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
   app.add_flag("--profile", profile_steps, "also time each step of the rasterizer");
   CLI11_PARSE(app, argc, argv);
   sadsplat::gaussians::setCpuThreads(std::max(1, threads));
-  const at::Device device = device_name == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU);
+  const at::Device device = sadsplat::gaussians::deviceNamed(device_name, "--device");
   if (device.is_cuda() && !at::hasCUDA()) {
     std::fprintf(stderr, "sadsplat_bench_rasterizer: no CUDA device\n");
     return 1;

@@ -14,6 +14,7 @@
 
 #include "bench_support.h"
 #include "sadsplat/gaussians/semantic_loss.h"
+#include "sadsplat/gaussians/device.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Semantic loss: fused vs reference, forward and forward+backward"};
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "no CUDA device\n");
     return 1;
   }
-  const at::Device device(device_name == "cuda" ? at::kCUDA : at::kCPU);
+  const at::Device device = sadsplat::gaussians::deviceNamed(device_name, "--device");
   at::manual_seed(0);
   const auto opts = at::TensorOptions().dtype(at::kFloat).device(device);
   const at::Tensor image_data = at::randn({height, width, 3 + features}, opts);

@@ -12,6 +12,8 @@ namespace {
 
 class ImportCommand : public Command {
  public:
+  // Half resolution, as `sadsplat train SCENE` imports (the paper trains at half resolution).
+  ImportCommand() { options_.scale = 0.5; }
   CLI::App* add(CLI::App& app) override {
     CLI::App* c = app.add_subcommand("import", "Import a scene directory into a scene cache");
     c->add_option("SCENE", dir_, "scene directory")->required();

@@ -74,6 +74,30 @@ CameraParams unpackCamera(const std::vector<double>& v) {
               "CUDA tensors");
 }
 
+// The backend of tensor `t`: `cpu()` for a CPU tensor; for a CUDA tensor `cuda(stream)` on its
+// device (a guard) and that device's current stream, or an error in a build without CUDA. The
+// CUDA part is written with SADSPLAT_CUDA_PART, which leaves it out of builds without CUDA (its
+// functions are not declared there).
+template <typename Cpu, typename Cuda>
+decltype(auto) onBackend(const at::Tensor& t, Cpu&& cpu, Cuda&& cuda) {
+  if (t.is_cuda()) {
+#if SADSPLAT_HAVE_CUDA
+    const c10::cuda::CUDAGuard guard(t.device());
+    return cuda(currentStream(t));
+#else
+    (void)cuda;
+    noCuda();
+#endif
+  }
+  return cpu();
+}
+
+#if SADSPLAT_HAVE_CUDA
+#define SADSPLAT_CUDA_PART(...) [&](void* stream) { __VA_ARGS__ }
+#else
+#define SADSPLAT_CUDA_PART(...) [](void*) {}
+#endif
+
 // An output's gradient, or zeros of its shape when autograd passed none (made only then: the
 // backward runs every step).
 at::Tensor orZeros(const at::Tensor& grad, at::IntArrayRef sizes,
@@ -88,17 +112,9 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     const CameraParams cam = unpackCamera(camera);
     const ScopedPhase phase("project");
     const at::Tensor m = means.contiguous(), q = quats.contiguous(), s = log_scales.contiguous();
-    raster::ProjectionResult r;
-    if (m.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      const c10::cuda::CUDAGuard guard(m.device());
-      r = raster::projectForwardCuda(m, q, s, cam, currentStream(m));
-#else
-      noCuda();
-#endif
-    } else {
-      r = raster::projectForwardCpu(m, q, s, cam);
-    }
+    const raster::ProjectionResult r = onBackend(
+        m, [&] { return raster::projectForwardCpu(m, q, s, cam); },
+        SADSPLAT_CUDA_PART(return raster::projectForwardCuda(m, q, s, cam, stream);));
     ctx->save_for_backward({m, q, s, r.radii});
     ctx->saved_data["camera"] = camera;
     ctx->mark_non_differentiable({r.radii});
@@ -112,20 +128,16 @@ struct ProjectFunction : public torch::autograd::Function<ProjectFunction> {
     const CameraParams cam = unpackCamera(ctx->saved_data["camera"].toDoubleVector());
     const at::Tensor g_m2 = orZeros(grads[0], {m.size(0), 2}, m.options());
     const at::Tensor g_co = orZeros(grads[1], {m.size(0), 3}, m.options());
-    raster::ProjectionGrads g;
-    if (m.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      // Training renders no depth: the CUDA kernel takes its missing gradient as zeros.
-      const c10::cuda::CUDAGuard guard(m.device());
-      const at::Tensor g_d = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
-      g = raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d, currentStream(m));
-#else
-      noCuda();
-#endif
-    } else {
-      const at::Tensor g_d = orZeros(grads[2], {m.size(0)}, m.options());
-      g = raster::projectBackwardCpu(m, q, s, radii, cam, g_m2, g_co, g_d);
-    }
+    const raster::ProjectionGrads g = onBackend(
+        m,
+        [&] {
+          const at::Tensor g_d = orZeros(grads[2], {m.size(0)}, m.options());
+          return raster::projectBackwardCpu(m, q, s, radii, cam, g_m2, g_co, g_d);
+        },
+        SADSPLAT_CUDA_PART(
+            // Training renders no depth: the CUDA kernel takes its missing gradient as zeros.
+            const at::Tensor g_d = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
+            return raster::projectBackwardCuda(m, q, s, radii, cam, g_m2, g_co, g_d, stream);));
     return {g.means, g.quats, g.log_scales, at::Tensor()};
   }
 };
@@ -143,20 +155,16 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     const ScopedPhase phase("rasterize");
     const at::Tensor m2 = means2d.contiguous(), co = conics.contiguous(),
                      op = opacities.contiguous(), val = values.contiguous();
-    raster::RasterResult r;
-    if (m2.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      const c10::cuda::CUDAGuard guard(m2.device());
-      r = raster::rasterizeForwardCuda(m2, co, op, val, radii.contiguous(), depths.contiguous(),
-                                       static_cast<int>(width), static_cast<int>(height),
-                                       capacity, currentStream(m2));
-#else
-      noCuda();
-#endif
-    } else {
-      r = raster::rasterizeForwardCpu(m2, co, op, val, radii.contiguous(), depths.contiguous(),
-                                      static_cast<int>(width), static_cast<int>(height));
-    }
+    const int w = static_cast<int>(width), h = static_cast<int>(height);
+    raster::RasterResult r = onBackend(
+        m2,
+        [&] {
+          return raster::rasterizeForwardCpu(m2, co, op, val, radii.contiguous(),
+                                             depths.contiguous(), w, h);
+        },
+        SADSPLAT_CUDA_PART(return raster::rasterizeForwardCuda(m2, co, op, val, radii.contiguous(),
+                                                               depths.contiguous(), w, h, capacity,
+                                                               stream);));
     ctx->save_for_backward({m2, co, op, val});
     // alpha is also an output: keeping the output itself in saved_data would make a reference
     // cycle output -> grad_fn -> ctx -> output and leak every graph (~8 MB per 800x450 render
@@ -202,21 +210,18 @@ struct RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
         }
       }
     }
-    raster::RasterGrads g;
-    if (val.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      // Alpha without a gradient (a black background): the CUDA kernel takes it as zeros.
-      const c10::cuda::CUDAGuard guard(val.device());
-      const at::Tensor g_alpha = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
-      g = raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha,
-                                        currentStream(val));
-#else
-      noCuda();
-#endif
-    } else {
-      const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha.sizes(), fwd.alpha.options());
-      g = raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img, g_alpha);
-    }
+    const raster::RasterGrads g = onBackend(
+        val,
+        [&] {
+          const at::Tensor g_alpha = orZeros(grads[2], fwd.alpha.sizes(), fwd.alpha.options());
+          return raster::rasterizeBackwardCpu(saved[0], saved[1], saved[2], val, fwd, g_img,
+                                              g_alpha);
+        },
+        SADSPLAT_CUDA_PART(
+            // Alpha without a gradient (a black background): the CUDA kernel takes it as zeros.
+            const at::Tensor g_alpha = grads[2].defined() ? grads[2].contiguous() : at::Tensor();
+            return raster::rasterizeBackwardCuda(saved[0], saved[1], saved[2], val, fwd, g_img,
+                                                 g_alpha, stream);));
     // No gradient for radii, depths, width, height, split, the tile-list capacity and the flag.
     return {g.means2d,    g.conics,     g.opacities,  g.values,     at::Tensor(), at::Tensor(),
             at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
@@ -241,17 +246,9 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
     const ScopedPhase phase("SH");
     const std::array<double, 3> campos{camera[0], camera[1], camera[2]};
     const int degree = static_cast<int>(camera[3]);
-    at::Tensor colors;
-    if (m.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      const c10::cuda::CUDAGuard guard(m.device());
-      colors = raster::shForwardCuda(sh, m, campos, degree, currentStream(m));
-#else
-      noCuda();
-#endif
-    } else {
-      colors = raster::shForwardCpu(sh, m, campos, degree);
-    }
+    const at::Tensor colors = onBackend(
+        m, [&] { return raster::shForwardCpu(sh, m, campos, degree); },
+        SADSPLAT_CUDA_PART(return raster::shForwardCuda(sh, m, campos, degree, stream);));
     ctx->save_for_backward({sh.dc, sh.rest, m});
     ctx->saved_data["camera"] = camera;
     return {colors};
@@ -266,17 +263,9 @@ struct ShFunction : public torch::autograd::Function<ShFunction> {
     const raster::ShParts sh{saved[0], saved[1]};
     const at::Tensor& m = saved[2];
     const at::Tensor g = orZeros(grads[0], {m.size(0), 3}, m.options());
-    raster::ShGrads out;
-    if (m.is_cuda()) {
-#if SADSPLAT_HAVE_CUDA
-      const c10::cuda::CUDAGuard guard(m.device());
-      out = raster::shBackwardCuda(sh, m, campos, degree, g, currentStream(m));
-#else
-      noCuda();
-#endif
-    } else {
-      out = raster::shBackwardCpu(sh, m, campos, degree, g);
-    }
+    const raster::ShGrads out = onBackend(
+        m, [&] { return raster::shBackwardCpu(sh, m, campos, degree, g); },
+        SADSPLAT_CUDA_PART(return raster::shBackwardCuda(sh, m, campos, degree, g, stream);));
     return {out.dc, out.rest, out.means, at::Tensor()};
   }
 };
@@ -405,7 +394,8 @@ std::array<at::Tensor, 4> projectGaussians(const at::Tensor& means, const at::Te
   expectTensor(means, "means", n, {3}, means);
   expectTensor(quats, "quats", n, {4}, means);
   expectTensor(log_scales, "log_scales", n, {3}, means);
-  const auto out = ProjectFunction::apply(means, quats, log_scales, packCamera(raster::cameraParams(camera)));
+  const auto out =
+      ProjectFunction::apply(means, quats, log_scales, packCamera(raster::cameraParams(camera)));
   return {out[0], out[1], out[2], out[3]};
 }
 

@@ -15,6 +15,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/gaussians/densification.h"
+#include "sadsplat/gaussians/device.h"
 #include "sadsplat/gaussians/gaussian_tensors.h"
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/initialization.h"
@@ -310,11 +311,11 @@ void Trainer::State::readLossValues(const StepPass& pass, StepStats& stats) cons
 Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State(config)) {
   State& s = *state_;
   config.check();
-  if (config.device == "cuda") {
+  s.device = deviceNamed(config.device, "<config>");
+  if (s.device.is_cuda()) {
     if (!at::hasCUDA()) {
       throw Error("<config>", "device", "cpu (no CUDA device or no CUDA build here)", "cuda");
     }
-    s.device = at::Device(at::kCUDA, 0);
     if (config.tile_list_margin > 0) {
       s.tile_capacity = std::make_unique<TileListCapacity>(config.tile_list_margin);
     }

@@ -13,6 +13,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/run_directory.h"
 #include "sadsplat/pipeline/opened_run.h"
+#include "sadsplat/gaussians/device.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -48,7 +49,7 @@ struct SplatFrames::State {
 
 SplatFrames::SplatFrames(const std::string& path, const std::string& device) : state_(new State) {
   State& s = *state_;
-  if (device == "cuda") s.device = at::Device(at::kCUDA, 0);
+  s.device = gaussians::deviceNamed(device, path);
   if (io::RunDirectory::hasCheckpoint(path)) {
     s.run = std::make_unique<OpenedRun>(openRun(path));
     s.cloud = s.run->trainer->toCloud();

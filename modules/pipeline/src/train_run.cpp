@@ -19,6 +19,7 @@
 #include "sadsplat/io/semantic_ply.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
+#include "sadsplat/gaussians/device.h"
 #include "training_report.h"
 
 namespace sadsplat {
@@ -26,7 +27,7 @@ namespace pipeline {
 namespace {
 
 at::Device deviceOf(const gaussians::TrainConfig& config) {
-  return config.device == "cuda" ? at::Device(at::kCUDA, 0) : at::Device(at::kCPU);
+  return gaussians::deviceNamed(config.device, "<config>");
 }
 
 // The configuration a run trains with: the schedule resolved, or for a resumed run its own
