@@ -14,6 +14,7 @@
 #include "sadsplat/gaussians/image_metrics.h"
 
 #include "sadsplat/io/scene_cache.h"
+#include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 #include "sadsplat/semantic_drop/hard_concrete.h"
 #include "sadsplat/semantic_drop/semantic_confidence.h"

@@ -1,5 +1,7 @@
 #include "sadsplat/gaussians/counter_random.h"
 
+#include <ATen/CPUGeneratorImpl.h>
+
 namespace sadsplat {
 namespace gaussians {
 
@@ -8,6 +10,11 @@ std::uint64_t mixBits(std::uint64_t x) {
   x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
   x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
   return x ^ (x >> 31);
+}
+
+at::Generator seededGenerator(std::uint64_t seed, RandomPurpose purpose, std::uint64_t iteration) {
+  return at::detail::createCPUGenerator(
+      mixBits(seed ^ mixBits(purposeKey(purpose) ^ mixBits(iteration))));
 }
 
 namespace {

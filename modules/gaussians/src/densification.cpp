@@ -9,8 +9,10 @@
 #include <tuple>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/gaussians/densification_stats.h"
-#include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/gaussians/parameter_store.h"
+#include "sadsplat/gaussians/train_config.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -123,7 +125,8 @@ class DefaultDensification : public DensificationStrategy {
 
     const at::Tensor clone_idx = clone.nonzero().squeeze(1);
     const at::Tensor split_idx = split.nonzero().squeeze(1);
-    std::map<std::string, at::Tensor> extra = splitRows(params, split_idx, scales, iteration, 7);
+    std::map<std::string, at::Tensor> extra =
+        splitRows(params, split_idx, scales, iteration, RandomPurpose::kDensifySplit);
     for (const Parameter& q : params.all()) {
       if (!q.per_gaussian) continue;
       const at::Tensor cloned = q.value.detach().index_select(0, clone_idx);
@@ -142,13 +145,13 @@ class DefaultDensification : public DensificationStrategy {
   }
 
   // Split: two samples from each Gaussian of `idx`, scales divided by 1.6 (3DGS); the new rows
-  // of every per-Gaussian parameter. `salt` separates the random streams of the callers.
+  // of every per-Gaussian parameter. `purpose` separates the random streams of the callers.
   std::map<std::string, at::Tensor> splitRows(ParameterStore& params, const at::Tensor& idx,
                                               const at::Tensor& scales, int iteration,
-                                              std::uint64_t salt) const {
+                                              RandomPurpose purpose) const {
     const Settings& c = config_;
     const at::Tensor s = scales.index_select(0, idx).repeat({2, 1});
-    at::Generator gen = seededGenerator(c.seed, salt, static_cast<std::uint64_t>(iteration));
+    at::Generator gen = seededGenerator(c.seed, purpose, static_cast<std::uint64_t>(iteration));
     const at::Tensor noise = at::normal(0.0, 1.0, {s.size(0), 3}, gen).to(s.device()) * s;
     const at::Tensor q = params["quats"].value.detach().index_select(0, idx).repeat({2, 1});
     const at::Tensor qn = q / q.norm(2, 1, true);
@@ -181,7 +184,8 @@ class DefaultDensification : public DensificationStrategy {
     const at::Tensor large = std::get<0>(scales.max(1)) > config_.large_split_scale * extent_;
     if (!large.any().item<bool>()) return;
     const at::Tensor idx = large.nonzero().squeeze(1);
-    resize(large.logical_not(), splitRows(params, idx, scales, iteration, 11));
+    resize(large.logical_not(),
+           splitRows(params, idx, scales, iteration, RandomPurpose::kLargeSplit));
     clearStatistics();
   }
 
@@ -207,7 +211,10 @@ class DefaultDensification : public DensificationStrategy {
       }
       const at::Tensor idx = split.nonzero().squeeze(1);
       added += idx.size(0);
-      resize(split.logical_not(), splitRows(params, idx, scales, iteration, 101 + round));
+      resize(split.logical_not(),
+             splitRows(
+                 params, idx, scales, iteration,
+                 static_cast<RandomPurpose>(purposeKey(RandomPurpose::kScaleLimitSplit) + round)));
     }
     clearStatistics();
   }

@@ -55,11 +55,8 @@ void DropState::addL0Gradient(ParameterStore& params, int it) const {
   if (!gated(it) || !balanced()) return;
   // The L0 schedule (lambda_l0_from, lambda_l0_ramp) applies to the strength as to lambda_l0.
   if (it < options_.lambda_l0_from) return;
-  double strength = options_.l0_strength * guard_[0];
-  if (options_.lambda_l0_ramp > 0) {
-    strength *= std::min(
-        1.0, static_cast<double>(it - options_.lambda_l0_from + 1) / options_.lambda_l0_ramp);
-  }
+  const double strength = options_.l0_strength * guard_.pressure *
+                          l0Ramp(options_.lambda_l0_from, options_.lambda_l0_ramp, it);
   Parameter& la = params["log_alpha"];
   at::Tensor grad = la.value.grad();
   if (strength == 0 || !grad.defined()) return;
@@ -93,10 +90,11 @@ void DropState::observeGuardProbe(int done, double probe_mse) {
   if (!std::isfinite(probe_mse)) return;
   // The reference is the lowest reading since the last opacity reset: a drop whose cost the
   // training has not won back by the next event halves the pressure again.
-  const bool fresh = guard_[1] < 0 || openedByReset(static_cast<int>(guard_[2]), done);
-  if (!fresh && probe_mse > guard_[1] * (1 + options_.drop_guard)) guard_[0] *= 0.5;
-  guard_[1] = fresh ? probe_mse : std::min(guard_[1], probe_mse);
-  guard_[2] = done;
+  const bool fresh =
+      guard_.lowest < 0 || openedByReset(static_cast<int>(guard_.last_reading), done);
+  if (!fresh && probe_mse > guard_.lowest * (1 + options_.drop_guard)) guard_.pressure *= 0.5;
+  guard_.lowest = fresh ? probe_mse : std::min(guard_.lowest, probe_mse);
+  guard_.last_reading = done;
 }
 
 bool DropState::refreshesL0Weights(int it) const {
@@ -124,8 +122,8 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
   if (balanced() && done < options_.lambda_l0_from) return decision;
   DropInputs in;
   if (balanced()) {
-    in.max_removed = static_cast<std::int64_t>(
-        std::floor(options_.drop_max_fraction * guard_[0] * static_cast<double>(params.rows())));
+    in.max_removed = static_cast<std::int64_t>(std::floor(
+        options_.drop_max_fraction * guard_.pressure * static_cast<double>(params.rows())));
   }
   in.means = params["means"].value.detach();
   in.opacities = at::sigmoid(params["opacity"].value.detach());
@@ -196,8 +194,9 @@ void DropState::save(TensorArchive& a) const {
   a.tensors["confidence"] = confidence_;
   a.tensors["l0_weights"] = l0_weights_;
   // The archive stores no doubles: their bits as int64, so that a resumed run continues exactly.
-  std::vector<std::int64_t> bits(guard_.size());
-  std::memcpy(bits.data(), guard_.data(), sizeof(double) * guard_.size());
+  const std::array<double, 4> packed = guard_.packed();
+  std::vector<std::int64_t> bits(packed.size());
+  std::memcpy(bits.data(), packed.data(), sizeof(double) * packed.size());
   a.tensors["drop_guard"] = at::tensor(bits, at::kLong);
 }
 
@@ -207,19 +206,19 @@ void DropState::load(const TensorArchive& a, const std::string& path, const at::
   l0_weights_ = a.tensors.count("l0_weights") ? a.tensor("l0_weights", path).to(device)
                                               : at::ones_like(confidence_);
   // Checkpoints written before the balanced rule have no guard state: a fresh guard.
-  guard_ = {1.0, -1.0, 0.0, kGuardVersion};
+  guard_ = DropGuard();
   if (a.tensors.count("drop_guard")) {
     const at::Tensor g = a.tensor("drop_guard", path).to(at::kCPU).contiguous();
     if (g.numel() != 4 || g.scalar_type() != at::kLong) {
       throw Error(path, "drop_guard", "4 int64 values (the guard's doubles)",
                   std::to_string(g.numel()) + " values of " + std::string(g.dtype().name()));
     }
-    std::memcpy(guard_.data(), g.data_ptr<std::int64_t>(), sizeof(double) * guard_.size());
-    if (!(guard_[0] > 0 && guard_[0] <= 1)) {
-      throw Error(path, "drop_guard pressure", "a value in (0, 1]", std::to_string(guard_[0]));
+    std::array<double, 4> packed{};
+    std::memcpy(packed.data(), g.data_ptr<std::int64_t>(), sizeof(double) * packed.size());
+    if (!(packed[0] > 0 && packed[0] <= 1)) {
+      throw Error(path, "drop_guard pressure", "a value in (0, 1]", std::to_string(packed[0]));
     }
-    // Written before the fixed probe views: the pressure holds, the next reading starts afresh.
-    if (guard_[3] != kGuardVersion) guard_ = {guard_[0], -1.0, 0.0, kGuardVersion};
+    guard_ = DropGuard::unpacked(packed);
   }
 }
 

@@ -20,6 +20,25 @@
 namespace sadsplat {
 namespace gaussians {
 
+// The balanced rule's guard (DropState::observeGuardProbe): the factor it leaves on the L0
+// strength and the drop cap, the lowest probe reading since the last opacity reset (< 0: none
+// yet) and the iteration of the last reading.
+struct DropGuard {
+  double pressure = 1.0;
+  double lowest = -1.0;
+  double last_reading = 0.0;
+
+  // The checkpoint's form: the three values and kVersion (checkpoints written before the fixed
+  // probe views held a count of training-loss readings >= 0 there).
+  static constexpr double kVersion = -2.0;
+  std::array<double, 4> packed() const { return {pressure, lowest, last_reading, kVersion}; }
+  // From a checkpoint; one of another version keeps its pressure and starts a fresh reading.
+  static DropGuard unpacked(const std::array<double, 4>& v) {
+    if (v[3] != kVersion) return {v[0], -1.0, 0.0};
+    return {v[0], v[1], v[2]};
+  }
+};
+
 class DropState {
  public:
   using Resize = DensificationStrategy::Resize;
@@ -63,7 +82,7 @@ class DropState {
   // itself) halves the pressure.
   void observeGuardProbe(int done, double probe_mse);
   // The factor on the L0 strength and the drop cap that the guard has left (1 at the start).
-  double pressure() const { return guard_[0]; }
+  double pressure() const { return guard_.pressure; }
 
   // Whether the L0 term's weights are recomputed before iteration `it`: with l0_importance, when
   // the L0 schedule starts and every drop interval after (a fixed schedule, so that a resumed run
@@ -101,14 +120,9 @@ class DropState {
   std::shared_ptr<const DropStrategy> drop_;
   at::Tensor confidence_;  // [N] last semantic confidence computed by the drop (0 before)
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
-  bool balanced() const { return options_.drop_rule == "balanced"; }
+  bool balanced() const { return balancedDropRule(options_); }
   bool openedByReset(int from, int to) const;
-  // guard_[3] of the guard's present state (checkpoints written before the fixed probe views held
-  // a count of training-loss readings >= 0 there, and start a fresh reading).
-  static constexpr double kGuardVersion = -2.0;
-  // The guard's state: pressure, the lowest reading since the last opacity reset (< 0: none
-  // yet), the iteration of the last reading, and kGuardVersion.
-  std::array<double, 4> guard_{1.0, -1.0, 0.0, kGuardVersion};
+  DropGuard guard_;
 };
 
 }  // namespace gaussians

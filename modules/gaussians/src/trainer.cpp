@@ -31,10 +31,6 @@
 namespace sadsplat {
 namespace gaussians {
 
-at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration) {
-  return at::detail::createCPUGenerator(mixBits(seed ^ mixBits(purpose ^ mixBits(iteration))));
-}
-
 namespace {
 
 // Every log-scale stays within e^+-20 of the scene extent, and within what the model's writer and
@@ -348,7 +344,7 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   p.add("scales", t.log_scales, config.lr_scaling);
   p.add("quats", t.rotations, config.lr_rotation);
   p.add("features", t.features, config.lr_feature, true, /*steps_without_gradient=*/true);
-  at::Generator gen = seededGenerator(config.seed, 3, 0);
+  at::Generator gen = seededGenerator(config.seed, RandomPurpose::kDecoderInit, 0);
   const double bound = 1.0 / std::sqrt(std::max(1, s.config.feature_dim));
   p.add("decoder_w",
         at::empty({s.num_classes, s.config.feature_dim}).uniform_(-bound, bound, gen).to(s.device),

@@ -37,7 +37,7 @@ ViewRole TrainingViews::role(int v, const TrainConfig& config) const {
 namespace {
 
 // The view of a draw: the next one of a seeded shuffle of `views` (an epoch per pass).
-int pickView(const std::vector<int>& views, std::uint64_t seed, std::uint64_t purpose,
+int pickView(const std::vector<int>& views, std::uint64_t seed, RandomPurpose purpose,
              int counter) {
   const int n = static_cast<int>(views.size());
   const int epoch = counter / n, pos = counter % n;
@@ -45,7 +45,7 @@ int pickView(const std::vector<int>& views, std::uint64_t seed, std::uint64_t pu
   std::iota(order.begin(), order.end(), 0);
   std::vector<std::uint64_t> keys(n);
   for (int i = 0; i < n; ++i) {
-    keys[i] = mixBits(seed ^ mixBits(purpose ^ mixBits(epoch * 1000003ull + i)));
+    keys[i] = mixBits(seed ^ mixBits(purposeKey(purpose) ^ mixBits(epoch * 1000003ull + i)));
   }
   std::sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
   return views[order[pos]];
@@ -53,18 +53,18 @@ int pickView(const std::vector<int>& views, std::uint64_t seed, std::uint64_t pu
 
 }  // namespace
 
-StepViews drawStepViews(const TrainingViews& s, const TrainConfig& c, int it, int rank,
-                        int ranks, bool in_group) {
+StepViews drawStepViews(const TrainingViews& s, const TrainConfig& c, int it, int rank, int ranks,
+                        bool in_group) {
   const int batch = c.views_per_step * ranks;
   const bool semantic_step = !s.labelled_views.empty() && c.semantic_interval > 0 &&
                              c.lambda_semantic > 0 && it % c.semantic_interval == 0;
   // The views of one draw: a training view, on semantic steps also a labelled one.
   auto drawViews = [&](int draw, std::vector<int>* views) {
-    const int tv = pickView(s.train_views, c.seed, 1, it * batch + draw);
+    const int tv = pickView(s.train_views, c.seed, RandomPurpose::kTrainingView, it * batch + draw);
     views->push_back(tv);
     if (semantic_step) {
-      const int lv =
-          pickView(s.labelled_views, c.seed, 2, (it / c.semantic_interval) * batch + draw);
+      const int lv = pickView(s.labelled_views, c.seed, RandomPurpose::kLabelledView,
+                              (it / c.semantic_interval) * batch + draw);
       if (lv != tv) views->push_back(lv);
     }
   };

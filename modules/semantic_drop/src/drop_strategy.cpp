@@ -23,7 +23,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         lambda_l0_from_(c.lambda_l0_from),
         lambda_l0_ramp_(c.lambda_l0_ramp),
         seed_(c.seed),
-        balanced_(c.drop_rule == "balanced"),
+        balanced_(gaussians::balancedDropRule(c)),
         closed_gate_gradients_(c.closed_gate_gradients),
         hc_(hc) {}
 
@@ -37,8 +37,9 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
     // Counter-based noise on the parameters' device: nothing drawn on the host and copied.
-    return sampleCounterGate(log_alpha, seed_, 13, static_cast<std::uint64_t>(iteration), hc_,
-                             closed_gate_gradients_);
+    return sampleCounterGate(log_alpha, seed_,
+                             gaussians::purposeKey(gaussians::RandomPurpose::kGateNoise),
+                             static_cast<std::uint64_t>(iteration), hc_, closed_gate_gradients_);
   }
 
   at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
@@ -87,7 +88,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
     if (semantic_) p_drop = p_drop * (1 - confidence);
     if (structure_) p_drop = p_drop * (1 - p_nonzero);
     p_drop = p_drop.clamp(0, 1);
-    at::Generator gen = gaussians::seededGenerator(seed_, 17, static_cast<std::uint64_t>(done));
+    at::Generator gen = gaussians::seededGenerator(seed_, gaussians::RandomPurpose::kDropSample,
+                                                   static_cast<std::uint64_t>(done));
     const at::Tensor u =
         at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
             .uniform_(0, 1, gen)
@@ -102,8 +104,8 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         const at::Tensor drawn = removed_now.nonzero().squeeze(1);
         const at::Tensor order =
             std::get<1>(p_drop.index_select(0, drawn).sort(/*stable=*/true, 0, true));
-        const at::Tensor spared = drawn.index_select(0, order.narrow(0, in.max_removed,
-                                                                     n - in.max_removed));
+        const at::Tensor spared =
+            drawn.index_select(0, order.narrow(0, in.max_removed, n - in.max_removed));
         d.keep.index_fill_(0, spared, true);
       }
     }
@@ -135,9 +137,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
 }  // namespace
 
 double scheduledL0Weight(double lambda, int from, int ramp, int iteration) {
-  if (iteration < from) return 0;
-  if (ramp <= 0) return lambda;
-  return lambda * std::min(1.0, static_cast<double>(iteration - from + 1) / ramp);
+  return lambda * gaussians::l0Ramp(from, ramp, iteration);
 }
 
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,

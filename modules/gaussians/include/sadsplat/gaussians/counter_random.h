@@ -18,6 +18,29 @@ namespace gaussians {
 /// seeded shuffles and generators are keyed by it too).
 std::uint64_t mixBits(std::uint64_t x);
 
+/// \brief The trainer's random streams. Each draw is keyed by (seed, purpose, iteration), so that
+/// a resumed run draws what an uninterrupted one does and no two streams repeat each other. The
+/// values are part of every trained model: changing one changes the results.
+enum class RandomPurpose : std::uint64_t {
+  kTrainingView = 1,       ///< the training view of a step (a seeded shuffle per epoch)
+  kLabelledView = 2,       ///< the labelled view of a semantic step
+  kDecoderInit = 3,        ///< the semantic decoder's initial weights
+  kDensifySplit = 7,       ///< the samples of 3DGS's split
+  kLargeSplit = 11,        ///< the samples of the split of large Gaussians
+  kGateNoise = 13,         ///< the Hard Concrete gates' noise in training renders
+  kDropSample = 17,        ///< the drop event's draw against P_drop
+  kScaleLimitSplit = 101,  ///< the splits at the scale limit: round r draws as 101 + r (r < 8)
+};
+
+/// \brief The number a purpose keys its draws with.
+inline std::uint64_t purposeKey(RandomPurpose purpose) {
+  return static_cast<std::uint64_t>(purpose);
+}
+
+/// \brief A CPU generator determined by (seed, purpose, iteration): the trainer's randomness
+/// drawn with LibTorch's generators.
+at::Generator seededGenerator(std::uint64_t seed, RandomPurpose purpose, std::uint64_t iteration);
+
 /// \brief The key of the draw (seed, purpose, iteration): counterUniform's element i is
 /// counterUniformAt(counterKey(seed, purpose, iteration), i) (counter_hash.h).
 CounterKey counterKey(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration);

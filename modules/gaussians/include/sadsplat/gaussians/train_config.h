@@ -165,6 +165,15 @@ struct DropOptions {
   bool closed_gate_gradients = false;
 };
 
+/// \brief The factor of the L0 schedule in (0-based) `iteration`: 0 before `from`, then rising
+/// linearly to 1 over `ramp` iterations (ramp 0: 1 at once). The L0 weight of the paper's rule
+/// and the L0 force of the balanced rule both follow it (DropOptions::lambda_l0_from / _ramp).
+double l0Ramp(int from, int ramp, int iteration);
+
+/// \brief Whether `options` ask for the balanced drop rule (drop_rule "balanced"), not the
+/// paper's.
+bool balancedDropRule(const DropOptions& options);
+
 /// \brief Every training parameter, with the defaults of the paper / 3DGS, in groups that the
 /// trainer's parts receive alone (the densification its DensificationOptions, the drop its
 /// DropOptions). Each field is listed once more, in the option table (train_options.h), which

@@ -26,10 +26,6 @@
 namespace sadsplat {
 namespace gaussians {
 
-/// \brief A CPU generator determined by (seed, purpose, iteration): the trainer's randomness, so
-/// that a resumed run draws the same numbers as an uninterrupted one.
-at::Generator seededGenerator(std::uint64_t seed, std::uint64_t purpose, std::uint64_t iteration);
-
 /// \brief Numbers reported after each step.
 struct StepStats {
   int iteration = 0;

@@ -6,7 +6,8 @@
 
 #include <memory>
 
-#include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/gaussians/drop_strategy.h"
+#include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/semantic_drop/hard_concrete.h"
 
 namespace sadsplat {
