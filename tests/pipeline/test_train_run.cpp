@@ -33,6 +33,9 @@ struct Case {
   bool run_to_end;  // the default and long schedules stop before their first step here
 };
 
+// ctest lists a parameter by this (not by its bytes).
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 class ScheduleAgreement : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ScheduleAgreement, PrintedRecordedAndRunScheduleAreOne) {
