@@ -21,7 +21,7 @@ namespace {
 using gaussians::raster::CameraParams;
 using gaussians::raster::CpuTileLoops;
 
-CameraParams frontCamera(int width, int height, double f) {
+CameraParams frontCameraParams(int width, int height, double f) {
   CameraParams c;
   c.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   c.fx = c.fy = f;
@@ -83,7 +83,7 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
                       std::uint64_t seed, bool needles = false, double closed_share = 0) {
   SCOPED_TRACE(testing::Message() << width << "x" << height << ", " << n << " Gaussians, D " << D
                                   << ", opacity up to " << opacity << ", closed " << closed_share);
-  const CameraParams cam = frontCamera(width, height, 0.9 * width);
+  const CameraParams cam = frontCameraParams(width, height, 0.9 * width);
   Scene s = projectedScene(n, D, cam, seed, opacity, needles);
   if (closed_share > 0) {
     s.opacities = at::where(at::rand({n}) < closed_share, -s.opacities, s.opacities);
@@ -129,7 +129,7 @@ void expectPathsAgree(int width, int height, int n, int D, double opacity, doubl
 
 // kFastest is one of the loops above, so it renders as they do.
 TEST(RasterCpuPaths, FastestIsBitIdenticalToTheScalarLoops) {
-  const CameraParams cam = frontCamera(48, 40, 0.9 * 48);
+  const CameraParams cam = frontCameraParams(48, 40, 0.9 * 48);
   const Scene s = projectedScene(1500, 3, cam, 11, 0.95);
   using gaussians::raster::rasterizeForwardCpu;
   const auto fast = rasterizeForwardCpu(s.means2d, s.conics, s.opacities, s.values, s.radii,
@@ -211,7 +211,7 @@ TEST(RasterCpuPaths, ClosedGatesAreBitIdentical) {
 // Gaussians than one binning run.
 TEST(RasterCpuPaths, TileListsAreInDepthThenIdOrderWithAnyThreadCount) {
   const int width = 70, height = 50;
-  const CameraParams cam = frontCamera(width, height, 60.0);
+  const CameraParams cam = frontCameraParams(width, height, 60.0);
   Scene s = projectedScene(9000, 3, cam, 21, 0.9);
   s.depths = at::round(s.depths * 4) / 4;
   // Reference: per tile, the ids that meet it (in id order), stable-sorted by depth.
