@@ -9,6 +9,21 @@
 
 namespace sadsplat {
 namespace pipeline {
+namespace {
+
+// The train log's record of an event of step `s`: its type, the iteration, the Gaussians after it
+// and how many it removed.
+io::TrainLogRecord eventRecord(const char* type, const gaussians::StepStats& s, long long removed) {
+  io::TrainLogRecord r;
+  r.type = type;
+  r.iteration = s.iteration;
+  r.removed = removed;
+  r.gaussians = s.num_gaussians;
+  return r;
+}
+
+}  // namespace
+
 std::string formatSeconds(double s) {
   std::ostringstream out;
   const int total = static_cast<int>(std::round(s));
@@ -71,31 +86,17 @@ void TrainingReport::stepped(const gaussians::StepStats& stats,
 void TrainingReport::log(const gaussians::StepStats& s, double seconds, bool last) {
   if (!log_) return;
   if (s.dropped > 0) {
-    io::TrainLogRecord r;
-    r.type = "drop";
-    r.iteration = s.iteration;
-    r.removed = s.dropped;
-    r.gaussians = s.num_gaussians;
+    io::TrainLogRecord r = eventRecord("drop", s, s.dropped);
     r.low_confidence = s.drop.removed_low_confidence;
     r.unseen = s.drop.removed_unseen;
     r.closed_gate = s.drop.removed_closed_gate;
     log_->append(r);
   }
-  if (s.removed_closed_gates > 0) {
-    io::TrainLogRecord r;
-    r.type = "closed_gates";
-    r.iteration = s.iteration;
-    r.removed = s.removed_closed_gates;
-    r.gaussians = s.num_gaussians;
-    log_->append(r);
-  }
+  if (s.removed_closed_gates > 0)
+    log_->append(eventRecord("closed_gates", s, s.removed_closed_gates));
   if (s.recovery_started) {
-    io::TrainLogRecord r;
-    r.type = "recovery";
-    r.iteration = s.iteration;
-    r.removed = s.recovery_closed_gates + s.recovery_pruned;
+    io::TrainLogRecord r = eventRecord("recovery", s, s.recovery_closed_gates + s.recovery_pruned);
     r.closed_gate = s.recovery_closed_gates;
-    r.gaussians = s.num_gaussians;
     log_->append(r);
   }
   if (s.losses_read && (s.iteration % kLossInterval == 0 || last)) {
@@ -117,13 +118,7 @@ void TrainingReport::events(const gaussians::StepStats& stats,
   // converged (a real survey reached 3 M Gaussians by iteration 6000 of the long schedule).
   if (!said_cap_ && stats.num_gaussians >= config.max_gaussians) {
     said_cap_ = true;
-    if (log_) {
-      io::TrainLogRecord r;
-      r.type = "max_gaussians_reached";
-      r.iteration = it;
-      r.gaussians = stats.num_gaussians;
-      log_->append(r);
-    }
+    if (log_) log_->append(eventRecord("max_gaussians_reached", stats, 0));
     if (progress_) {
       *progress_ << "\n[densify] iteration " << it << ": the model reached max_gaussians ("
                  << config.max_gaussians << "); densification adds no more. "

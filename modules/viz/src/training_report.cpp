@@ -14,6 +14,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/train_log.h"
 #include "sadsplat/viz/chart_png.h"
 
@@ -38,12 +39,13 @@ RunFacts loadRun(const std::string& dir) {
   RunFacts r;
   r.dir = dir;
   r.name = shortName(dir);
-  const std::string log = (fs::path(dir) / "train_log.jsonl").string();
+  const io::RunDirectory files(dir);
+  const std::string log = files.trainLog();
   if (!io::isRegularFile(log)) {
     throw Error(log, "file", "the train log that `sadsplat train` writes", "missing");
   }
   r.log = io::readTrainLog(log);
-  const std::string metrics = (fs::path(dir) / "metrics.json").string();
+  const std::string metrics = files.metrics();
   if (io::isRegularFile(metrics)) {
     r.metrics = parseOrDiscard(io::readWholeFile(metrics));
     if (r.metrics.is_discarded() || !r.metrics.is_object()) {
@@ -113,8 +115,8 @@ std::string writeTrainingReport(const ReportOptions& options) {
     }
   }
   if (total.x.empty()) {
-    throw Error((fs::path(run.dir) / "train_log.jsonl").string(), "records",
-                "at least one step record", "none");
+    throw Error(io::RunDirectory(run.dir).trainLog(), "records", "at least one step record",
+                "none");
   }
   std::vector<ChartSeries> loss_series = {total, rgb, sem, rest};
   std::vector<ChartSeries> count_series = {count, drops};
@@ -222,7 +224,7 @@ std::string writeTrainingReport(const ReportOptions& options) {
   }
   if (events == 0) md << "No drop events (a run without the semantic-aware drop).\n";
   if (have_iou) md << "\n## IoU per class\n\n![IoU per class](per_class_iou.png)\n";
-  const fs::path panels = fs::path(run.dir) / "panels";
+  const fs::path panels = io::RunDirectory(run.dir).panels();
   if (io::isDirectory(panels.string())) {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(panels)) {

@@ -70,7 +70,9 @@ ViewModel loadViewModel(const std::string& path) {
   } else if (!io::pathExists(path)) {
     throw Error(path, "model", "a run directory, or a .ply / .pcd cloud", "no such file");
   }
-  const std::string beside = (fs::path(model).parent_path() / "classes.json").string();
+  // classes.json beside the model: in its run directory, or beside a copied model.
+  const fs::path folder = fs::path(model).parent_path();
+  const std::string beside = io::RunDirectory(folder.empty() ? "." : folder.string()).classes();
   if (io::isRegularFile(beside)) classes_json = beside;
   m.name = shortName(path);
   if (io::cloudKind(model) == io::CloudKind::kSemantic) {
