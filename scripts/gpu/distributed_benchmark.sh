@@ -8,8 +8,13 @@
 #                  arithmetic as GPUS ranks: ITERATIONS / GPUS steps)
 #   xl_ranks       city-xl, GPUS NCCL ranks (--nproc GPUS --batch-schedule)
 #   city_1gpu, city_ranks   the same on the 70-view city (seed 0): the overhead at small scale
+#   xl_blocks      city-xl in BLOCKS (env, default 4) blocks one after another on GPU 0
+#                  (--blocks), each for ITERATIONS steps; then scripts/block_borders.py against
+#                  xl_1gpu on the views that straddle block borders
+#   xl_blocks_ranks  the same blocks shared by GPUS ranks (--blocks --nproc GPUS)
 # xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
-# Method: the full drop (--drop full), no pseudo-labels; 800x450 caches made here by synth.
+# Method: the full drop (--drop full), no pseudo-labels (PSEUDO=1: pseudo-labelled caches, as the
+# paper's full method); SIZE (env, default 800x450) caches made here by synth.
 # VIEWS (env, default 1): views per step and rank in the batched runs (global batch GPUS x VIEWS).
 # EXTRA_FLAGS (env) go to every training, e.g. --profile (then $OUT gets profile_<run>.md).
 # Output names carry the shape: xl_ranks4x2 (4 ranks x 2 views), xl_1gpu_batch8 (8 views a step).
@@ -27,8 +32,13 @@ mkdir -p "$work"
 summary="$out/summary.txt"
 echo "== $(date -u +%F) iterations $iterations, $gpus GPUs: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" | tee -a "$summary"
 
-xl=$(scene_cache city-xl)
-city=$(scene_cache city_0)
+wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
+xl=$(scene_cache city-xl "${SIZE:-800x450}")
+if [ "${PSEUDO:-0}" = 1 ]; then xl=$(pl_cache "$xl"); fi
+if [[ $wanted == *" city_"* ]]; then
+  city=$(scene_cache city_0 "${SIZE:-800x450}")
+  if [ "${PSEUDO:-0}" = 1 ]; then city=$(pl_cache "$city"); fi
+fi
 
 # Peak memory.used per GPU while a command runs (nvidia-smi, every 200 ms).
 peak_memory() {
@@ -50,15 +60,18 @@ run() {
   local gaussians; gaussians=$(tr '\r' '\n' < "$out/train_$name.log" | grep -o 'gaussians [0-9]*' | tail -1)
   CUDA_VISIBLE_DEVICES=${visible%%,*} "$bin" eval "$dir" > "$out/metrics_$name.json" 2> "$out/eval_$name.log" || true
   local miou psnr
-  miou=$(grep -o '"miou": *[0-9.]*' "$out/metrics_$name.json" | head -1 | grep -o '[0-9.]*$' || echo "?")
-  psnr=$(grep -o '"psnr": *[0-9.]*' "$out/metrics_$name.json" | head -1 | grep -o '[0-9.]*$' || echo "?")
+  # metrics.json's top-level keys (per_view also has a "psnr" per view).
+  read -r miou psnr merged < <(python3 -c 'import json, sys
+try: m = json.load(open(sys.argv[1])); print(m.get("miou"), m["psnr"], m["num_gaussians"])
+except Exception: print("? ? ?")' "$dir/metrics.json")
+  [ -f "$dir/blocks.json" ] && gaussians="gaussians $merged (merged)"
   echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
+  if [ -f "$dir/blocks.json" ]; then cp "$dir/blocks.json" "$out/blocks_$name.json"; fi
 }
 
 views=${VIEWS:-1}
 batch=$(( gpus * views ))
 half=$(( iterations / batch ))
-wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
 all_gpus=$(seq -s, 0 $(( gpus - 1 )))
 if [ "${PAIR:-0}" = 1 ] && [[ $wanted == *" xl_1gpu "* && $wanted == *" xl_1gpu_batch "* ]]; then
   run xl_1gpu "$xl" 0 --iterations "$iterations" &
@@ -71,4 +84,10 @@ fi
 [[ $wanted == *" xl_ranks "* ]] && run "xl_ranks${gpus}x$views" "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 [[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
 [[ $wanted == *" city_ranks "* ]] && run "city_ranks${gpus}x$views" "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
+blocks=${BLOCKS:-4}
+[[ $wanted == *" xl_blocks "* ]] && run "xl_blocks$blocks" "$xl" 0 --iterations "$iterations" --blocks "$blocks"
+[[ $wanted == *" xl_blocks_ranks "* ]] && run "xl_blocks${blocks}_ranks$gpus" "$xl" "$all_gpus" --iterations "$iterations" --blocks "$blocks" --nproc "$gpus"
+if [[ $wanted == *" xl_blocks "* ]]; then
+  python3 scripts/block_borders.py "$work/xl_blocks$blocks" "$work/xl_1gpu" 2>&1 | tee -a "$summary" || true
+fi
 echo "(batch runs take $half steps of $batch views)" >> "$summary"

@@ -1,5 +1,6 @@
 // `sadsplat train SCENE --out RUN`: train semantic Gaussians. The training flags come from the
 // option table (gaussians/train_options.h); a --config JSON file is applied first, flags on top.
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -18,6 +19,7 @@
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/train_options.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/pipeline/block_run.h"
 #include "sadsplat/pipeline/train_run.h"
 
 namespace sadsplat {
@@ -50,6 +52,25 @@ class TrainCommand : public Command {
                   "levels off; on real surveys it grows larger models than the default; keys you "
                   "set are kept)")
         ->check(CLI::IsMember({"paper", "long"}));
+    c->add_option("--blocks", blocks_,
+                  "train the scene in N blocks on its ground plane, one after another (or shared "
+                  "by the --nproc ranks), each on the views that see it, and merge them into one "
+                  "model (docs/GUIDE.md: surveys larger than your GPU)")
+        ->check(CLI::Range(1, 4096));
+    c->add_option("--block-overlap", block_options_.overlap,
+                  "with --blocks: a block's cell grown by this share of its size on each side")
+        ->check(CLI::Range(0.0, 1.0))
+        ->capture_default_str();
+    c->add_option("--block-view-share", block_options_.view_share,
+                  "with --blocks: a view trains a block when this share of the sparse points it "
+                  "sees lie in the block's grown cell (labelled views: "
+                  "--block-labelled-view-share)")
+        ->check(CLI::Range(0.001, 1.0))
+        ->capture_default_str();
+    c->add_option("--block-labelled-view-share", block_options_.labelled_view_share,
+                  "with --blocks: the same share for a labelled view")
+        ->check(CLI::Range(0.001, 1.0))
+        ->capture_default_str();
     c->add_flag("--profile", profile_,
                 "time each phase of the iterations (waits for the GPU at every phase boundary) "
                 "and count its ATen operator calls; writes RUN/profile.md and, operator by "
@@ -119,9 +140,9 @@ class TrainCommand : public Command {
     options.schedule.kind = gaussians::parseScheduleKind(schedule_);
     options.schedule.given = given;
     if (batch_schedule_) options.schedule.batch_ranks = rank_env ? rank_env->world_size : 1;
-    if (rank_env) {
+    if (rank_env && config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);
+    if (rank_env && blocks_ == 0) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
-      if (config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);
       options.collective = distributed::joinGroup(*rank_env, config.device);
     }
     options.scene = scene_;
@@ -133,6 +154,7 @@ class TrainCommand : public Command {
     options.progress = quiet_rank ? nullptr : &std::cout;
     options.stop = &g_stop;
     installStopHandlers();
+    if (blocks_ > 0) return trainInBlocks(options, config, rank_env, local_ranks);
     const double seconds = pipeline::trainRun(options, config);
     if (local_ranks) local_ranks->waitAll();
     if (!quiet_rank)
@@ -141,10 +163,38 @@ class TrainCommand : public Command {
   }
 
  private:
+  // --blocks: each rank trains its blocks on its own; rank 0 merges once all have finished.
+  int trainInBlocks(const pipeline::TrainRunOptions& options, const gaussians::TrainConfig& config,
+                    const std::optional<distributed::RankEnvironment>& rank_env,
+                    std::optional<distributed::LocalRanks>& local_ranks) {
+    if (batch_schedule_)
+      throw Error("<command line>", "--batch-schedule",
+                  "no --blocks (the global batch is data-parallel training's; a block trains on "
+                  "one rank)",
+                  "both");
+    pipeline::BlockRunOptions blocks;
+    blocks.partition = block_options_;
+    blocks.partition.blocks = blocks_;
+    blocks.rank = rank_env ? rank_env->rank : 0;
+    blocks.ranks = rank_env ? rank_env->world_size : 1;
+    blocks.wait_for_ranks = !local_ranks && blocks.ranks > 1;
+    const auto start = std::chrono::steady_clock::now();
+    pipeline::trainBlocks(options, config, blocks);
+    if (local_ranks) local_ranks->waitAll();
+    if (blocks.rank != 0) return 0;
+    pipeline::mergeBlocks(options, blocks);
+    std::cout << "trained in " << blocks_ << " blocks in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+              << " s; model in " << out_ << "/model.ply\n";
+    return 0;
+  }
+
   std::string scene_, out_, config_file_, schedule_ = "paper";
   double scale_ = 0.5;
   bool resume_ = false, profile_ = false, profile_host_ = false, batch_schedule_ = false;
   int nproc_ = 0;
+  int blocks_ = 0;
+  geo::BlockOptions block_options_;
   std::map<const gaussians::TrainOption*, CLI::Option*> flags_;
   std::map<const gaussians::TrainOption*, std::string> values_;
 };

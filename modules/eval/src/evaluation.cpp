@@ -170,7 +170,17 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     for (std::size_t i = 0; i < labels.size(); ++i) {
       if (view.mask.pixels[i] == 0) labels[i] = io::kIgnoreLabel;
     }
+    ViewScore score;
+    score.name = view.name;
+    score.accuracy = std::numeric_limits<double>::quiet_NaN();
     if (semantic && !view.labels.empty()) {
+      std::size_t right = 0, labelled = 0;
+      for (std::size_t i = 0; i < pixels; ++i) {
+        if (labels[i] == io::kIgnoreLabel) continue;
+        ++labelled;
+        right += labels[i] == pred8[i] ? 1 : 0;
+      }
+      if (labelled > 0) score.accuracy = static_cast<double>(right) / labelled;
       std::vector<std::int64_t> pred64(pred8.begin(), pred8.end());
       result.confusion.add(labels.data(), pred64.data(), labels.size());
       ++result.labelled_views;
@@ -182,7 +192,8 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                               .div(255.0)
                               .to(r.rgb.device());
     const at::Tensor rgb = r.rgb.clamp(0, 1);
-    psnr_sum += gaussians::psnr(rgb, gt);
+    score.psnr = gaussians::psnr(rgb, gt);
+    psnr_sum += score.psnr;
     {
       const at::Tensor inside = at::from_blob(const_cast<std::uint8_t*>(view.mask.pixels.data()),
                                               {H, W}, at::TensorOptions().dtype(at::kByte))
@@ -200,8 +211,10 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
         ++covered_views;
       }
     }
-    ssim_sum += gaussians::ssim(rgb, gt).item<double>();
+    score.ssim = gaussians::ssim(rgb, gt).item<double>();
+    ssim_sum += score.ssim;
     result.views.push_back(view.name);
+    result.per_view.push_back(score);
 #if SADSPLAT_HAVE_OPENCV
     if (!panel_dir.empty()) {
       const std::string stem = view.name.substr(0, view.name.find_last_of('.'));
@@ -230,6 +243,14 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
 
 std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& classes,
                         const RunFacts& facts) {
+  nlohmann::json perView = nlohmann::json::array();
+  for (const ViewScore& v : r.per_view) {
+    perView.push_back({{"name", v.name},
+                       {"psnr", v.psnr},
+                       {"ssim", v.ssim},
+                       {"accuracy", std::isnan(v.accuracy) ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(v.accuracy)}});
+  }
   nlohmann::json per_class = nlohmann::json::object();
   const auto iou = r.confusion.perClassIou();
   for (std::size_t c = 0; c < classes.size(); ++c) {
@@ -275,7 +296,8 @@ std::string metricsJson(const EvalResult& r, const std::vector<ClassInfo>& class
       {"device", facts.device},
       {"classes", names},
       {"confusion_matrix", matrix},
-      {"views", r.views}};
+      {"views", r.views},
+      {"per_view", perView}};
   return j.dump(2) + "\n";
 }
 

@@ -110,6 +110,10 @@ class DefaultDensification : public DensificationStrategy {
     requireRows(max_radii_, "max_radii", rows);
   }
 
+  std::vector<std::string> rowTensors() const override {
+    return {"grad_accum", "denom", "max_radii"};
+  }
+
  private:
   void densifyAndPrune(ParameterStore& params, const std::function<at::Tensor()>& effective_opacity,
                        bool prune_big, int iteration, const Resize& resize) {

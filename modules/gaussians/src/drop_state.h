@@ -112,6 +112,8 @@ class DropState {
   void save(TensorArchive& archive) const;
   void load(const TensorArchive& archive, const std::string& path, const at::Device& device);
   void checkRows(std::int64_t rows) const;
+  /// The archive names (save) of the per-row tensors.
+  std::vector<std::string> rowTensors() const { return {"confidence", "l0_weights"}; }
 
  private:
   DropOptions options_;

@@ -159,5 +159,14 @@ void ParameterStore::checkRows() const {
   }
 }
 
+std::vector<std::string> ParameterStore::rowTensors() const {
+  std::vector<std::string> names;
+  for (const Parameter& q : params_) {
+    if (!q.per_gaussian) continue;
+    names.insert(names.end(), {q.name, q.name + ".m", q.name + ".v"});
+  }
+  return names;
+}
+
 }  // namespace gaussians
 }  // namespace sadsplat

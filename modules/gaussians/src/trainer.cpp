@@ -543,9 +543,18 @@ void Trainer::saveCheckpoint(const std::string& path) const {
   writeTensorArchive(path, checkpointSnapshot());
 }
 
-void Trainer::loadCheckpoint(const std::string& path) {
+void Trainer::loadCheckpoint(const std::string& path) { loadCheckpoint(readTensorArchive(path), path); }
+
+std::vector<std::string> Trainer::checkpointRowTensors() const {
+  const State& s = *state_;
+  std::vector<std::string> names = s.params.rowTensors();
+  for (const auto& list : {s.drop.rowTensors(), s.densification->rowTensors()})
+    names.insert(names.end(), list.begin(), list.end());
+  return names;
+}
+
+void Trainer::loadCheckpoint(const TensorArchive& a, const std::string& path) {
   State& s = *state_;
-  const TensorArchive a = readTensorArchive(path);
   if (static_cast<int>(a.number("num_classes", path)) != s.num_classes) {
     throw Error(path, "num_classes", "the scene's class count " + std::to_string(s.num_classes),
                 std::to_string(static_cast<int>(a.number("num_classes", path))));

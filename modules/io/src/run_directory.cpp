@@ -11,6 +11,12 @@
 namespace sadsplat {
 namespace io {
 
+RunDirectory RunDirectory::block(int index) const {
+  std::string number = std::to_string(index);
+  number.insert(0, number.size() < 3 ? 3 - number.size() : 0, '0');
+  return RunDirectory(path_ + "/blocks/b" + number);
+}
+
 bool RunDirectory::isRun(const std::string& path) {
   const RunDirectory run(path);
   return isDirectory(path) && isRegularFile(run.runJson()) && isRegularFile(run.model());

@@ -180,7 +180,24 @@ TrainingInterrupted::TrainingInterrupted(const std::string& run, int iteration)
                 "; checkpoint written, continue with `sadsplat train ... --resume`"),
       iteration_(iteration) {}
 
-double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_in) {
+double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config) {
+  return trainRun(o, config, loadScene(o.scene, o.scale, o.progress));
+}
+
+void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
+                     const io::Scene& scene, const io::RunRecord& record) {
+  trainer.saveCheckpoint(dir.checkpoint());
+  dir.writeRecord(record);
+  writeModel(dir, trainer, scene.classes);
+  if (!scene.classes.empty()) io::writeClassesJson(dir.classes(), scene.classes);
+  if (scene.georeference) {
+    // The model's frame: east-north-up metres around the origin (for GIS outputs and viewers).
+    io::writeTextFileAtomically(dir.georeference(), io::georeferenceToJson(*scene.georeference));
+  }
+}
+
+double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_in,
+                const io::Scene& scene) {
   // Rank 0 of a data-parallel group (or a single process) writes the run; the ranks hold the
   // same Gaussians at every step.
   const bool writer = !o.collective || o.collective->rank() == 0;
@@ -189,7 +206,6 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   double previous_seconds = 0;
   gaussians::TrainConfig config = runConfiguration(
       o, gaussians::resolveSchedule(config_in, o.schedule), dir, &previous_seconds);
-  const io::Scene scene = loadScene(o.scene, o.scale, o.progress);
   gaussians::Trainer trainer(scene, config);
   config = trainer.config();  // what the loop counts, the log prints and config.json records
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
@@ -243,14 +259,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   report.finished(config, profile ? profileTables(*profile, *o.profile, config, dir, writer) : "");
   const double total = seconds();
   if (!writer) return total;
-  trainer.saveCheckpoint(dir.checkpoint());
-  dir.writeRecord(io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), total});
-  writeModel(dir, trainer, scene.classes);
-  if (!scene.classes.empty()) io::writeClassesJson(dir.classes(), scene.classes);
-  if (scene.georeference) {
-    // The model's frame: east-north-up metres around the origin (for GIS outputs and viewers).
-    io::writeTextFileAtomically(dir.georeference(), io::georeferenceToJson(*scene.georeference));
-  }
+  writeTrainedRun(dir, trainer, scene,
+                  io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), total});
   return total;
 }
 

@@ -28,6 +28,16 @@ FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& 
 /// \brief How many training views must see a pixel's surface for EvalResult::psnr_covered.
 constexpr int kCoveredMinViews = 2;
 
+/// \brief The scores of one evaluated view.
+struct ViewScore {
+  std::string name;
+  double psnr = 0;
+  double ssim = 0;
+  /// Share of its labelled pixels (inside the mask) whose predicted class is right; NaN for a
+  /// view without a label map or a model without classes.
+  double accuracy = 0;
+};
+
 /// \brief Everything measured on the test views.
 struct EvalResult {
   ConfusionMatrix confusion{1};
@@ -46,6 +56,7 @@ struct EvalResult {
   /// 3 renders per view after a warm-up, each waited for (on CUDA, includes one small copy).
   double render_ms = 0;
   std::vector<std::string> views;
+  std::vector<ViewScore> per_view;  ///< in the order of `views`
   FloaterCensus floaters;
   int labelled_views = 0;  ///< evaluated views with a label map (the confusion matrix's)
   bool held_out = false;   ///< the views are the scene's test views (else its training views)
@@ -70,7 +81,8 @@ struct RunFacts {
 };
 
 /// \brief metrics.json text: miou, macc, oacc, per_class_iou, psnr, ssim, num_gaussians,
-/// floaters, iterations, train_seconds, device, classes, confusion_matrix, views.
+/// floaters, iterations, train_seconds, device, classes, confusion_matrix, views, per_view
+/// (name, psnr, ssim, accuracy or null).
 std::string metricsJson(const EvalResult& result, const std::vector<ClassInfo>& classes,
                         const RunFacts& facts);
 

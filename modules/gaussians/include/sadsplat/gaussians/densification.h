@@ -57,6 +57,8 @@ class DensificationStrategy {
                     const at::Device& device) = 0;
   /// \brief Throws unless every statistic has `rows` rows.
   virtual void checkRows(std::int64_t rows) const = 0;
+  /// \brief The archive names (save) of the statistics with one row per Gaussian.
+  virtual std::vector<std::string> rowTensors() const = 0;
 };
 
 /// \brief The 3DGS strategy with its options (densify_* / percent_dense / min_opacity /

@@ -82,6 +82,8 @@ class ParameterStore {
   void load(const TensorArchive& archive, const std::string& path, const at::Device& device);
   /// \brief Throws unless every per-row tensor has `rows()` rows.
   void checkRows() const;
+  /// \brief The archive names (save) of the per-row tensors: values and moments.
+  std::vector<std::string> rowTensors() const;
 
  private:
   std::vector<Parameter> params_;

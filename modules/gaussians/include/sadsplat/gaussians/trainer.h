@@ -131,6 +131,12 @@ class Trainer {
   void saveCheckpoint(const std::string& path) const;
   /// \brief Restores a state written by saveCheckpoint (same scene and configuration).
   void loadCheckpoint(const std::string& path);
+  /// \brief Restores a state from an archive (as loadCheckpoint; `path` names it in errors).
+  void loadCheckpoint(const TensorArchive& archive, const std::string& path);
+  /// \brief The names of the checkpoint's tensors with one row per Gaussian (parameters and
+  /// their Adam moments, the drop's and the densification's statistics); the others are global
+  /// (the decoder, the drop's guard).
+  std::vector<std::string> checkpointRowTensors() const;
 
   /// \brief Render-ready parameters (for tests): activated views are not applied.
   GaussianParams parameters() const;

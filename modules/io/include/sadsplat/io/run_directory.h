@@ -8,6 +8,7 @@
 /// properties), model.pcd (the same Gaussians as PCD), model_semantic.pcd / model_semantic.ply
 /// (the plain semantic cloud: centre, class colour, class id), classes.json, georeference.json (a
 /// georeferenced scene's frame), train_log.jsonl, and after `eval` metrics.json and panels/.
+/// A run trained block by block also holds blocks.json and blocks/bNNN/, each a run directory.
 
 #include <string>
 
@@ -49,6 +50,10 @@ class RunDirectory {
   std::string panels() const { return file("panels"); }
   std::string profile() const { return file("profile.md"); }
   std::string profileOperators() const { return file("profile_operators.md"); }
+  /// \brief A block run's partition (geo::BlockPartition::toJson).
+  std::string blocksJson() const { return file("blocks.json"); }
+  /// \brief The run directory of block `index` of a block run (blocks/b000, ...).
+  RunDirectory block(int index) const;
 
   /// \brief Reads run.json (`scene` required unless `scene_required` is false; a missing scale,
   /// device or count keeps its default).

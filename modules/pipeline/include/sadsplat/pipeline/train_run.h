@@ -12,6 +12,8 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/io/run_directory.h"
+#include "sadsplat/io/scene.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -59,6 +61,16 @@ class TrainingInterrupted : public Error {
 /// \throws sadsplat::Error on bad input, a diverged training or no GPU memory;
 /// TrainingInterrupted when `stop` was set
 double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& config);
+
+/// \brief As trainRun, on a scene already in memory (options.scene is what run.json records).
+double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& config,
+                const io::Scene& scene);
+
+/// \brief Writes the files of a trained model into a run directory: checkpoint.bin, run.json
+/// (`record`), model.ply / model.pcd, with classes the semantic clouds and classes.json, and a
+/// georeferenced scene's georeference.json.
+void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
+                     const io::Scene& scene, const io::RunRecord& record);
 
 }  // namespace pipeline
 }  // namespace sadsplat

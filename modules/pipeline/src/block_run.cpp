@@ -1,0 +1,199 @@
+#include "sadsplat/pipeline/block_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/block_merge.h"
+#include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/run_directory.h"
+#include "sadsplat/pipeline/opened_run.h"
+#include "sadsplat/semantic_drop/drop_strategy.h"
+
+namespace sadsplat {
+namespace pipeline {
+namespace {
+
+// The scene and its partition, as every rank and the merge compute them.
+struct PartitionedScene {
+  io::Scene scene;
+  geo::BlockPartition partition;
+};
+
+PartitionedScene partitioned(const TrainRunOptions& o, const BlockRunOptions& b) {
+  PartitionedScene p;
+  p.scene = loadScene(o.scene, o.scale, o.progress);
+  p.partition = geo::partitionScene(p.scene, b.partition, o.scene);
+  return p;
+}
+
+// Whether a block's run directory holds its finished training.
+bool finished(const io::RunDirectory& dir, int iterations) {
+  return io::RunDirectory::isRun(dir.path()) && io::RunDirectory::hasCheckpoint(dir.path()) &&
+         dir.readRecord(false).iterations >= iterations;
+}
+
+void sayBlock(std::ostream* out, const geo::Block& block, const geo::BlockPartition& p,
+              const io::Scene& scene, const std::string& what) {
+  if (out == nullptr) return;
+  *out << "block " << block.index + 1 << "/" << p.blocks.size() << " (row " << block.row
+       << ", column " << block.column << "): " << block.views.size() << " views ("
+       << block.labelledViews(scene) << " labelled), " << block.points.size()
+       << " sparse points: " << what << "\n";
+  if (scene.classes.empty() || (what != "training" && what != "resuming")) return;
+  const bool supervised = std::any_of(block.views.begin(), block.views.end(), [&](int v) {
+    return scene.views[v].labelled || !scene.views[v].pseudo.empty();
+  });
+  if (!supervised) {
+    *out << "  warning: no labelled or pseudo-labelled view trains this block: its Gaussians' "
+            "classes stay untrained (run `sadsplat pseudo-labels` on the scene, or label a view "
+            "that sees it)\n";
+  }
+}
+
+// The block whose decoder the merged model keeps: the most labelled views, then the most views.
+int referenceBlock(const geo::BlockPartition& p, const io::Scene& scene,
+                   const std::vector<int>& trained) {
+  int best = trained.front();
+  for (int b : trained) {
+    const auto key = [&](int i) {
+      return std::make_pair(p.blocks[i].labelledViews(scene), p.blocks[i].views.size());
+    };
+    if (key(b) > key(best)) best = b;
+  }
+  return best;
+}
+
+// Polls the other ranks' block directories until each has finished (torchrun stops every rank
+// when one fails, so this does not outlive a failed rank).
+void waitForOtherRanks(const TrainRunOptions& o, const PartitionedScene& ps, int iterations,
+                       const BlockRunOptions& b) {
+  const io::RunDirectory dir(o.out);
+  bool said = false;
+  for (;;) {
+    std::vector<int> waiting;
+    for (const geo::Block& block : ps.partition.blocks) {
+      if (block.index % b.ranks == b.rank || block.views.empty()) continue;
+      if (!finished(dir.block(block.index), iterations)) waiting.push_back(block.index + 1);
+    }
+    if (waiting.empty()) return;
+    if (!said && o.progress) {
+      *o.progress << "waiting for the other ranks' " << waiting.size() << " blocks\n";
+      said = true;
+    }
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+  }
+}
+
+}  // namespace
+
+double trainBlocks(const TrainRunOptions& o, const gaussians::TrainConfig& config,
+                   const BlockRunOptions& b) {
+  if (b.ranks < 1 || b.rank < 0 || b.rank >= b.ranks)
+    throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(b.rank));
+  const io::RunDirectory dir(o.out);
+  const PartitionedScene ps = partitioned(o, b);
+  if (b.rank == 0) {
+    io::makeDirectory(o.out);
+    io::writeTextFileAtomically(dir.blocksJson(), ps.partition.toJson(ps.scene));
+  }
+  const int iterations = gaussians::resolveSchedule(config, o.schedule).config.iterations;
+  double seconds = 0;
+  for (const geo::Block& block : ps.partition.blocks) {
+    if (block.index % b.ranks != b.rank) continue;
+    const io::RunDirectory block_dir = dir.block(block.index);
+    if (block.views.empty()) {
+      sayBlock(o.progress, block, ps.partition, ps.scene, "no view sees it, skipped");
+      continue;
+    }
+    if (finished(block_dir, iterations)) {
+      sayBlock(o.progress, block, ps.partition, ps.scene, "finished before, kept");
+      continue;
+    }
+    TrainRunOptions block_options = o;
+    block_options.out = block_dir.path();
+    block_options.collective = nullptr;
+    block_options.resume = o.resume && io::RunDirectory::hasCheckpoint(block_dir.path());
+    sayBlock(o.progress, block, ps.partition, ps.scene,
+             block_options.resume ? "resuming" : "training");
+    seconds += trainRun(block_options, config, geo::blockScene(ps.scene, block));
+  }
+  if (b.rank == 0 && b.wait_for_ranks) waitForOtherRanks(o, ps, iterations, b);
+  return seconds;
+}
+
+void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
+  const io::RunDirectory dir(o.out);
+  const PartitionedScene ps = partitioned(o, b);
+  const std::string expected = ps.partition.toJson(ps.scene);
+  if (!io::pathExists(dir.blocksJson()) || io::readWholeFile(dir.blocksJson()) != expected)
+    throw Error(dir.blocksJson(), "partition",
+                "the partition of this scene with these block options (train it with them)",
+                io::pathExists(dir.blocksJson()) ? "another one" : "no file");
+  // The blocks: each finished (its checkpoint at its configuration's iterations).
+  std::vector<int> trained;
+  double seconds = 0;
+  for (const geo::Block& block : ps.partition.blocks) {
+    if (block.views.empty()) continue;
+    const io::RunDirectory block_dir = dir.block(block.index);
+    if (!io::RunDirectory::hasCheckpoint(block_dir.path()))
+      throw Error(block_dir.path(), "checkpoint.bin", "a trained block", "missing");
+    const auto block_config = gaussians::TrainConfig::fromJson(
+        io::readWholeFile(block_dir.config()), block_dir.config());
+    const io::RunRecord record = block_dir.readRecord(false);
+    if (record.iterations < block_config.iterations || !io::RunDirectory::isRun(block_dir.path()))
+      throw Error(block_dir.runJson(), "iterations",
+                  std::to_string(block_config.iterations) + " (a finished block)",
+                  std::to_string(record.iterations));
+    trained.push_back(block.index);
+    seconds += record.train_seconds;
+  }
+  if (trained.empty()) throw Error(o.out, "blocks", "at least one trained block", "none");
+  const int reference = referenceBlock(ps.partition, ps.scene, trained);
+  const io::RunDirectory reference_dir = dir.block(reference);
+  const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
+      io::readWholeFile(reference_dir.config()), reference_dir.config());
+  // The merged model lives in a trainer over one view of the reference block: the writers
+  // need a trainer, not the scene's every view on the device.
+  io::Scene carrier = geo::blockScene(ps.scene, ps.partition.blocks[reference]);
+  carrier.views.resize(1);
+  carrier.points = ps.scene.points;
+  gaussians::Trainer trainer(carrier, config);
+  trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
+  std::vector<gaussians::BlockCheckpoint> parts;
+  int reference_part = 0;
+  std::int64_t total = 0;
+  for (int index : trained) {
+    gaussians::BlockCheckpoint part;
+    part.origin = dir.block(index).checkpoint();
+    part.archive = gaussians::readTensorArchive(part.origin);
+    const at::Tensor means = part.archive.tensor("means", part.origin).to(at::kFloat).contiguous();
+    const std::vector<int> cells =
+        ps.partition.blocksOf(means.data_ptr<float>(), static_cast<std::size_t>(means.size(0)));
+    at::Tensor keep = at::empty({means.size(0)}, at::kBool);
+    bool* k = keep.data_ptr<bool>();
+    for (std::size_t i = 0; i < cells.size(); ++i) k[i] = cells[i] == index;
+    total += means.size(0);
+    if (index == reference) reference_part = static_cast<int>(parts.size());
+    part.keep = keep;
+    parts.push_back(std::move(part));
+  }
+  trainer.loadCheckpoint(
+      gaussians::mergeBlockCheckpoints(parts, trainer.checkpointRowTensors(), reference_part),
+      dir.checkpoint());
+  io::makeDirectory(o.out);
+  io::writeTextFileAtomically(dir.config(), trainer.config().toJson());
+  writeTrainedRun(dir, trainer, ps.scene,
+                  io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), seconds});
+  if (o.progress) {
+    *o.progress << "merged " << trained.size() << " blocks: " << trainer.numGaussians()
+                << " Gaussians (of " << total << " in the blocks, each keeping its cell's), the "
+                << "decoder of block " << reference + 1 << "; " << seconds
+                << " s of training in all\n";
+  }
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat

@@ -1,0 +1,137 @@
+// `sadsplat train --blocks`: the scene trained block by block and merged into one run that holds
+// each block's Gaussians of its own cell once, evaluates like any run, resumes by keeping the
+// finished blocks, and trains its blocks on two Gloo ranks as in one process.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/geo/block_partition.h"
+#include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/scene_cache.h"
+#include "sadsplat/pipeline/block_run.h"
+#include "test_support/test_support.h"
+
+namespace sadsplat {
+namespace {
+
+using test::kCli;
+using test::kTinySceneCache;
+
+// Gaussians of `ply` per cell of the partition.
+std::vector<int> perCell(const geo::BlockPartition& p, const std::string& ply) {
+  std::vector<int> n(p.blocks.size(), 0);
+  for (const auto& g : io::readGaussianPly(ply)) ++n[p.blockOf({g.x, g.y, g.z})];
+  return n;
+}
+
+const std::string kTrain = " train " + kTinySceneCache + " --iterations 30";
+const std::string kBlockRun = kTrain + " --blocks 2";
+
+TEST(BlockRun, TheMergedModelHoldsEachBlocksOwnCellOnceAndResumes) {
+  test::TempDir dir;
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --out " + dir.file("run"), &out), 0) << out;
+  EXPECT_NE(out.find("block 2/2"), std::string::npos) << out;
+  geo::BlockOptions options;
+  options.blocks = 2;
+  const io::Scene scene = io::readSceneCache(kTinySceneCache);
+  const geo::BlockPartition p = geo::partitionScene(scene, options, kTinySceneCache);
+  ASSERT_EQ(p.blocks.size(), 2u);
+  const auto recorded = nlohmann::json::parse(test::readFile(dir.file("run/blocks.json")));
+  ASSERT_EQ(recorded["blocks"].size(), 2u);
+  const std::vector<int> merged = perCell(p, dir.file("run/model.ply"));
+  int total = 0;
+  for (const geo::Block& b : p.blocks) {
+    ASSERT_FALSE(b.views.empty());
+    EXPECT_EQ(recorded["blocks"][b.index]["views"].size(), b.views.size());
+    const std::string block_model = dir.file("run/blocks/b00" + std::to_string(b.index)) +
+                                    "/model.ply";
+    const std::vector<int> own = perCell(p, block_model);
+    // The merge keeps exactly the block's Gaussians inside its cell, and it had others outside.
+    EXPECT_EQ(merged[b.index], own[b.index]) << b.index;
+    EXPECT_GT(static_cast<int>(io::readGaussianPly(block_model).size()), own[b.index]);
+    EXPECT_GT(own[b.index], 0);
+    total += own[b.index];
+  }
+  EXPECT_EQ(static_cast<int>(io::readGaussianPly(dir.file("run/model.ply")).size()), total);
+  // Resuming keeps the finished blocks and merges them into the same model.
+  const std::string model = test::readFile(dir.file("run/model.ply"));
+  ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --resume --out " + dir.file("run"), &out), 0)
+      << out;
+  EXPECT_NE(out.find("finished before, kept"), std::string::npos) << out;
+  EXPECT_EQ(out.find("): training"), std::string::npos) << out;
+  EXPECT_EQ(test::readFile(dir.file("run/model.ply")), model);
+}
+
+TEST(BlockRun, TheMergedRunEvaluatesEveryTestViewAsWellAsOneRun) {
+  test::TempDir dir;
+  std::string out;
+  const std::string longer = " train " + kTinySceneCache + " --iterations 200";
+  ASSERT_EQ(test::runCommand(kCli + longer + " --blocks 2 --out " + dir.file("blocks"), &out), 0)
+      << out;
+  ASSERT_EQ(test::runCommand(kCli + longer + " --out " + dir.file("one"), &out), 0) << out;
+  for (const char* run : {"blocks", "one"})
+    ASSERT_EQ(test::runCommand(kCli + " eval " + dir.file(run), &out), 0) << out;
+  const auto blocks = nlohmann::json::parse(test::readFile(dir.file("blocks/metrics.json")));
+  const auto one = nlohmann::json::parse(test::readFile(dir.file("one/metrics.json")));
+  int test_views = 0;
+  for (const io::View& v : io::readSceneCache(kTinySceneCache).views) test_views += v.test;
+  EXPECT_EQ(static_cast<int>(blocks["views"].size()), test_views);
+  // Per view: the scores whose mean is the run's.
+  ASSERT_EQ(blocks["per_view"].size(), blocks["views"].size());
+  double psnr_sum = 0;
+  for (const auto& v : blocks["per_view"]) {
+    psnr_sum += v["psnr"].get<double>();
+    EXPECT_GE(v["accuracy"].get<double>(), 0.0);
+    EXPECT_LE(v["accuracy"].get<double>(), 1.0);
+  }
+  EXPECT_NEAR(psnr_sum / blocks["per_view"].size(), blocks["psnr"].get<double>(), 1e-9);
+  // Measured (CPU, 2026-11-29): 6.67 dB / 67.3 % mIoU against one run's 6.85 dB / 74.8 %, and
+  // 4.0 dB for either after 30 iterations (the tiny scene's 64 x 48 views are hard to fit).
+  EXPECT_GT(blocks["psnr"].get<double>(), one["psnr"].get<double>() - 1.0);
+  EXPECT_GT(blocks["miou"].get<double>(), 0.5);
+}
+
+TEST(BlockRun, TwoGlooRanksTrainTheBlocksAsOneProcessDoes) {
+  if (!SADSPLAT_TEST_HAVE_GLOO) GTEST_SKIP() << "LibTorch without c10d Gloo";
+  test::TempDir dir;
+  std::string out;
+  ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --out " + dir.file("one"), &out), 0) << out;
+  ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --nproc 2 --out " + dir.file("two"), &out), 0)
+      << out;
+  // Each rank trained one block on its own, with the same data and seed: the same model.
+  const auto a = io::readGaussianPly(dir.file("one/model.ply"));
+  const auto b = io::readGaussianPly(dir.file("two/model.ply"));
+  ASSERT_EQ(a.size(), b.size());
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    d += std::abs(a[i].x - b[i].x) + std::abs(a[i].y - b[i].y) + std::abs(a[i].z - b[i].z);
+  EXPECT_LT(d / a.size(), 1e-4);
+}
+
+TEST(BlockRun, MismatchedOptionsAreClearErrors) {
+  test::TempDir dir;
+  std::string out;
+  EXPECT_EQ(test::runCommand(kCli + kBlockRun + " --batch-schedule --out " + dir.file("r"), &out),
+            1);
+  EXPECT_NE(out.find("--batch-schedule"), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --out " + dir.file("run"), &out), 0) << out;
+  pipeline::TrainRunOptions o;
+  o.scene = kTinySceneCache;
+  o.out = dir.file("run");
+  pipeline::BlockRunOptions b;
+  b.partition.blocks = 2;
+  b.partition.overlap = 0.5;  // not the partition the blocks were trained on
+  try {
+    pipeline::mergeBlocks(o, b);
+    FAIL() << "merged blocks of another partition";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("blocks.json"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace sadsplat
