@@ -12,6 +12,7 @@
 #                  (--blocks), each for ITERATIONS steps; then scripts/block_borders.py against
 #                  xl_1gpu on the views that straddle block borders
 #   xl_blocks_ranks  the same blocks shared by GPUS ranks (--blocks --nproc GPUS)
+#   xl_stream      as xl_1gpu with --stream-views (views in host memory, uploaded per step)
 # xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
 # Method: the full drop (--drop full), no pseudo-labels (PSEUDO=1: pseudo-labelled caches, as the
 # paper's full method); SIZE (env, default 800x450) caches made here by synth.
@@ -84,6 +85,7 @@ fi
 [[ $wanted == *" xl_ranks "* ]] && run "xl_ranks${gpus}x$views" "$xl" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 [[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
 [[ $wanted == *" city_ranks "* ]] && run "city_ranks${gpus}x$views" "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
+[[ $wanted == *" xl_stream "* ]] && run xl_1gpu_stream "$xl" 0 --iterations "$iterations" --stream-views
 blocks=${BLOCKS:-4}
 [[ $wanted == *" xl_blocks "* ]] && run "xl_blocks$blocks" "$xl" 0 --iterations "$iterations" --blocks "$blocks"
 [[ $wanted == *" xl_blocks_ranks "* ]] && run "xl_blocks${blocks}_ranks$gpus" "$xl" "$all_gpus" --iterations "$iterations" --blocks "$blocks" --nproc "$gpus"

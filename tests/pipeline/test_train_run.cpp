@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/train_log.h"
 #include "sadsplat/pipeline/train_run.h"
 #include "test_support/test_support.h"
@@ -113,6 +115,51 @@ TEST(ResolveSchedule, RulesApplyInOrderAndOnce) {
   EXPECT_EQ(gaussians::resolveSchedule(TrainConfig{}).config.scale_limit_from, 6000);
   EXPECT_TRUE(gaussians::resolveSchedule(TrainConfig{}).notes.empty());
   EXPECT_THROW(gaussians::parseScheduleKind("short"), Error);
+}
+
+}  // namespace
+}  // namespace sadsplat
+
+namespace sadsplat {
+namespace {
+
+// Streamed views (TrainConfig::stream_views: 8-bit host copies uploaded per step) train the
+// model that views held on the device train: bit for bit on the CPU; on a GPU to the rounding of
+// its backward's atomics (two held runs differ as much).
+void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
+  test::TempDir dir;
+  TrainConfig config;
+  config.iterations = 40;
+  config.device = device;
+  config.drop = "full";
+  config.drop_interval = 20;
+  config.checkpoint_interval = 0;
+  pipeline::TrainRunOptions o;
+  o.scene = kCache;
+  for (const bool streamed : {false, true}) {
+    config.stream_views = streamed;
+    o.out = dir.file(streamed ? "streamed" : "held");
+    pipeline::trainRun(o, config);
+  }
+  const std::string held = test::readFile(dir.file("held/model.ply"));
+  const std::string streamed = test::readFile(dir.file("streamed/model.ply"));
+  if (device == "cpu") {
+    EXPECT_TRUE(held == streamed) << "the same model, byte for byte";
+    return;
+  }
+  const auto a = io::readGaussianPly(dir.file("held/model.ply"));
+  const auto b = io::readGaussianPly(dir.file("streamed/model.ply"));
+  ASSERT_EQ(a.size(), b.size());
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d += std::abs(a[i].x - b[i].x) / a.size();
+  EXPECT_LT(d, 1e-4);
+}
+
+TEST(StreamedViews, TrainLikeHeldViewsOnTheCpu) { expectStreamedViewsTrainLikeHeldViews("cpu"); }
+
+TEST(StreamedViews, TrainLikeHeldViewsOnAGpu) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  expectStreamedViewsTrainLikeHeldViews("cuda");
 }
 
 }  // namespace

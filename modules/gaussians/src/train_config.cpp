@@ -154,6 +154,11 @@ const std::vector<TrainOption> kOptions = {
      nullptr, 4, kInf},
     {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
     {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
+    {"stream_views", &C::stream_views,
+     "keep the training views in host memory (8 bits) and upload each step's views when it "
+     "renders them: GPU memory for the model and a step's views instead of every view as floats "
+     "(the same values)",
+     "--stream-views"},
     {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1, kInf},
     {"prune_floaters", &C::prune_floaters,
      "after the last iteration remove Gaussians seen by fewer than floater_min_views training "

@@ -128,9 +128,10 @@ struct Trainer::State {
     at::Tensor sum;
     for (int v : probe) {
       const at::Tensor rgb = render(g, views.cameras[v], settings).rgb.clamp(0, 1);
-      const at::Tensor mask = views.masks[v].unsqueeze(2);
+      const DeviceView view = views.onDevice(v);
+      const at::Tensor mask = view.mask.unsqueeze(2);
       const at::Tensor mse =
-          ((rgb - views.images[v]).square() * mask).sum() / (3 * mask.sum()).clamp_min(1);
+          ((rgb - view.image).square() * mask).sum() / (3 * mask.sum()).clamp_min(1);
       sum = sum.defined() ? sum + mse : mse;
     }
     at::Tensor mean = (sum / static_cast<double>(probe.size())).reshape({1}).contiguous();
@@ -203,9 +204,10 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
   enterPhase(p, "losses forward");
   // Factors of exactly 1 (a full mask, unit weights) are left out: the same values, fewer
   // operations for the host to issue and for the autograd engine to run backwards.
-  const at::Tensor& gt = views.images[v];
+  const DeviceView view = views.onDevice(v);
+  const at::Tensor& gt = view.image;
   const bool masked = !views.mask_is_full[v];
-  const at::Tensor mask = masked ? views.masks[v].unsqueeze(2) : at::Tensor();
+  const at::Tensor mask = masked ? view.mask.unsqueeze(2) : at::Tensor();
   const auto masking = [&](const at::Tensor& image) { return masked ? image * mask : image; };
   // Unmasked with the fused SSIM: rgbLoss (on CUDA one autograd node; elsewhere this very
   // composition).
@@ -223,7 +225,7 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
     const at::Tensor& w = params["decoder_w"].value;
     const at::Tensor& b = params["decoder_b"].value;
     const auto loss_of = c.fused_semantic_loss ? semanticLoss : semanticLossReference;
-    const at::Tensor& labels = views.labels[v];
+    const at::Tensor& labels = view.labels;
     const at::Tensor sem = role.decoder_learns
                                ? loss_of(r.features, labels, w, b)
                                : loss_of(r.features, labels, w.detach(), b.detach());

@@ -18,6 +18,16 @@ std::vector<int> TrainingViews::guardProbeViews() const {
   return probe;
 }
 
+DeviceView TrainingViews::onDevice(int v) const {
+  if (!streamed) return {images[v], masks[v], labels[v]};
+  // The conversions of loadTrainingViews, on the device: the same values.
+  DeviceView d;
+  d.image = images[v].to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
+  d.mask = masks[v].to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
+  if (labels[v].defined()) d.labels = labels[v].to(device, /*non_blocking=*/true).to(at::kLong);
+  return d;
+}
+
 std::vector<RasterCamera> TrainingViews::trainingCameras() const {
   std::vector<RasterCamera> training;
   for (int v : train_views) training.push_back(cameras[v]);
@@ -84,6 +94,12 @@ StepViews drawStepViews(const TrainingViews& s, const TrainConfig& c, int it, in
 TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& config,
                                 const at::Device& device) {
   TrainingViews s;
+  s.streamed = config.stream_views;
+  s.device = device;
+  // A host copy the device can read asynchronously: page-locked for a CUDA device.
+  const auto host = [&](const at::Tensor& t) {
+    return device.is_cuda() ? t.pin_memory() : t.clone();
+  };
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
     const io::View& v = scene.views[i];
     s.cameras.push_back(RasterCamera::fromPinhole(v.camera));
@@ -97,16 +113,13 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
       continue;
     }
     const int H = v.camera.height, W = v.camera.width;
-    at::Tensor rgb = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()), {H, W, 3},
-                                   at::TensorOptions().dtype(at::kByte))
-                         .to(at::kFloat)
-                         .div(255.0);
-    at::Tensor mask = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()), {H, W},
-                                    at::TensorOptions().dtype(at::kByte))
-                          .to(at::kFloat)
-                          .div(255.0);
-    s.images.push_back(rgb.to(device));
-    s.masks.push_back(mask.to(device));
+    const at::Tensor rgb8 = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
+                                          {H, W, 3}, at::TensorOptions().dtype(at::kByte));
+    const at::Tensor mask8 = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()),
+                                           {H, W}, at::TensorOptions().dtype(at::kByte));
+    const at::Tensor mask = mask8.to(at::kFloat).div(255.0);
+    s.images.push_back(s.streamed ? host(rgb8) : rgb8.to(at::kFloat).div(255.0).to(device));
+    s.masks.push_back(s.streamed ? host(mask8) : mask.to(device));
     s.mask_is_full.push_back(std::all_of(v.mask.pixels.begin(), v.mask.pixels.end(),
                                          [](std::uint8_t m) { return m == 255; }));
     // Semantic supervision (ground truth wins, then kept pseudo-labels) and the confidence map
@@ -116,8 +129,8 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
     const std::vector<std::int16_t> sup = io::supervisionLabels(v, config.use_pseudo_labels);
     if (std::any_of(sup.begin(), sup.end(), [](std::int16_t l) { return l >= 0; })) {
       labels = at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W},
-                             at::TensorOptions().dtype(at::kShort))
-                   .to(at::kLong);
+                             at::TensorOptions().dtype(at::kShort));
+      labels = s.streamed ? host(labels) : labels.to(at::kLong);
       if (gt) {
         s.labelled_views.push_back(static_cast<int>(i));
       } else {
@@ -136,7 +149,7 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
       confidence = at::where(gt_valid, at::ones({H, W}),
                              confidence.defined() ? confidence : at::zeros({H, W}));
     }
-    s.labels.push_back(labels.defined() ? labels.to(device) : labels);
+    s.labels.push_back(labels.defined() && !s.streamed ? labels.to(device) : labels);
     s.semantic_weight.push_back(gt ? config.lambda_semantic : config.lambda_pseudo);
     s.confidence_maps.push_back(confidence.defined() ? confidence.to(device) : confidence);
     s.train_views.push_back(static_cast<int>(i));

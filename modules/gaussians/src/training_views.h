@@ -22,17 +22,32 @@ struct ViewRole {
 
 constexpr int kGuardProbeViews = 4;
 
+// A training view's pictures on the device, as the losses read them.
+struct DeviceView {
+  at::Tensor image;   // [H, W, 3] float in [0, 1]
+  at::Tensor mask;    // [H, W] float, 1 = valid pixel
+  at::Tensor labels;  // [H, W] int64, -1 = not supervised (or undefined)
+};
+
 struct TrainingViews {
+  // Held (the default): images, masks and labels are the DeviceView tensors, on the device.
+  // Streamed (TrainConfig::stream_views): they are host copies in 8 / 8 / 16 bits (pinned for a
+  // CUDA device) that onDevice uploads and converts each time a step uses the view.
+  bool streamed = false;
+  at::Device device{at::kCPU};
   std::vector<RasterCamera> cameras;        // every view of the scene
-  std::vector<at::Tensor> images;           // [H, W, 3] float in [0, 1] (training views only)
-  std::vector<at::Tensor> masks;            // [H, W] float, 1 = valid pixel
+  std::vector<at::Tensor> images;           // training views only (see above)
+  std::vector<at::Tensor> masks;
   std::vector<char> mask_is_full;           // every pixel valid: the mask multiplies nothing
-  std::vector<at::Tensor> labels;           // [H, W] int64, -1 = not supervised (or undefined)
+  std::vector<at::Tensor> labels;           // undefined where a view supervises no class
   std::vector<double> semantic_weight;      // lambda_semantic (ground truth) or lambda_pseudo
   std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (or undefined)
   int pseudo_labelled_views = 0;
   std::vector<int> train_views, labelled_views;
 
+  // View v's pictures on the device: the held tensors, or the host copies uploaded (the copy is
+  // queued on the current stream: the host does not wait for it).
+  DeviceView onDevice(int v) const;
   std::vector<RasterCamera> trainingCameras() const;
   // The training views the drop's guard renders (a fixed set, so its readings are comparable):
   // up to kGuardProbeViews spread evenly over the training views.

@@ -197,6 +197,10 @@ struct TrainConfig : ScheduleOptions,
   int init_random_count = 100000;  ///< 3DGS's random initialisation of synthetic scenes
   std::array<float, 3> background{0, 0, 0};
   std::string device = "cpu";  ///< "cpu" or "cuda"
+  /// Keep the training views in host memory in their 8-bit form and upload each step's views to
+  /// the device when it renders them (device memory: the model and a step's views, not every
+  /// view as floats); the same values as views held on the device.
+  bool stream_views = false;
 
   /// \brief Checks every option against its range in the option table (train_options.h) and
   /// the rules between options (recovery_iterations below iterations).
