@@ -304,6 +304,16 @@ TEST(AerialBenchmark, CityXlIsFourTilesWithTheirOwnOrbitsAndSplits) {
     EXPECT_EQ(std::count(full.test.begin(), full.test.end(), v), 0) << v;
   }
   for (int n : labelled_per_tile) EXPECT_EQ(n, 3);
+  // city-xxl: 4 x 4 tiles (16x the area), 1,120 views, every tile split as the ordinary scene.
+  const synth::SynthOptions xxl = synth::SynthOptions::tiledCity(5, 4);
+  EXPECT_EQ(xxl.views, 1120);
+  EXPECT_EQ(xxl.max_points, 320000);
+  ASSERT_EQ(xxl.labelled.size(), 48u);
+  ASSERT_EQ(xxl.test.size(), 112u);
+  std::vector<int> test_per_tile(16, 0);
+  for (int v : xxl.test) ++test_per_tile[v % 16];
+  for (int n : test_per_tile) EXPECT_EQ(n, 7);
+  EXPECT_EQ(synth::World(synth::SceneKind::kCity, 3, 4).extent(), 4 * one.extent());
 
   // View i looks at the centre of tile i % 4 (+-4 m of jitter): its optical axis meets the ground
   // there.

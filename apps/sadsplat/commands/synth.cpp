@@ -23,8 +23,8 @@ class SynthCommand : public Command {
     c->add_option("--kind", kind_, "city, country or port")->capture_default_str();
     c->add_option("--seed", seed_, "scene seed")->capture_default_str();
     c->add_option("--preset", preset_,
-                  "demo (320x180), full (1600x900) or city-xl (a city of 4x the area, 280 views "
-                  "of 1600x900)");
+                  "demo (320x180), full (1600x900), city-xl (a city of 4x the area, 280 views "
+                  "of 1600x900) or city-xxl (16x the area, 1,120 views of 1600x900)");
     c->add_option("--views", views_, "number of views (70)");
     c->add_option("--capture", capture_,
                   "orbit (oblique views around the scene, the paper's), grid (a nadir "
@@ -128,13 +128,13 @@ class SynthCommand : public Command {
     } else if (preset_.empty() || preset_ == "full") {
       o.kind = kind;
       o.seed = seed_;
-    } else if (preset_ == "city-xl") {
+    } else if (preset_ == "city-xl" || preset_ == "city-xxl") {
       if (kind != synth::SceneKind::kCity) {
-        throw Error("<command line>", "--preset city-xl", "--kind city", kind_);
+        throw Error("<command line>", "--preset " + preset_, "--kind city", kind_);
       }
-      o = synth::SynthOptions::cityXl(seed_);
+      o = synth::SynthOptions::tiledCity(seed_, preset_ == "city-xl" ? 2 : 4);
     } else {
-      throw Error("<command line>", "--preset", "demo, full or city-xl", preset_);
+      throw Error("<command line>", "--preset", "demo, full, city-xl or city-xxl", preset_);
     }
     if (views_ > 0) o.views = views_;
     o.capture = synth::captureFromName(capture_);

@@ -152,6 +152,7 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
   p.columns = shape[1];
   p.e_edges = gridEdges(p.columns, e_lo, e_hi);
   p.n_edges = gridEdges(p.rows, n_lo, n_hi);
+  std::vector<std::vector<int>> grown_of(np);  // per point: the blocks whose grown cell holds it
   const double grow_e = options.overlap * (e_hi - e_lo) / p.columns;
   const double grow_n = options.overlap * (n_hi - n_lo) / p.rows;
   for (int r = 0; r < p.rows; ++r) {
@@ -165,7 +166,9 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
       const auto gn = grownInterval(p.n_edges, r, grow_n);
       b.grown = {ge[0], ge[1], gn[0], gn[1]};
       for (std::size_t i = 0; i < np; ++i) {
-        if (b.grown.contains(en[i][0], en[i][1])) b.points.push_back(static_cast<int>(i));
+        if (!b.grown.contains(en[i][0], en[i][1])) continue;
+        b.points.push_back(static_cast<int>(i));
+        grown_of[i].push_back(b.index);
       }
       p.blocks.push_back(std::move(b));
     }
@@ -193,9 +196,7 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
       if (!(u >= 0 && u < cam.width && w >= 0 && w < cam.height)) continue;
       ++seen;
       ++in_cell[cell_of[i]];
-      for (const Block& b : p.blocks) {
-        if (b.grown.contains(en[i][0], en[i][1])) ++in_block[b.index];
-      }
+      for (int b : grown_of[i]) ++in_block[b];
     }
     if (seen == 0) continue;  // sees no point: no block can use it
     for (int n : in_cell) p.view_cell_shares[v].push_back(static_cast<double>(n) / seen);

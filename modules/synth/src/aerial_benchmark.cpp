@@ -460,20 +460,21 @@ SynthOptions SynthOptions::demo(SceneKind kind, std::uint64_t seed) {
   return o;
 }
 
-SynthOptions SynthOptions::cityXl(std::uint64_t seed) {
+SynthOptions SynthOptions::tiledCity(std::uint64_t seed, int tiles) {
   SynthOptions o;
   o.kind = SceneKind::kCity;
   o.seed = seed;
-  o.tiles = 2;
-  o.views = 280;
-  o.max_points = 80000;
-  // The ordinary split on every tile: view i belongs to tile i % 4 as its (i / 4)-th view.
+  o.tiles = tiles;
+  const int count = tiles * tiles;
+  o.views = o.views * count;
+  o.max_points = o.max_points * count;
+  // The ordinary split on every tile: view i belongs to tile i % count as its (i / count)-th.
   const std::vector<int> labelled = o.labelled, test = o.test;
   o.labelled.clear();
   o.test.clear();
-  for (int tile = 0; tile < 4; ++tile) {
-    for (int j : labelled) o.labelled.push_back(4 * j + tile);
-    for (int j : test) o.test.push_back(4 * j + tile);
+  for (int tile = 0; tile < count; ++tile) {
+    for (int j : labelled) o.labelled.push_back(count * j + tile);
+    for (int j : test) o.test.push_back(count * j + tile);
   }
   return o;
 }

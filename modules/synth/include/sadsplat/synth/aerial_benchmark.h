@@ -59,7 +59,11 @@ struct SynthOptions {
   /// \brief The `--preset city-xl` benchmark: a city of 2 x 2 tiles (4x the area), 280 views of
   /// 1600x900 (70 per tile), 80,000 sparse points; per tile the ordinary split (3 labelled
   /// training views, 7 test views), so 12 labelled and 28 test views in all.
-  static SynthOptions cityXl(std::uint64_t seed);
+  static SynthOptions cityXl(std::uint64_t seed) { return tiledCity(seed, 2); }
+  /// \brief A city of tiles x tiles ordinary scenes: 70 views of 1600x900 and 20,000 sparse
+  /// points per tile, each tile with the ordinary split (3 labelled, 7 test views). tiles 2:
+  /// `--preset city-xl`; tiles 4: `--preset city-xxl` (16x the area, 1,120 views).
+  static SynthOptions tiledCity(std::uint64_t seed, int tiles);
 };
 
 /// \brief A grid capture's layout: lines, photos per line and the altitude above the ground.
