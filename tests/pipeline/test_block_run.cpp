@@ -126,7 +126,7 @@ TEST(BlockRun, MismatchedOptionsAreClearErrors) {
   b.partition.blocks = 2;
   b.partition.overlap = 0.5;  // not the partition the blocks were trained on
   try {
-    pipeline::mergeBlocks(o, b);
+    pipeline::BlockRun(o, b).merge();
     FAIL() << "merged blocks of another partition";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("blocks.json"), std::string::npos) << e.what();

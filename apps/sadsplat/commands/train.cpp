@@ -179,10 +179,11 @@ class TrainCommand : public Command {
     blocks.ranks = rank_env ? rank_env->world_size : 1;
     blocks.wait_for_ranks = !local_ranks && blocks.ranks > 1;
     const auto start = std::chrono::steady_clock::now();
-    pipeline::trainBlocks(options, config, blocks);
+    pipeline::BlockRun run(options, blocks);
+    run.train(config);
     if (local_ranks) local_ranks->waitAll();
     if (blocks.rank != 0) return 0;
-    pipeline::mergeBlocks(options, blocks);
+    run.merge();
     std::cout << "trained in " << blocks_ << " blocks in "
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
               << " s; model in " << out_ << "/model.ply\n";

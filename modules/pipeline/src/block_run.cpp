@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <utility>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/block_merge.h"
@@ -15,19 +16,6 @@
 namespace sadsplat {
 namespace pipeline {
 namespace {
-
-// The scene and its partition, as every rank and the merge compute them.
-struct PartitionedScene {
-  io::Scene scene;
-  geo::BlockPartition partition;
-};
-
-PartitionedScene partitioned(const TrainRunOptions& o, const BlockRunOptions& b) {
-  PartitionedScene p;
-  p.scene = loadScene(o.scene, o.scale, o.progress);
-  p.partition = geo::partitionScene(p.scene, b.partition, o.scene);
-  return p;
-}
 
 // Whether a block's run directory holds its finished training.
 bool finished(const io::RunDirectory& dir, int iterations) {
@@ -68,13 +56,13 @@ int referenceBlock(const geo::BlockPartition& p, const io::Scene& scene,
 
 // Polls the other ranks' block directories until each has finished (torchrun stops every rank
 // when one fails, so this does not outlive a failed rank).
-void waitForOtherRanks(const TrainRunOptions& o, const PartitionedScene& ps, int iterations,
-                       const BlockRunOptions& b) {
+void waitForOtherRanks(const TrainRunOptions& o, const geo::BlockPartition& partition,
+                       int iterations, const BlockRunOptions& b) {
   const io::RunDirectory dir(o.out);
   bool said = false;
   for (;;) {
     std::vector<int> waiting;
-    for (const geo::Block& block : ps.partition.blocks) {
+    for (const geo::Block& block : partition.blocks) {
       if (block.index % b.ranks == b.rank || block.views.empty()) continue;
       if (!finished(dir.block(block.index), iterations)) waiting.push_back(block.index + 1);
     }
@@ -89,45 +77,51 @@ void waitForOtherRanks(const TrainRunOptions& o, const PartitionedScene& ps, int
 
 }  // namespace
 
-double trainBlocks(const TrainRunOptions& o, const gaussians::TrainConfig& config,
-                   const BlockRunOptions& b) {
-  if (b.ranks < 1 || b.rank < 0 || b.rank >= b.ranks)
-    throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(b.rank));
+BlockRun::BlockRun(TrainRunOptions options, BlockRunOptions blocks)
+    : options_(std::move(options)), blocks_(std::move(blocks)) {
+  if (blocks_.ranks < 1 || blocks_.rank < 0 || blocks_.rank >= blocks_.ranks)
+    throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(blocks_.rank));
+  scene_ = loadScene(options_.scene, options_.scale, options_.progress);
+  partition_ = geo::partitionScene(scene_, blocks_.partition, options_.scene);
+}
+
+double BlockRun::train(const gaussians::TrainConfig& config) {
+  const TrainRunOptions& o = options_;
+  const BlockRunOptions& b = blocks_;
   const io::RunDirectory dir(o.out);
-  const PartitionedScene ps = partitioned(o, b);
   if (b.rank == 0) {
     io::makeDirectory(o.out);
-    io::writeTextFileAtomically(dir.blocksJson(), ps.partition.toJson(ps.scene));
+    io::writeTextFileAtomically(dir.blocksJson(), partition_.toJson(scene_));
   }
   const int iterations = gaussians::resolveSchedule(config, o.schedule).config.iterations;
   double seconds = 0;
-  for (const geo::Block& block : ps.partition.blocks) {
+  for (const geo::Block& block : partition_.blocks) {
     if (block.index % b.ranks != b.rank) continue;
     const io::RunDirectory block_dir = dir.block(block.index);
     if (block.views.empty()) {
-      sayBlock(o.progress, block, ps.partition, ps.scene, "no view sees it, skipped");
+      sayBlock(o.progress, block, partition_, scene_, "no view sees it, skipped");
       continue;
     }
     if (finished(block_dir, iterations)) {
-      sayBlock(o.progress, block, ps.partition, ps.scene, "finished before, kept");
+      sayBlock(o.progress, block, partition_, scene_, "finished before, kept");
       continue;
     }
     TrainRunOptions block_options = o;
     block_options.out = block_dir.path();
     block_options.collective = nullptr;
     block_options.resume = o.resume && io::RunDirectory::hasCheckpoint(block_dir.path());
-    sayBlock(o.progress, block, ps.partition, ps.scene,
+    sayBlock(o.progress, block, partition_, scene_,
              block_options.resume ? "resuming" : "training");
-    seconds += trainRun(block_options, config, geo::blockScene(ps.scene, block));
+    seconds += trainRun(block_options, config, geo::blockScene(scene_, block));
   }
-  if (b.rank == 0 && b.wait_for_ranks) waitForOtherRanks(o, ps, iterations, b);
+  if (b.rank == 0 && b.wait_for_ranks) waitForOtherRanks(o, partition_, iterations, b);
   return seconds;
 }
 
-void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
+void BlockRun::merge() const {
+  const TrainRunOptions& o = options_;
   const io::RunDirectory dir(o.out);
-  const PartitionedScene ps = partitioned(o, b);
-  const std::string expected = ps.partition.toJson(ps.scene);
+  const std::string expected = partition_.toJson(scene_);
   if (!io::pathExists(dir.blocksJson()) || io::readWholeFile(dir.blocksJson()) != expected)
     throw Error(dir.blocksJson(), "partition",
                 "the partition of this scene with these block options (train it with them)",
@@ -135,7 +129,7 @@ void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
   // The blocks: each finished (its checkpoint at its configuration's iterations).
   std::vector<int> trained;
   double seconds = 0;
-  for (const geo::Block& block : ps.partition.blocks) {
+  for (const geo::Block& block : partition_.blocks) {
     if (block.views.empty()) continue;
     const io::RunDirectory block_dir = dir.block(block.index);
     if (!io::RunDirectory::hasCheckpoint(block_dir.path()))
@@ -151,15 +145,15 @@ void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
     seconds += record.train_seconds;
   }
   if (trained.empty()) throw Error(o.out, "blocks", "at least one trained block", "none");
-  const int reference = referenceBlock(ps.partition, ps.scene, trained);
+  const int reference = referenceBlock(partition_, scene_, trained);
   const io::RunDirectory reference_dir = dir.block(reference);
   const gaussians::TrainConfig config = gaussians::TrainConfig::fromJson(
       io::readWholeFile(reference_dir.config()), reference_dir.config());
   // The merged model lives in a trainer over one view of the reference block: the writers
   // need a trainer, not the scene's every view on the device.
-  io::Scene carrier = geo::blockScene(ps.scene, ps.partition.blocks[reference]);
+  io::Scene carrier = geo::blockScene(scene_, partition_.blocks[reference]);
   carrier.views.resize(1);
-  carrier.points = ps.scene.points;
+  carrier.points = scene_.points;
   gaussians::Trainer trainer(carrier, config);
   trainer.setDropStrategy(semantic_drop::makeDropStrategy(config));
   std::vector<gaussians::BlockCheckpoint> parts;
@@ -171,7 +165,7 @@ void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
     part.archive = gaussians::readTensorArchive(part.origin);
     const at::Tensor means = part.archive.tensor("means", part.origin).to(at::kFloat).contiguous();
     const std::vector<int> cells =
-        ps.partition.blocksOf(means.data_ptr<float>(), static_cast<std::size_t>(means.size(0)));
+        partition_.blocksOf(means.data_ptr<float>(), static_cast<std::size_t>(means.size(0)));
     at::Tensor keep = at::empty({means.size(0)}, at::kBool);
     bool* k = keep.data_ptr<bool>();
     for (std::size_t i = 0; i < cells.size(); ++i) k[i] = cells[i] == index;
@@ -185,7 +179,7 @@ void mergeBlocks(const TrainRunOptions& o, const BlockRunOptions& b) {
       dir.checkpoint());
   io::makeDirectory(o.out);
   io::writeTextFileAtomically(dir.config(), trainer.config().toJson());
-  writeTrainedRun(dir, trainer, ps.scene,
+  writeTrainedRun(dir, trainer, scene_,
                   io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), seconds});
   if (o.progress) {
     *o.progress << "merged " << trained.size() << " blocks: " << trainer.numGaussians()

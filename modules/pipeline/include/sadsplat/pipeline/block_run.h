@@ -26,22 +26,38 @@ struct BlockRunOptions {
   bool wait_for_ranks = false;
 };
 
-/// \brief Partitions options.scene, writes RUN/blocks.json (rank 0) and trains this rank's blocks
-/// into RUN/blocks/bNNN, each on its views and the sparse points of its grown cell, with
-/// `config` (each block gets the whole schedule). A block that finished is kept; with
-/// options.resume an interrupted one continues from its checkpoint. A block no view sees is
-/// skipped. Returns the seconds this rank trained.
-/// \throws sadsplat::Error on bad input or a failed block (naming its directory)
-double trainBlocks(const TrainRunOptions& options, const gaussians::TrainConfig& config,
-                   const BlockRunOptions& blocks);
+/// \brief A scene (options.scene, loaded once) and its partition, trained block by block into
+/// options.out.
+class BlockRun {
+ public:
+  /// \throws sadsplat::Error on a scene that cannot be read or partitioned
+  BlockRun(TrainRunOptions options, BlockRunOptions blocks);
 
-/// \brief Merges the finished blocks of RUN into RUN itself (checkpoint.bin, model.ply, run.json,
-/// config.json, ...): each block's Gaussians whose centre lies in its cell, the decoders made
-/// one (the decoder of the block with the most labelled views). run.json's train_seconds is the
-/// blocks' sum (one device's time).
-/// \throws sadsplat::Error when blocks.json does not match the partition of these options, or a
-/// block that has views has not finished
-void mergeBlocks(const TrainRunOptions& options, const BlockRunOptions& blocks);
+  const io::Scene& scene() const { return scene_; }
+  const geo::BlockPartition& partition() const { return partition_; }
+
+  /// \brief Writes RUN/blocks.json (rank 0) and trains this rank's blocks into RUN/blocks/bNNN,
+  /// each on its views and the sparse points of its grown cell, with `config` (each block gets
+  /// the whole schedule). A block that finished is kept; with options.resume an interrupted one
+  /// continues from its checkpoint. A block no view sees is skipped. Returns the seconds this
+  /// rank trained.
+  /// \throws sadsplat::Error on bad input or a failed block (naming its directory)
+  double train(const gaussians::TrainConfig& config);
+
+  /// \brief Merges the finished blocks of RUN into RUN itself (checkpoint.bin, model.ply,
+  /// run.json, config.json, ...): each block's Gaussians whose centre lies in its cell, the
+  /// decoders made one (the decoder of the block with the most labelled views). run.json's
+  /// train_seconds is the blocks' sum (one device's time).
+  /// \throws sadsplat::Error when blocks.json is not this partition (trained with other block
+  /// options), or a block that has views has not finished
+  void merge() const;
+
+ private:
+  TrainRunOptions options_;
+  BlockRunOptions blocks_;
+  io::Scene scene_;
+  geo::BlockPartition partition_;
+};
 
 }  // namespace pipeline
 }  // namespace sadsplat
