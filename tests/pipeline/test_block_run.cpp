@@ -57,6 +57,14 @@ TEST(BlockRun, TheMergedModelHoldsEachBlocksOwnCellOnceAndResumes) {
     total += own[b.index];
   }
   EXPECT_EQ(static_cast<int>(io::readGaussianPly(dir.file("run/model.ply")).size()), total);
+  ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("run"), &out), 0) << out;
+  EXPECT_NE(out.find("blocks: 1 x 2 grid"), std::string::npos) << out;
+  // A damaged blocks.json is a clear error naming it.
+  const std::string partition = test::readFile(dir.file("run/blocks.json"));
+  test::writeFile(dir.file("run/blocks.json"), "{\"rows\": 1}");
+  EXPECT_EQ(test::runCommand(kCli + " info " + dir.file("run"), &out), 1);
+  EXPECT_NE(out.find("blocks.json"), std::string::npos) << out;
+  test::writeFile(dir.file("run/blocks.json"), partition);
   // Resuming keeps the finished blocks and merges them into the same model.
   const std::string model = test::readFile(dir.file("run/model.ply"));
   ASSERT_EQ(test::runCommand(kCli + kBlockRun + " --resume --out " + dir.file("run"), &out), 0)

@@ -9,6 +9,8 @@
 #include <map>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/cloud_files.h"
@@ -125,6 +127,20 @@ void describeGaussians(std::ostream& out, const pcl::PointCloud<GaussianPoint>& 
     out << "gaussians per class id:";
     for (const auto& [id, count] : histogram) out << " " << id << ":" << count;
     out << "\n";
+  }
+}
+
+// A block run's partition (blocks.json): the grid and each block's training views.
+void describeBlocks(std::ostream& out, const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(readWholeFile(path));
+    out << "blocks: " << j.at("rows").get<int>() << " x " << j.at("columns").get<int>()
+        << " grid, trained apart and merged (blocks/); training views per block:";
+    for (const auto& b : j.at("blocks")) out << " " << b.at("views").size();
+    out << "\n";
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, "blocks", "the partition `train --blocks` writes", printable(e.what()));
   }
 }
 
@@ -254,6 +270,7 @@ std::string describeFile(const std::string& path) {
       } else {
         out << "georeference: none (the scene's SfM frame)\n";
       }
+      if (optionalFileExists(run.blocksJson())) describeBlocks(out, run.blocksJson());
       out << describeFile(run.model());
       return out.str();
     }
