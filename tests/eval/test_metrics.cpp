@@ -39,3 +39,24 @@ TEST(ConfusionMatrix, RejectsPredictionsOutsideTheClasses) {
 
 }  // namespace
 }  // namespace sadsplat
+
+namespace sadsplat {
+namespace {
+
+TEST(ConfusionMatrix, AddingAMatrixCountsAsAddingItsPixels) {
+  const std::uint8_t gt_a[] = {0, 1, 2, 255}, gt_b[] = {2, 2, 0, 1};
+  const std::int64_t pred_a[] = {0, 2, 2, 1}, pred_b[] = {2, 0, 0, 1};
+  eval::ConfusionMatrix a(3), b(3), all(3);
+  a.add(gt_a, pred_a, 4);
+  b.add(gt_b, pred_b, 4);
+  all.add(gt_a, pred_a, 4);
+  all.add(gt_b, pred_b, 4);
+  a.add(b);
+  for (int g = 0; g < 3; ++g)
+    for (int p = 0; p < 3; ++p) EXPECT_EQ(a.at(g, p), all.at(g, p)) << g << " " << p;
+  EXPECT_EQ(a.total(), 7);
+  EXPECT_THROW(a.add(eval::ConfusionMatrix(4)), Error);
+}
+
+}  // namespace
+}  // namespace sadsplat

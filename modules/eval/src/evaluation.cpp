@@ -174,15 +174,11 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
     score.name = view.name;
     score.accuracy = std::numeric_limits<double>::quiet_NaN();
     if (semantic && !view.labels.empty()) {
-      std::size_t right = 0, labelled = 0;
-      for (std::size_t i = 0; i < pixels; ++i) {
-        if (labels[i] == io::kIgnoreLabel) continue;
-        ++labelled;
-        right += labels[i] == pred8[i] ? 1 : 0;
-      }
-      if (labelled > 0) score.accuracy = static_cast<double>(right) / labelled;
       std::vector<std::int64_t> pred64(pred8.begin(), pred8.end());
-      result.confusion.add(labels.data(), pred64.data(), labels.size());
+      ConfusionMatrix confusion(result.confusion.numClasses());
+      confusion.add(labels.data(), pred64.data(), labels.size());
+      if (confusion.total() > 0) score.accuracy = confusion.overallAccuracy();
+      result.confusion.add(confusion);
       ++result.labelled_views;
     }
     const int W = view.camera.width, H = view.camera.height;

@@ -19,6 +19,14 @@ void ConfusionMatrix::add(const std::uint8_t* gt, const std::int64_t* pred, std:
   }
 }
 
+void ConfusionMatrix::add(const ConfusionMatrix& other) {
+  if (other.n_ != n_) {
+    throw Error("<evaluation>", "confusion matrix", std::to_string(n_) + " classes",
+                std::to_string(other.n_));
+  }
+  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
+}
+
 std::int64_t ConfusionMatrix::total() const {
   std::int64_t t = 0;
   for (auto c : counts_) t += c;

@@ -67,9 +67,13 @@ int Block::labelledViews(const io::Scene& scene) const {
   return n;
 }
 
+int BlockPartition::blockAt(double e, double n) const {
+  return intervalOf(n_edges, n) * columns + intervalOf(e_edges, e);
+}
+
 int BlockPartition::blockOf(const std::array<double, 3>& p) const {
   const auto local = ground.toLocal(p);
-  return intervalOf(n_edges, local[1]) * columns + intervalOf(e_edges, local[0]);
+  return blockAt(local[0], local[1]);
 }
 
 std::vector<int> BlockPartition::blocksOf(const float* xyz, std::size_t count) const {
@@ -175,9 +179,7 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
   }
   // Which points each view sees, and the share of them in each block's cell and grown cell.
   std::vector<int> cell_of(np);
-  for (std::size_t i = 0; i < np; ++i) {
-    cell_of[i] = intervalOf(p.n_edges, en[i][1]) * p.columns + intervalOf(p.e_edges, en[i][0]);
-  }
+  for (std::size_t i = 0; i < np; ++i) cell_of[i] = p.blockAt(en[i][0], en[i][1]);
   bool any_train = false;
   p.view_cell_shares.resize(scene.views.size());
   for (std::size_t v = 0; v < scene.views.size(); ++v) {

@@ -14,6 +14,8 @@ class ConfusionMatrix {
   explicit ConfusionMatrix(int num_classes);
   /// \brief Adds pixels; gt == 255 (or any value >= num_classes) is ignored; pred must be a class.
   void add(const std::uint8_t* gt, const std::int64_t* pred, std::size_t n);
+  /// \brief Adds another matrix's counts (the same number of classes).
+  void add(const ConfusionMatrix& other);
   std::int64_t at(int gt, int pred) const {
     return counts_[static_cast<std::size_t>(gt) * n_ + pred];
   }

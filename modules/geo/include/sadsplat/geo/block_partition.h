@@ -74,6 +74,8 @@ struct BlockPartition {
 
   /// \brief The block whose cell holds a scene point.
   int blockOf(const std::array<double, 3>& scene_point) const;
+  /// \brief The block whose cell holds the ground-plane point (e, n).
+  int blockAt(double e, double n) const;
   /// \brief The same for many points (x, y, z interleaved), one index per point.
   std::vector<int> blocksOf(const float* xyz, std::size_t count) const;
   /// \brief JSON text: the grid; per block its cell, grown cell, views (names and shares) and
