@@ -27,7 +27,7 @@ while (Date.now() < deadline) {
   await new Promise((r) => setTimeout(r, 500));
   const r = await send('Runtime.evaluate', { expression: 'document.title', returnByValue: true });
   title = r.result?.result?.value ?? '';
-  if (title === 'ready' || title.startsWith('error')) break;
+  if (title.startsWith('ready') || title.startsWith('error')) break;
 }
 const shot = await send('Page.captureScreenshot', { format: 'png' });
 fs.writeFileSync(out, Buffer.from(shot.result.data, 'base64'));

@@ -30,6 +30,27 @@ TEST(Geodesy, EastNorthUpIsMetresAroundTheOrigin) {
   EXPECT_NEAR(again[2], 42.0, 1e-3);
 }
 
+TEST(Geodesy, TheEnuToEcefMatrixPlacesPointsToAMillimetre) {
+  // On the equator at the prime meridian, ENU (e, n, u) is ECEF (a + u, e, n).
+  const auto m0 = geo::enuToEcefMatrix({0, 0, 0});
+  EXPECT_NEAR(m0[12], 6378137.0, 1e-6);
+  EXPECT_NEAR(m0[0 * 4 + 1], 1.0, 1e-12);  // east column: +y
+  EXPECT_NEAR(m0[1 * 4 + 2], 1.0, 1e-12);  // north column: +z
+  EXPECT_NEAR(m0[2 * 4 + 0], 1.0, 1e-12);  // up column: +x
+  EXPECT_EQ(m0[15], 1.0);
+  // Elsewhere: M (e, n, u, 1) equals the ECEF of fromEnu(e, n, u), to a millimetre.
+  const io::GeoPosition origin{46.8426566, -91.9940080, 198.55};
+  const auto m = geo::enuToEcefMatrix(origin);
+  for (const std::array<double, 3> enu : {std::array<double, 3>{0, 0, 0}, {120.5, -80.25, 31.0},
+                                          {-950.0, 1200.0, -40.0}}) {
+    const auto want = geo::ecefOf(geo::fromEnu(enu, origin));
+    for (int r = 0; r < 3; ++r) {
+      const double got = m[r] * enu[0] + m[4 + r] * enu[1] + m[8 + r] * enu[2] + m[12 + r];
+      EXPECT_NEAR(got, want[r], 1e-3) << "row " << r;
+    }
+  }
+}
+
 TEST(Geodesy, UtmZoneEpsgCodes) {
   EXPECT_EQ(geo::utmEpsg({46.843, -91.994, 0}), 32615);  // Duluth, MN: zone 15 N
   EXPECT_EQ(geo::utmEpsg({48.137, 11.575, 0}), 32632);   // Munich: zone 32 N

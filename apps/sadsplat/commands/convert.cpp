@@ -5,6 +5,8 @@
 #include "sadsplat/geo/las_export.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/io/gltf_splats.h"
+#include "sadsplat/pipeline/globe_export.h"
 
 namespace sadsplat {
 namespace cli {
@@ -19,9 +21,10 @@ class ConvertCommand : public Command {
         "semantic clouds .ply/.pcd");
     c->add_option("IN", in_, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")->required();
     c->add_option("OUT", out_,
-                  "output .ply, .pcd, .splat, .spz, or .las (LAS 1.4: centres, colour, ASPRS "
-                  "class, in the georeference's UTM zone; classes.json and georeference.json are "
-                  "read from the input's folder)")
+                  "output .ply, .pcd, .splat, .spz, .las (LAS 1.4: centres, colour, ASPRS "
+                  "class, in the georeference's UTM zone) or .glb (glTF KHR_gaussian_splatting, "
+                  "SPZ-compressed, classes as feature IDs, upright in glTF's y-up axes); "
+                  "classes.json and georeference.json are read from the input's folder")
         ->required();
     c->add_option("--classification-map", classification_map_,
                   ".las: JSON {\"class name\": ASPRS code} replacing the default codes");
@@ -30,9 +33,14 @@ class ConvertCommand : public Command {
                   "older web viewers read)")
         ->check(CLI::IsMember({2, 3, 4}))
         ->capture_default_str();
+    c->add_flag("!--glb-no-spz", glb_.spz, ".glb: plain float accessors instead of SPZ");
     return c;
   }
   int run(const Invocation&) override {
+    if (io::lowerExtension(out_) == ".glb") {
+      std::cerr << "sadsplat: note: " << pipeline::exportGlb(in_, out_, glb_) << "\n";
+      return 0;
+    }
     if (io::lowerExtension(out_) == ".las") {
       const geo::LasExportOptions options = geo::lasOptionsBeside(in_, classification_map_);
       std::cout << (io::cloudKind(in_) == io::CloudKind::kSemantic
@@ -49,6 +57,7 @@ class ConvertCommand : public Command {
  private:
   std::string in_, out_, classification_map_;
   io::ConvertOptions options_;
+  io::GltfSplatOptions glb_;
 };
 
 }  // namespace

@@ -114,6 +114,23 @@ GeoPosition fromEnu(const std::array<double, 3>& enu, const GeoPosition& origin)
   return fromEcef(x);
 }
 
+std::array<double, 3> ecefOf(const GeoPosition& p) {
+  const Eigen::Vector3d x = toEcef(p);
+  return {x.x(), x.y(), x.z()};
+}
+
+std::array<double, 16> enuToEcefMatrix(const GeoPosition& origin) {
+  const Eigen::Matrix3d rows = enuBasis(origin);  // rows: east, north, up
+  const Eigen::Vector3d o = toEcef(origin);
+  std::array<double, 16> m{};
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) m[4 * c + r] = rows(c, r);
+  }
+  for (int r = 0; r < 3; ++r) m[12 + r] = o[r];
+  m[15] = 1;
+  return m;
+}
+
 Similarity fitSimilarity(const std::vector<std::array<double, 3>>& from,
                          const std::vector<std::array<double, 3>>& to, double inlier_metres,
                          std::vector<bool>* inliers, bool* consensus) {

@@ -38,6 +38,20 @@ constexpr std::uint64_t kMaxZstdRatio = 1024;
 // the basis functions odd in y or z change sign, those even in both keep it.
 constexpr float kRdfRubShSign[15] = {-1, -1, 1, -1, 1, 1, -1, 1, -1, 1, -1, -1, 1, -1, 1};
 
+// The cloud turned 180 degrees about x (y -> -y, z -> -z): what RDF <-> RUB does, applied twice
+// to keep a cloud's axes as stored.
+void turnAboutX(pcl::PointCloud<GaussianPoint>& cloud) {
+  for (GaussianPoint& p : cloud) {
+    p.y = -p.y;
+    p.z = -p.z;
+    p.rot[2] = -p.rot[2];
+    p.rot[3] = -p.rot[3];
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < kShRestPerChannel; ++k) p.f_rest[c * kShRestPerChannel + k] *= kRdfRubShSign[k];
+    }
+  }
+}
+
 std::size_t shDim(int degree) {
   return static_cast<std::size_t>(shCoefficientsForDegree(degree) - 1);
 }
@@ -362,8 +376,9 @@ pcl::PointCloud<GaussianPoint> readVersion4(const std::string& path, const std::
 
 }  // namespace
 
-void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
-              const SpzWriteOptions& options) {
+std::vector<std::uint8_t> encodeSpz(const std::string& path,
+                                    const pcl::PointCloud<GaussianPoint>& cloud,
+                                    const SpzWriteOptions& options) {
   if (options.sh_degree < 0 || options.sh_degree > kMaxShDegree) {
     throw Error(path, "SH degree option", "0..3", std::to_string(options.sh_degree));
   }
@@ -379,7 +394,14 @@ void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& clo
   layout.degree = options.sh_degree;
   layout.rotation = options.version == 2 ? 3 : 4;
   const int bits = fractionalBitsFor(path, cloud);
-  const std::vector<std::uint8_t> data = pack(cloud, layout, bits);
+  std::vector<std::uint8_t> data;
+  if (options.axes_as_stored) {
+    pcl::PointCloud<GaussianPoint> turned = cloud;
+    turnAboutX(turned);
+    data = pack(turned, layout, bits);
+  } else {
+    data = pack(cloud, layout, bits);
+  }
   const std::uint8_t flags = options.antialiased ? kFlagAntialiased : 0;
   std::vector<std::uint8_t> file;
   if (options.version < 4) {
@@ -413,13 +435,23 @@ void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& clo
       offset += sizes[s];
     }
   }
+  return file;
+}
+
+void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
+              const SpzWriteOptions& options) {
+  const std::vector<std::uint8_t> file = encodeSpz(path, cloud, options);
   writeFileAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
   });
 }
 
 pcl::PointCloud<GaussianPoint> readSpz(const std::string& path, SpzFileInfo* info) {
-  const std::string bytes = readWholeFile(path);
+  return decodeSpz(path, readWholeFile(path), info);
+}
+
+pcl::PointCloud<GaussianPoint> decodeSpz(const std::string& path, const std::string& bytes,
+                                         SpzFileInfo* info, bool axes_as_stored) {
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
   pcl::PointCloud<GaussianPoint> cloud;
   if (bytes.size() >= 4 && load<std::uint32_t>(data) == kMagic) {
@@ -432,6 +464,7 @@ pcl::PointCloud<GaussianPoint> readSpz(const std::string& path, SpzFileInfo* inf
                 bytes.size() < 4 ? "a file of " + std::to_string(bytes.size()) + " bytes"
                                  : "other bytes");
   }
+  if (axes_as_stored) turnAboutX(cloud);
   const GaussianReadReport report = checkReadGaussians(path, cloud);
   if (info != nullptr) {
     info->num_points = cloud.size();

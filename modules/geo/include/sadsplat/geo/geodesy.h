@@ -21,6 +21,11 @@ using io::utmEpsg;
 std::array<double, 3> toEnu(const GeoPosition& p, const GeoPosition& origin);
 /// \brief The inverse of toEnu.
 GeoPosition fromEnu(const std::array<double, 3>& enu, const GeoPosition& origin);
+/// \brief Earth-centred, Earth-fixed (WGS84) metres of a position.
+std::array<double, 3> ecefOf(const GeoPosition& p);
+/// \brief The 4 x 4 matrix (column-major, as 3D Tiles' `transform`) that takes local
+/// east-north-up metres around `origin` to ECEF: columns east, north, up and the origin.
+std::array<double, 16> enuToEcefMatrix(const GeoPosition& origin);
 
 
 /// \brief The similarity from `from` to `to` (point pairs) with the least squared error (Umeyama

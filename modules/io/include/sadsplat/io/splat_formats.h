@@ -37,7 +37,9 @@
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sadsplat/common/gaussian_point.h"
 
@@ -64,6 +66,9 @@ struct SpzWriteOptions {
   /// quaternion bytes: what older viewers read, e.g. @mkkellogg/gaussian-splats-3d 0.4.7)
   int version = 3;
   bool antialiased = false;  ///< the header flag: the model was trained with antialiasing
+  /// store the cloud's axes as they are instead of RDF -> RUB (the glTF SPZ payload, whose
+  /// reader takes the axes as stored: gltf_splats.h)
+  bool axes_as_stored = false;
 };
 
 /// \brief What an `.spz` file's header says, and what reading it changed.
@@ -81,6 +86,14 @@ struct SpzFileInfo {
 /// \throws sadsplat::Error on bad options or values that are not writable
 void writeSpz(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
               const SpzWriteOptions& options = {});
+/// \brief The bytes writeSpz writes (`path` names the data in errors).
+std::vector<std::uint8_t> encodeSpz(const std::string& path,
+                                    const pcl::PointCloud<GaussianPoint>& cloud,
+                                    const SpzWriteOptions& options = {});
+/// \brief Decodes `.spz` bytes as readSpz does (`path` names them in errors); with
+/// `axes_as_stored`, the axes are not turned RUB -> RDF.
+pcl::PointCloud<GaussianPoint> decodeSpz(const std::string& path, const std::string& bytes,
+                                         SpzFileInfo* info = nullptr, bool axes_as_stored = false);
 /// \brief Reads `.spz` version 2, 3 or 4 into RDF axes.
 /// \throws sadsplat::Error naming the file and the field on a bad header, corrupt or truncated
 /// data, a count the data does not match (decompression stops at what the count needs) or a
