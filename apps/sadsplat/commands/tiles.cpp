@@ -30,6 +30,9 @@ class TilesCommand : public Command {
     c->add_option("--sh-degree", options_.sh_degree, "SH degrees kept (0..3)")
         ->check(CLI::Range(0, 3))
         ->capture_default_str();
+    c->add_flag("--color-by-class", options_.color_by_class,
+                "draw every splat in its class's colour (classes.json), no view-dependent colour: "
+                "the class map in 3D for clients that cannot style splats by feature ID");
     c->add_flag("!--merge-across-classes", options_.class_aware,
                 "levels of detail may merge Gaussians of different classes");
     return c;

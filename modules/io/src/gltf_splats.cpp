@@ -28,9 +28,8 @@ constexpr std::uint32_t kJsonChunk = 0x4e4f534a;  // "JSON"
 constexpr std::uint32_t kBinChunk = 0x004e4942;   // "BIN\0"
 constexpr int kFloat = 5126;
 constexpr int kUnsignedByte = 5121;
-constexpr int kUnsignedShort = 5123;
 constexpr int kArrayBuffer = 34962;
-constexpr std::uint16_t kNullFeature = 65535;
+constexpr std::uint32_t kNullFeature = 65535;
 constexpr const char* kSplat = "KHR_gaussian_splatting";
 constexpr const char* kSpz = "KHR_gaussian_splatting_compression_spz_2";
 constexpr const char* kPrefix = "KHR_gaussian_splatting:";
@@ -80,16 +79,19 @@ int shRestStart(int degree) { return degree * degree - 1; }
 void addFeatureIds(const pcl::PointCloud<GaussianPoint>& cloud, const GltfSplatOptions& options,
                    BinaryBuilder& b, json& primitive, json& gltf, json& used) {
   if (options.classes.empty()) return;
-  std::vector<std::uint16_t> ids(cloud.size());
-  std::set<std::uint16_t> present;
+  // Float IDs (exact below 2^24): a vertex attribute's elements must be 4-byte aligned, which
+  // tightly packed 16-bit IDs are not.
+  std::vector<float> ids(cloud.size());
+  std::set<std::uint32_t> present;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const std::uint32_t label = cloud[i].label;
-    ids[i] = label < options.classes.size() ? static_cast<std::uint16_t>(label) : kNullFeature;
-    if (ids[i] != kNullFeature) present.insert(ids[i]);
+    const std::uint32_t id = label < options.classes.size() ? label : kNullFeature;
+    ids[i] = static_cast<float>(id);
+    if (id != kNullFeature) present.insert(id);
   }
   if (present.empty()) return;
   primitive["attributes"]["_FEATURE_ID_0"] =
-      b.addAccessor(ids.data(), ids.size() * 2, ids.size(), "SCALAR", kUnsignedShort);
+      b.addAccessor(ids.data(), ids.size() * 4, ids.size(), "SCALAR", kFloat);
   primitive["extensions"]["EXT_mesh_features"] = {
       {"featureIds",
        json::array({{{"featureCount", present.size()},
@@ -425,9 +427,16 @@ pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatIn
   }
   GltfSplatInfo result;
   if (attributes.contains("_FEATURE_ID_0")) {
-    const std::vector<std::uint16_t> ids =
-        glb.values<std::uint16_t>(attributes["_FEATURE_ID_0"], "_FEATURE_ID_0", kUnsignedShort, 1, n);
-    for (std::size_t i = 0; i < n; ++i) cloud[i].label = ids[i] == kNullFeature ? kUnlabelled : ids[i];
+    const std::vector<float> ids =
+        glb.values<float>(attributes["_FEATURE_ID_0"], "_FEATURE_ID_0", kFloat, 1, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(ids[i] >= 0 && ids[i] <= kNullFeature) || ids[i] != std::floor(ids[i])) {
+        throw Error(path, "_FEATURE_ID_0 of splat " + std::to_string(i), "a whole number 0..65535",
+                    std::to_string(ids[i]));
+      }
+      const auto id = static_cast<std::uint32_t>(ids[i]);
+      cloud[i].label = id == kNullFeature ? kUnlabelled : id;
+    }
     const json& table = gltf.at("extensions").at("EXT_structural_metadata").at("propertyTables").at(0);
     const std::size_t classes = table.at("count");
     const json& names = table.at("properties").at("name");

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -32,7 +33,43 @@ Eigen::Matrix3d zUpToGltf() {
   return m;
 }
 
+// Where a client should look: the median centre of the Gaussians (floaters do not move it) and
+// the half-diagonal of the middle half of them (the dense scene, not its outliers), z-up frame.
+std::array<double, 4> lookAt(const pcl::PointCloud<GaussianPoint>& cloud) {
+  std::array<std::vector<double>, 3> xyz;
+  for (const GaussianPoint& p : cloud) {
+    xyz[0].push_back(p.x);
+    xyz[1].push_back(p.y);
+    xyz[2].push_back(p.z);
+  }
+  auto quantile = [](std::vector<double>& v, double q) {
+    const std::size_t k = static_cast<std::size_t>(q * (v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return v[k];
+  };
+  std::array<double, 4> out{};
+  double diagonal = 0;
+  for (int k = 0; k < 3; ++k) {
+    out[k] = quantile(xyz[k], 0.5);
+    const double spread = quantile(xyz[k], 0.75) - quantile(xyz[k], 0.25);
+    if (k < 2) diagonal += spread * spread;
+  }
+  out[3] = 0.5 * std::sqrt(diagonal);
+  return out;
+}
+
 }  // namespace
+
+void colorByClass(pcl::PointCloud<GaussianPoint>& cloud, const std::vector<ClassInfo>& classes) {
+  constexpr float kC0 = 0.28209479177387814f;
+  for (GaussianPoint& p : cloud) {
+    for (int c = 0; c < 3; ++c) {
+      const float rgb = p.label < classes.size() ? classes[p.label].color[c] / 255.0f : 0.5f;
+      p.f_dc[c] = (rgb - 0.5f) / kC0;
+    }
+    std::fill(std::begin(p.f_rest), std::end(p.f_rest), 0.0f);
+  }
+}
 
 UprightModel openUprightModel(const std::string& model_or_run) {
   const bool run = io::RunDirectory::isRun(model_or_run);
@@ -75,7 +112,13 @@ UprightModel openUprightModel(const std::string& model_or_run) {
 std::string exportTiles(const std::string& model_or_run, const std::string& out_dir,
                         const TilesExportOptions& options, std::ostream* progress) {
   const auto start = std::chrono::steady_clock::now();
-  const UprightModel m = openUprightModel(model_or_run);
+  UprightModel m = openUprightModel(model_or_run);
+  if (options.color_by_class) {
+    if (m.classes.empty()) {
+      throw Error(model_or_run, "--color-by-class", "a model with classes (classes.json)", "none");
+    }
+    colorByClass(m.cloud, m.classes);
+  }
   if (progress) *progress << "model: " << m.cloud.size() << " Gaussians; frame: " << m.frame << "\n";
   tiles::TileTreeOptions tree_options;
   tree_options.max_splats = options.max_splats;
@@ -90,7 +133,20 @@ std::string exportTiles(const std::string& model_or_run, const std::string& out_
   t.content.sh_degree = options.sh_degree;
   t.content.classes = m.classes;
   nlohmann::json extras = {{"generator", "sadsplat tiles"}, {"frame", m.frame}};
+  const std::array<double, 4> look = lookAt(m.cloud);
   if (m.georeference) {
+    const io::GeoPosition at = geo::fromEnu({look[0], look[1], look[2]}, m.georeference->origin);
+    extras["look_at"] = {{"latitude", at.latitude},
+                         {"longitude", at.longitude},
+                         {"height", at.altitude},
+                         {"radius", look[3]}};
+    const tiles::Tile& root = tree.tiles[0];
+    const io::GeoPosition box = geo::fromEnu({0.5 * (root.lo[0] + root.hi[0]),
+                                              0.5 * (root.lo[1] + root.hi[1]),
+                                              0.5 * (root.lo[2] + root.hi[2])},
+                                             m.georeference->origin);
+    extras["root_box_centre"] = {
+        {"latitude", box.latitude}, {"longitude", box.longitude}, {"height", box.altitude}};
     t.root_transform = geo::enuToEcefMatrix(m.georeference->origin);
     extras["georeferenced"] = true;
     extras["origin"] = {{"latitude", m.georeference->origin.latitude},
@@ -98,6 +154,7 @@ std::string exportTiles(const std::string& model_or_run, const std::string& out_
                         {"altitude", m.georeference->origin.altitude}};
   } else {
     extras["georeferenced"] = false;
+    extras["look_at"] = {{"x", look[0]}, {"y", look[1]}, {"z", look[2]}, {"radius", look[3]}};
     extras["note"] = "local tileset: no georeference, no root transform (place it in the client)";
   }
   if (!m.classes.empty()) {

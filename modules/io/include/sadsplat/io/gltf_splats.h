@@ -24,7 +24,8 @@
 ///   decodes it with coordinateSystem UNSPECIFIED and draws it as glTF content. The extension
 ///   text asks for LUF packing (x and z negated in the payload); docs/formats.md says what CesiumJS
 ///   shows for each.
-/// - `_FEATURE_ID_0` SCALAR unsigned short: the class id, 65535 (`nullFeatureId`) for an
+/// - `_FEATURE_ID_0` SCALAR float (whole numbers; vertex attributes must be 4-byte aligned, which
+///   packed 16-bit IDs are not): the class id, 65535 (`nullFeatureId`) for an
 ///   unlabelled splat; the property table `semantic_class` has one row per class: `name`
 ///   (STRING) and `color` (VEC3 UINT8). Written when classes are given and some splat has one.
 /// Buffer views are 8-byte aligned (EXT_structural_metadata asks it); JSON padded with spaces,

@@ -45,7 +45,14 @@ struct TilesExportOptions {
   bool spz = true;                 ///< SPZ-compressed content (else plain accessors)
   int sh_degree = 3;
   bool class_aware = true;         ///< levels of detail merge only Gaussians of one class
+  /// every splat drawn in its class's colour (classes.json; unlabelled: grey) with no
+  /// view-dependent colour: the class map in 3D for clients that cannot style splats by feature
+  /// ID (CesiumJS 1.145 does not)
+  bool color_by_class = false;
 };
+
+/// \brief Sets every Gaussian's colour to its class's (unlabelled: grey), SH degrees 1..3 zero.
+void colorByClass(pcl::PointCloud<GaussianPoint>& cloud, const std::vector<ClassInfo>& classes);
 
 /// \brief Writes the 3D Tiles tileset of `model_or_run` into `out_dir`; returns a summary
 /// (tiles, depth, splats, bytes, where it sits on Earth or that it is local).
