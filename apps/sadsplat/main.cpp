@@ -27,6 +27,7 @@ std::vector<std::unique_ptr<Command>> allCommands() {
   commands.push_back(makeRenderCommand());
   commands.push_back(makeOrthoCommand());
   commands.push_back(makeTilesCommand());
+  commands.push_back(makeCompactCommand());
   commands.push_back(makeTableCommand());
   commands.push_back(makeDemoCommand());
   commands.push_back(makeSynthCommand());

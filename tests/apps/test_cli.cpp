@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -193,6 +194,62 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
 
 // --schedule long: the run's config has the long schedule's keys (prune after the densification,
 // refine the last sixth), keys the user set stay; other schedule names are usage errors.
+TEST(Cli, CompactTilesAndGlbOfATrainedRun) {
+  if (!io::haveSceneImport()) GTEST_SKIP() << "built without OpenCV";
+  test::TempDir dir;
+  std::string out;
+  const std::string run = dir.file("run");
+  ASSERT_EQ(
+      test::runCommand(kCli + " train " + kScene + " --scale 1 --iterations 30 --out " + run, &out),
+      0)
+      << out;
+  const std::size_t n = io::readGaussianPly(run + "/model.ply").size();
+  ASSERT_GT(n, 20u);
+  // compact: a run directory with half the Gaussians that eval scores.
+  ASSERT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --out " + dir.file("half"),
+                             &out),
+            0)
+      << out;
+  EXPECT_EQ(io::readGaussianPly(dir.file("half") + "/model.ply").size(), (n + 1) / 2);
+  ASSERT_EQ(test::runCommand(kCli + " eval " + dir.file("half"), &out), 0) << out;
+  EXPECT_NE(out.find("\"num_gaussians\": " + std::to_string((n + 1) / 2)), std::string::npos)
+      << out;
+  // Exactly one of --count / --ratio / --model.
+  EXPECT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --count 3 --out " +
+                                 dir.file("bad"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("exactly one"), std::string::npos) << out;
+  // tiles: every Gaussian in one leaf; a local tileset (the fixture has no georeference).
+  ASSERT_EQ(test::runCommand(kCli + " tiles " + run + " --out " + dir.file("tiles") +
+                                 " --max-splats " + std::to_string(n / 3),
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("local tileset"), std::string::npos) << out;
+  const nlohmann::json t = nlohmann::json::parse(test::readFile(dir.file("tiles/tileset.json")));
+  EXPECT_EQ(t["extras"]["georeferenced"], false);
+  EXPECT_FALSE(t["root"].contains("transform"));
+  std::size_t leaf_splats = 0;
+  std::function<void(const nlohmann::json&)> walk = [&](const nlohmann::json& tile) {
+    const std::string glb = dir.file("tiles/" + tile["content"]["uri"].get<std::string>());
+    ASSERT_EQ(test::runCommand(kCli + " info " + glb, &out), 0) << out;
+    if (!tile.contains("children")) {
+      const auto at = out.find("gaussians: ");
+      ASSERT_NE(at, std::string::npos) << out;
+      leaf_splats += std::stoul(out.substr(at + 11));
+    }
+    for (const auto& c : tile.value("children", nlohmann::json::array())) walk(c);
+  };
+  walk(t["root"]);
+  EXPECT_EQ(leaf_splats, n);
+  // convert to .glb, and an unknown frame is said, not guessed silently.
+  ASSERT_EQ(test::runCommand(kCli + " convert " + run + " " + dir.file("m.glb"), &out), 0) << out;
+  EXPECT_NE(out.find("glTF axes"), std::string::npos) << out;
+  ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("m.glb"), &out), 0) << out;
+  EXPECT_NE(out.find("gaussians: " + std::to_string(n)), std::string::npos) << out;
+}
+
 TEST(Cli, TheLongScheduleSetsItsKeysAndKeepsGivenOnes) {
   test::TempDir dir;
   const std::string cache = std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache";

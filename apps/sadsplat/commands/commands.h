@@ -19,6 +19,7 @@ std::unique_ptr<Command> makeEvalCommand();
 std::unique_ptr<Command> makeRenderCommand();
 std::unique_ptr<Command> makeOrthoCommand();
 std::unique_ptr<Command> makeTilesCommand();
+std::unique_ptr<Command> makeCompactCommand();
 std::unique_ptr<Command> makeTableCommand();
 std::unique_ptr<Command> makeDemoCommand();
 std::unique_ptr<Command> makeSynthCommand();

@@ -8,7 +8,12 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <memory>
+#include <set>
+#include <tuple>
 #include <unordered_map>
+
+#include <pcl/kdtree/kdtree_flann.h>
 
 #include "sadsplat/common/error.h"
 
@@ -16,7 +21,7 @@ namespace sadsplat {
 namespace filters {
 namespace {
 
-constexpr double kMaxMergedAlpha = 0.99;
+constexpr double kMaxMergedAlpha = 0.999;
 constexpr double kMinMergedAlpha = 1e-6;
 constexpr double kMinVariance = 1e-20;
 
@@ -72,6 +77,14 @@ std::vector<std::size_t> groupInVoxels(const pcl::PointCloud<GaussianPoint>& clo
 
 double sigmoidOf(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
+// A Gaussian's weight in a merge: opacity x the area of its ellipsoid's footprint, up to a constant
+// (s0 s1 + s0 s2 + s1 s2: what it covers on screen, whichever way it is seen).
+double massOf(const GaussianPoint& p) {
+  const double s0 = std::exp(double(p.scale[0])), s1 = std::exp(double(p.scale[1])),
+               s2 = std::exp(double(p.scale[2]));
+  return sigmoidOf(p.opacity) * (s0 * s1 + s0 * s2 + s1 * s2);
+}
+
 }  // namespace
 
 GaussianPoint mergeGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
@@ -81,9 +94,7 @@ GaussianPoint mergeGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
   std::vector<double> mass(indices.size());
   double total = 0;
   for (std::size_t j = 0; j < indices.size(); ++j) {
-    const GaussianPoint& p = cloud[indices[j]];
-    mass[j] = sigmoidOf(p.opacity) *
-              std::exp(double(p.scale[0]) + double(p.scale[1]) + double(p.scale[2]));
+    mass[j] = massOf(cloud[indices[j]]);
     total += mass[j];
   }
   if (!(total > 0) || !std::isfinite(total)) {  // all transparent: an unweighted mean
@@ -121,18 +132,18 @@ GaussianPoint mergeGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(second);
   Eigen::Matrix3d axes = eigen.eigenvectors();
   if (axes.determinant() < 0) axes.col(0) = -axes.col(0);
-  double volume = 1;
+  double sd[3];
   for (int k = 0; k < 3; ++k) {
-    const double sd = std::sqrt(std::max(eigen.eigenvalues()[k], kMinVariance));
-    out.scale[k] = static_cast<float>(std::log(sd));
-    volume *= sd;
+    sd[k] = std::sqrt(std::max(eigen.eigenvalues()[k], kMinVariance));
+    out.scale[k] = static_cast<float>(std::log(sd[k]));
   }
+  const double area = sd[0] * sd[1] + sd[0] * sd[2] + sd[1] * sd[2];
   const Eigen::Quaterniond q(axes);
   out.rot[0] = static_cast<float>(q.w());
   out.rot[1] = static_cast<float>(q.x());
   out.rot[2] = static_cast<float>(q.y());
   out.rot[3] = static_cast<float>(q.z());
-  const double alpha = std::clamp(total / volume, kMinMergedAlpha, kMaxMergedAlpha);
+  const double alpha = std::clamp(total / area, kMinMergedAlpha, kMaxMergedAlpha);
   out.opacity = static_cast<float>(std::log(alpha / (1.0 - alpha)));
   out.x = static_cast<float>(mean.x());
   out.y = static_cast<float>(mean.y());
@@ -173,6 +184,94 @@ std::size_t countVoxelGroups(const pcl::PointCloud<GaussianPoint>& cloud,
   return groups;
 }
 
+namespace {
+
+// Cuts `idx` (a range of indices) into `target` groups (see compactGaussians) appended to `groups`.
+void splitIntoGroups(const pcl::PointCloud<GaussianPoint>& cloud, std::vector<std::size_t>::iterator first,
+                     std::vector<std::size_t>::iterator last, std::size_t target,
+                     std::vector<std::pair<std::size_t, std::size_t>>& groups, std::size_t base) {
+  const std::size_t n = static_cast<std::size_t>(last - first);
+  if (target <= 1 || n <= 1) {
+    groups.emplace_back(base, base + n);
+    return;
+  }
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  for (auto it = first; it != last; ++it) {
+    const GaussianPoint& p = cloud[*it];
+    const Eigen::Vector3d x(p.x, p.y, p.z);
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const std::size_t left_target = target / 2;
+  const std::size_t cut = std::clamp<std::size_t>(n * left_target / target, 1, n - 1);
+  std::nth_element(first, first + static_cast<std::ptrdiff_t>(cut), last,
+                   [&](std::size_t a, std::size_t b) {
+                     const float* pa = &cloud[a].x;
+                     const float* pb = &cloud[b].x;
+                     return pa[axis] < pb[axis] || (pa[axis] == pb[axis] && a < b);
+                   });
+  const auto middle = first + static_cast<std::ptrdiff_t>(cut);
+  splitIntoGroups(cloud, first, middle, left_target, groups, base);
+  splitIntoGroups(cloud, middle, last, target - left_target, groups, base + cut);
+}
+
+}  // namespace
+
+namespace {
+
+// What the pair cost needs of a Gaussian: covariance, its log-determinant, mass.
+struct Moments {
+  Eigen::Matrix3d sigma;
+  double log_det = 0;
+  double mass = 0;
+};
+
+Moments momentsOf(const GaussianPoint& p) {
+  Eigen::Quaterniond q(p.rot[0], p.rot[1], p.rot[2], p.rot[3]);
+  if (!(q.norm() > 0)) q = Eigen::Quaterniond::Identity();
+  const Eigen::Matrix3d r = q.normalized().toRotationMatrix();
+  const Eigen::Vector3d v(std::exp(2.0 * p.scale[0]) + kMinVariance,
+                          std::exp(2.0 * p.scale[1]) + kMinVariance,
+                          std::exp(2.0 * p.scale[2]) + kMinVariance);
+  Moments m;
+  m.sigma = r * v.asDiagonal() * r.transpose();
+  m.log_det = std::log(v[0]) + std::log(v[1]) + std::log(v[2]);
+  m.mass = massOf(p);
+  return m;
+}
+
+// The cost of merging a and b: the entropy the moment-matched Gaussian adds over its two parts,
+// 0.5 (log det S - p_a log det S_a - p_b log det S_b) (>= 0, independent of the scene's scale:
+// near, overlapping pairs of any size are cheap), plus the squared difference of their colour
+// (all SH coefficients), as splat-transform's decimation (NanoGS) weighs shape against colour.
+double pairCost(const GaussianPoint& a, const Moments& ma, const GaussianPoint& b,
+                const Moments& mb) {
+  const double total = ma.mass + mb.mass;
+  const double pa = total > 0 ? std::clamp(ma.mass / total, 1e-12, 1 - 1e-12) : 0.5;
+  const double pb = 1 - pa;
+  const Eigen::Vector3d d(double(a.x) - b.x, double(a.y) - b.y, double(a.z) - b.z);
+  const Eigen::Matrix3d merged = pa * ma.sigma + pb * mb.sigma + pa * pb * d * d.transpose();
+  const double geometric =
+      0.5 * (std::log(std::max(merged.determinant(), 1e-300)) - pa * ma.log_det - pb * mb.log_det);
+  double colour = 0;
+  for (int c = 0; c < 3; ++c) colour += (a.f_dc[c] - b.f_dc[c]) * (a.f_dc[c] - b.f_dc[c]);
+  for (int c = 0; c < 3 * kShRestPerChannel; ++c) {
+    colour += (a.f_rest[c] - b.f_rest[c]) * (a.f_rest[c] - b.f_rest[c]);
+  }
+  return geometric + colour;
+}
+
+// The merged Gaussians' members' bounding boxes, to say how far a merge reaches.
+struct Reach {
+  Eigen::Vector3f lo, hi;
+  std::size_t members = 1;
+};
+
+}  // namespace
+
 CompactResult compactGaussians(const pcl::PointCloud<GaussianPoint>& cloud, std::size_t target,
                                bool class_aware) {
   if (target == 0) throw Error("<compact>", "target count", "at least 1 Gaussian", "0");
@@ -181,36 +280,100 @@ CompactResult compactGaussians(const pcl::PointCloud<GaussianPoint>& cloud, std:
     result.cloud = cloud;
     return result;
   }
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d hi = -lo;
-  for (const GaussianPoint& p : cloud) {
-    const Eigen::Vector3d x(p.x, p.y, p.z);
-    lo = lo.cwiseMin(x);
-    hi = hi.cwiseMax(x);
-  }
-  const double extent = std::max((hi - lo).maxCoeff(), 1e-6);
-  GaussianMergeOptions o;
-  o.class_aware = class_aware;
-  double small = extent * 1e-7, large = extent * 2;
-  o.voxel_size = large;
-  const std::size_t fewest = countVoxelGroups(cloud, o);
-  if (fewest > target) {
+  std::set<std::uint32_t> labels;
+  for (const GaussianPoint& p : cloud) labels.insert(class_aware ? p.label : 0u);
+  if (labels.size() > target) {
     throw Error("<compact>", "target count",
-                "at least the number of classes present (" + std::to_string(fewest) +
+                "at least the number of classes present (" + std::to_string(labels.size()) +
                     "): class-aware merging keeps one Gaussian per class",
                 std::to_string(target));
   }
-  while (large / small > 1.01) {
-    o.voxel_size = std::sqrt(small * large);
-    if (countVoxelGroups(cloud, o) <= target) {
-      large = o.voxel_size;
-    } else {
-      small = o.voxel_size;
-    }
+  auto current = std::make_shared<pcl::PointCloud<GaussianPoint>>(cloud);
+  std::vector<Reach> reach(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    reach[i].lo = reach[i].hi = Eigen::Vector3f(cloud[i].x, cloud[i].y, cloud[i].z);
   }
-  o.voxel_size = large;
-  result.cloud = mergeInVoxels(cloud, o);
-  result.voxel_size = large;
+  int neighbours = 8;
+  while (current->size() > target) {
+    const std::size_t n = current->size();
+    const std::size_t need = n - target;
+    std::vector<Moments> moments(n);
+    for (std::size_t i = 0; i < n; ++i) moments[i] = momentsOf((*current)[i]);
+    pcl::KdTreeFLANN<GaussianPoint> tree;
+    tree.setInputCloud(current);
+    // Each Gaussian's cheapest partner among its nearest neighbours (of its class).
+    std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+    pairs.reserve(n);
+    pcl::Indices found;
+    std::vector<float> distances;
+    const int k = static_cast<int>(std::min<std::size_t>(n, neighbours + 1));
+    for (std::size_t i = 0; i < n; ++i) {
+      tree.nearestKSearch((*current)[i], k, found, distances);
+      double best = std::numeric_limits<double>::max();
+      std::size_t partner = i;
+      for (const auto f : found) {
+        const std::size_t j = static_cast<std::size_t>(f);
+        if (j == i || (class_aware && (*current)[j].label != (*current)[i].label)) continue;
+        const double c = pairCost((*current)[i], moments[i], (*current)[j], moments[j]);
+        if (c < best) {
+          best = c;
+          partner = j;
+        }
+      }
+      if (partner != i) pairs.emplace_back(best, std::min(i, partner), std::max(i, partner));
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<std::size_t> partner_of(n, n);
+    std::size_t accepted = 0;
+    for (const auto& [cost, a, b] : pairs) {
+      if (accepted == need) break;
+      if (partner_of[a] != n || partner_of[b] != n) continue;
+      partner_of[a] = b;
+      partner_of[b] = a;
+      ++accepted;
+    }
+    if (accepted == 0) {
+      if (neighbours >= 256) {
+        throw Error("<compact>", "target count", "Gaussians with a neighbour of their class to merge",
+                    "none left within 256 neighbours");
+      }
+      neighbours *= 4;  // a class's Gaussians lie apart: look further
+      continue;
+    }
+    auto next = std::make_shared<pcl::PointCloud<GaussianPoint>>();
+    next->reserve(n - accepted);
+    std::vector<Reach> next_reach;
+    next_reach.reserve(n - accepted);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (partner_of[i] == n) {
+        next->push_back((*current)[i]);
+        next_reach.push_back(reach[i]);
+      } else if (partner_of[i] > i) {
+        const std::size_t j = partner_of[i];
+        next->push_back(mergeGaussians(*current, {i, j}));
+        Reach r;
+        r.lo = reach[i].lo.cwiseMin(reach[j].lo);
+        r.hi = reach[i].hi.cwiseMax(reach[j].hi);
+        r.members = reach[i].members + reach[j].members;
+        next_reach.push_back(r);
+      }
+    }
+    current = next;
+    reach = std::move(next_reach);
+  }
+  std::vector<double> extents;
+  for (const Reach& r : reach) {
+    if (r.members > 1) extents.push_back(static_cast<double>((r.hi - r.lo).norm()));
+  }
+  if (!extents.empty()) {
+    const std::size_t q = std::min(extents.size() - 1, (extents.size() * 9) / 10);
+    std::nth_element(extents.begin(), extents.begin() + static_cast<std::ptrdiff_t>(q), extents.end());
+    result.group_extent = extents[q];
+  }
+  result.cloud = std::move(*current);
+  result.cloud.width = static_cast<std::uint32_t>(result.cloud.size());
+  result.cloud.height = 1;
+  result.cloud.is_dense = true;
   return result;
 }
 

@@ -524,6 +524,38 @@ pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {
   return gaussians::toCloud(t);
 }
 
+at::Tensor Trainer::effectiveOpacity() const {
+  return state_->drop.effectiveOpacity(state_->params, state_->iteration).to(at::kCPU);
+}
+
+void Trainer::setGaussians(const pcl::PointCloud<GaussianPoint>& cloud) {
+  if (cloud.empty()) throw Error("<setGaussians>", "Gaussians", "at least one", "none");
+  TensorArchive a = checkpointSnapshot();
+  const std::int64_t d = state_->params["features"].value.size(1);
+  const GaussianTensors t = fromCloud(cloud, at::kCPU, static_cast<int>(d));
+  const std::map<std::string, at::Tensor> values = {
+      {"means", t.means},           {"sh_dc", t.sh_dc},   {"sh_rest", t.sh_rest},
+      {"opacity", t.opacity_logit}, {"scales", t.log_scales}, {"quats", t.rotations},
+      {"features", t.features},     {"log_alpha", t.log_alpha}};
+  for (const std::string& name : checkpointRowTensors()) {
+    auto entry = a.tensors.find(name);
+    if (entry == a.tensors.end() || !entry->second.defined()) continue;
+    at::Tensor& old = entry->second;
+    const auto value = values.find(name);
+    if (value != values.end()) {
+      if (value->second.sizes().slice(1) != old.sizes().slice(1)) {
+        throw Error("<setGaussians>", name, "rows shaped as the model's", "another shape");
+      }
+      old = value->second.to(old.scalar_type()).contiguous();
+    } else {
+      std::vector<std::int64_t> shape = old.sizes().vec();
+      shape[0] = t.size();
+      old = at::zeros(shape, old.options());
+    }
+  }
+  loadCheckpoint(a, "<setGaussians>");
+}
+
 TensorArchive Trainer::checkpointSnapshot() const {
   const State& s = *state_;
   TensorArchive a;

@@ -7,6 +7,7 @@
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/pcd.h"
 #include "sadsplat/io/semantic_ply.h"
+#include "sadsplat/io/gltf_splats.h"
 #include "sadsplat/io/splat_formats.h"
 
 namespace sadsplat {
@@ -16,7 +17,7 @@ namespace {
 [[noreturn]] void unknownExtension(const std::string& path, const std::string& kind) {
   throw Error(path, "file name",
               "a " + kind + " file ending in .ply or .pcd" +
-                  (kind == "Gaussian cloud" ? std::string(" (or .splat, .spz, .sog)")
+                  (kind == "Gaussian cloud" ? std::string(" (or .splat, .spz, .sog, .glb)")
                                             : std::string()),
               lowerExtension(path).empty() ? "no extension" : lowerExtension(path));
 }
@@ -31,7 +32,7 @@ bool isCompressedPlyName(const std::string& path) {
 
 CloudKind cloudKind(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".splat" || ext == ".spz" || ext == ".sog") {
+  if (ext == ".splat" || ext == ".spz" || ext == ".sog" || ext == ".glb") {
     requireRegularFile(path);
     return CloudKind::kGaussians;
   }
@@ -77,6 +78,8 @@ pcl::PointCloud<GaussianPoint> readGaussians(const std::string& path,
     SogFileInfo info;
     cloud = readSog(path, &info);
     clamped = info.clamped_opacities;
+  } else if (ext == ".glb") {
+    cloud = readSplatGlb(path);  // glTF's y-up axes, as written
   } else {
     unknownExtension(path, "Gaussian cloud");
   }

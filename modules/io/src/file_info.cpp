@@ -21,6 +21,7 @@
 #include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/io/gltf_splats.h"
 #include "sadsplat/io/splat_formats.h"
 
 namespace sadsplat {
@@ -257,7 +258,8 @@ std::string describeFile(const std::string& path) {
   if (!pathExists(path)) throw Error(path, "file", "an existing file or directory", "missing");
   if (isDirectory(path)) {
     const std::string ext = lowerExtension(path);
-    if (ext == ".ply" || ext == ".pcd" || ext == ".splat" || ext == ".spz" || ext == ".sog") {
+    if (ext == ".ply" || ext == ".pcd" || ext == ".splat" || ext == ".spz" || ext == ".sog" ||
+        ext == ".glb") {
       throw Error(path, "file", "a " + ext + " file", "a directory");
     }
     if (RunDirectory::isRun(path)) {
@@ -318,6 +320,19 @@ std::string describeFile(const std::string& path) {
     if (info.extensions) out << "extensions: present (skipped)\n";
     describeClamped(out, info.clamped_opacities);
     describeGaussians(out, cloud);
+  } else if (ext == ".glb") {
+    GltfSplatInfo info;
+    const auto cloud = readSplatGlb(path, &info);
+    out << path << ": glTF KHR_gaussian_splatting (" << (info.spz ? "SPZ payload" : "plain accessors")
+        << ", glTF y-up axes)\n"
+        << "SH degree: " << info.sh_degree << "\n"
+        << "classes: ";
+    if (info.class_names.empty()) out << "none";
+    for (std::size_t c = 0; c < info.class_names.size(); ++c) {
+      out << (c ? ", " : "") << info.class_names[c];
+    }
+    out << "\n";
+    describeGaussians(out, cloud);
   } else if (ext == ".sog") {
     SogFileInfo info;
     const auto cloud = readSog(path, &info);
@@ -335,7 +350,7 @@ std::string describeFile(const std::string& path) {
     describeGaussians(out, loadGaussianPcd(path));
   } else {
     throw Error(path, "file type",
-                "a .ply, .pcd, .splat, .spz, .sog or .las file, a scene cache or a scene directory",
+                "a .ply, .pcd, .splat, .spz, .sog, .glb or .las file, a scene cache or a scene directory",
                 ext.empty() ? "no extension" : ext);
   }
   // Whatever else came from the file: no control byte reaches the terminal (the lines stay).

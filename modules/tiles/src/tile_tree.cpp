@@ -66,8 +66,8 @@ class Builder {
     Tile& tile = tree.tiles[index];
     tile.children = std::move(children);
     tile.content = std::move(merged.cloud);
-    tile.merge_voxel = merged.voxel_size;
-    tile.geometric_error = std::max(std::sqrt(3.0) * merged.voxel_size,
+    tile.merge_extent = merged.group_extent;
+    tile.geometric_error = std::max(merged.group_extent,
                                     kErrorGrowth * child_error + 1e-3);
     boxOf(tile.content, tile);
     for (std::size_t c : tile.children) {

@@ -5,12 +5,13 @@
 /// default, class for class (a road Gaussian never merges into a roof). The levels of detail of
 /// a 3D Tiles tileset and `sadsplat compact` are made with it.
 ///
-/// A group G merges into one Gaussian with the group's mass m_i = alpha_i s_i0 s_i1 s_i2
-/// (opacity times volume) as weights: centre mu = sum m_i mu_i / M, covariance
-/// Sigma = sum m_i (Sigma_i + (mu_i - mu)(mu_i - mu)^T) / M (the second moment of the mixture),
-/// its eigenvectors the rotation and the square roots of its eigenvalues the scales; opacity
-/// M / (s0 s1 s2) (the mass kept), at most 0.99; colour (all SH), feature, gate and confidence
-/// the m-weighted means; label the group's (or, not class-aware, the label of the largest mass).
+/// A group G merges into one Gaussian with the group's masses m_i = alpha_i (s_i0 s_i1 + s_i0 s_i2 +
+/// s_i1 s_i2) (opacity times the ellipsoid's footprint area, up to a constant) as weights: centre
+/// mu = sum m_i mu_i / M, covariance Sigma = sum m_i (Sigma_i + (mu_i - mu)(mu_i - mu)^T) / M (the
+/// second moment of the mixture), its eigenvectors the rotation and the square roots of its
+/// eigenvalues the scales; opacity M / (s0 s1 + s0 s2 + s1 s2) (the mass kept), at most 0.999;
+/// colour (all SH), feature, gate and confidence the m-weighted means; label the group's (or, not
+/// class-aware, the label of the largest mass).
 /// A group of one is kept bit for bit.
 
 #include <pcl/point_cloud.h>
@@ -50,12 +51,18 @@ std::size_t countVoxelGroups(const pcl::PointCloud<GaussianPoint>& cloud,
 /// \brief The result of compactGaussians.
 struct CompactResult {
   pcl::PointCloud<GaussianPoint> cloud;
-  double voxel_size = 0;  ///< the cell edge used (0: nothing merged)
+  /// the 90th percentile over the merged Gaussians of their members' centres' bounding-box
+  /// diagonal (scene units): how far a merged Gaussian stands for its members (0: none merged)
+  double group_extent = 0;
 };
 
-/// \brief At most `target` Gaussians: the cloud unchanged when it has no more, else merged in
-/// the smallest voxels (bisected on a log scale to 1 %) that leave at most `target`.
-/// \throws sadsplat::Error when `target` is 0 or the labels alone leave more groups (class-aware)
+/// \brief Exactly `target` Gaussians (the cloud unchanged when it has no more), by rounds of
+/// pairwise merges: each Gaussian's cheapest partner among its 8 nearest neighbours of its class
+/// (class-aware), the cheapest disjoint pairs merged until the count is reached (at most halving
+/// per round; the search widens when no pair is left). The cost of a pair: the entropy its
+/// moment-matched merge adds, 0.5 (log det Sigma - p_i log det Sigma_i - p_j log det Sigma_j),
+/// plus the squared difference of their SH colour (as splat-transform's decimation weighs them).
+/// \throws sadsplat::Error when `target` is 0 or below the number of labels (class-aware)
 CompactResult compactGaussians(const pcl::PointCloud<GaussianPoint>& cloud, std::size_t target,
                                bool class_aware = true);
 

@@ -123,6 +123,15 @@ class Trainer {
   /// log_alpha / confidence as stored.
   pcl::PointCloud<GaussianPoint> toCloud() const;
   std::int64_t numGaussians() const;
+  /// \brief [N] the opacity each Gaussian renders with at evaluation: sigmoid of its logit, times
+  /// the drop's deterministic gate while gates are on.
+  at::Tensor effectiveOpacity() const;
+  /// \brief Replaces the Gaussians by `cloud` (its features in this model's feature space, e.g.
+  /// merges of this model's Gaussians): parameters from the cloud, their Adam moments and every
+  /// per-Gaussian statistic restarted at zero; the decoder, the drop's guard and the iteration
+  /// stay. For evaluating a simplified model with this run's decoder (`sadsplat compact`).
+  /// \throws sadsplat::Error for an empty cloud
+  void setGaussians(const pcl::PointCloud<GaussianPoint>& cloud);
 
   /// \brief Every tensor of the training state, copied to host memory: the archive stays as it
   /// is while training goes on (for writing it on another thread).

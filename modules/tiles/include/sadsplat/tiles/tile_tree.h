@@ -8,8 +8,9 @@
 /// Gaussians than the budget splits its rectangle in four at its middle (half-open cells; empty
 /// quarters dropped; Gaussians at one spot split by index); its content is then
 /// filters::compactGaussians of all Gaussians below it (class-aware by default). Geometric error
-/// (metres, what 3D Tiles refines by): 0 for a leaf; for an inner tile the diagonal of its merge
-/// voxel, and at least 1.5 x its children's largest, so it strictly decreases down the tree.
+/// (metres, what 3D Tiles refines by): 0 for a leaf; for an inner tile the 90th percentile of its
+/// merge groups' extent, and at least 1.5 x its children's largest, so it strictly decreases down
+/// the tree.
 
 #include <pcl/point_cloud.h>
 
@@ -33,7 +34,7 @@ struct TileTreeOptions {
 struct Tile {
   std::array<double, 3> lo{}, hi{};  ///< axis-aligned box of the content's 3-sigma extents
   double geometric_error = 0;        ///< 0 for a leaf
-  double merge_voxel = 0;            ///< the merge's voxel edge (0: the Gaussians themselves)
+  double merge_extent = 0;  ///< CompactResult::group_extent of its merge (0: the Gaussians themselves)
   int level = 0;
   std::vector<std::size_t> children;  ///< indices into TileTree::tiles
   std::vector<std::size_t> source;    ///< leaf: indices of its Gaussians in the input cloud
