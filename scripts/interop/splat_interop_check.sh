@@ -7,6 +7,7 @@
 # 2. splat-transform writes MODEL as .spz v4, .sog and .compressed.ply, and a plain .ply of its
 #    decode (where 255 alphas are +inf); sadsplat reads each (`info`, `convert` to .ply) and the
 #    counts are compared; the .spz's attributes as in 1.
+# 3. sadsplat writes MODEL as .sog; splat-transform reads it with the same count.
 # Prints one line per check and OUT_DIR/summary.txt; exit 1 if any check fails. Needs node, npm
 # and the npm registry (the tools go to .deps/splat-tools, git-ignored). Not part of CI.
 set -euo pipefail
@@ -60,4 +61,16 @@ for f in st.spz st.sog st.compressed.ply st_decoded.ply; do
   fi
 done
 check "splat-transform .spz v4 read by sadsplat" ply "$out/sadsplat_from_st.spz.ply"
+
+# sadsplat's .sog read by splat-transform: the same count and bounding box (its codebooks make
+# the per-Gaussian error larger than SPZ's, so no attribute-wise check here).
+"$cli" convert "$model" "$out/sadsplat.sog"
+st -g cpu "$out/sadsplat.sog" "$out/st_from_sadsplat_sog.ply" >/dev/null 2>&1 || true
+if [ -f "$out/st_from_sadsplat_sog.ply" ] &&
+   m=$("$cli" info "$out/st_from_sadsplat_sog.ply" | sed -n 's/^gaussians: //p') && [ "$m" = "$n" ]; then
+  report "PASS splat-transform reads sadsplat's .sog: $m Gaussians, $("$cli" info "$out/st_from_sadsplat_sog.ply" | grep 'bounding box') (model: $("$cli" info "$model" | grep 'bounding box'))"
+else
+  report "FAIL splat-transform reads sadsplat's .sog"
+  failed=1
+fi
 exit $failed

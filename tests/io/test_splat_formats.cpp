@@ -197,6 +197,47 @@ TEST(SplatFormats, ReadsSplatTransformSogAndCompressedPlyAsItsOwnDecoder) {
 }
 
 // Version 2 (for older viewers): the same except the quaternion, whose w is derived from x y z.
+TEST(SplatFormats, SogRoundTripWithinItsQuantisation) {
+  if (!io::haveSogSupport()) GTEST_SKIP() << "built without libwebp";
+  test::TempDir dir;
+  const auto cloud = plausibleGaussians(500);
+  io::writeGaussians(dir.file("m.sog"), cloud);
+  io::SogFileInfo info;
+  const auto back = io::readSog(dir.file("m.sog"), &info);
+  ASSERT_EQ(back.size(), cloud.size());
+  EXPECT_EQ(info.sh_bands, 3);
+  double position = 0, scale = 0, colour = 0, alpha = 0, sh = 0, rotation = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto& a = cloud[i];
+    const auto& b = back[i];
+    // 16 bits of log(1 + |x|) over [-log 51, log 51]: a step of ~1.2e-4 in log space.
+    const float xyz_a[3] = {a.x, a.y, a.z}, xyz_b[3] = {b.x, b.y, b.z};
+    for (int k = 0; k < 3; ++k) {
+      position = std::max(position, double(std::fabs(xyz_a[k] - xyz_b[k]) / (1 + std::fabs(xyz_a[k]))));
+    }
+    for (int k = 0; k < 3; ++k) {
+      scale = std::max(scale, double(std::fabs(a.scale[k] - b.scale[k])));
+      colour = std::max(colour, double(std::fabs(a.f_dc[k] - b.f_dc[k])));
+    }
+    alpha = std::max(alpha, std::fabs(1 / (1 + std::exp(-double(a.opacity))) -
+                                      1 / (1 + std::exp(-double(b.opacity)))));
+    for (int k = 0; k < 45; ++k) sh = std::max(sh, double(std::fabs(a.f_rest[k] - b.f_rest[k])));
+    const auto qa = unit(a.rot), qb = unit(b.rot);
+    double dot = 0;
+    for (int k = 0; k < 4; ++k) dot += qa[k] * qb[k];
+    rotation = std::max(rotation, 1 - std::fabs(dot));
+  }
+  EXPECT_LT(position, 1.5e-4);
+  EXPECT_LT(scale, 0.05);   // 256 entries over [-7, 1]: half a gap of ~0.03
+  EXPECT_LT(colour, 0.02);  // over [-1.7, 1.7]
+  EXPECT_LT(alpha, 0.5 / 255 + 1e-4);
+  EXPECT_LT(sh, 0.01);      // over [-0.9, 0.9]
+  EXPECT_LT(rotation, 2e-4);
+  // Smaller than the .spz of the same model would not be a fair bound (no gzip); the float PLY's
+  // 248 bytes per Gaussian is.
+  EXPECT_LT(test::readFile(dir.file("m.sog")).size(), 500u * 120);
+}
+
 TEST(SplatFormats, SpzVersion2ReadsBack) {
   test::TempDir dir;
   auto cloud = plausibleGaussians(100);

@@ -17,11 +17,11 @@ class ConvertCommand : public Command {
   CLI::App* add(CLI::App& app) override {
     CLI::App* c = app.add_subcommand(
         "convert",
-        "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz (also read: .sog, .compressed.ply), "
+        "Convert a cloud: Gaussians .ply/.pcd/.splat/.spz/.sog/.glb (also read: .compressed.ply), "
         "semantic clouds .ply/.pcd");
     c->add_option("IN", in_, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")->required();
     c->add_option("OUT", out_,
-                  "output .ply, .pcd, .splat, .spz, .las (LAS 1.4: centres, colour, ASPRS "
+                  "output .ply, .pcd, .splat, .spz, .sog (PlayCanvas), .las (LAS 1.4: centres, colour, ASPRS "
                   "class, in the georeference's UTM zone) or .glb (glTF KHR_gaussian_splatting, "
                   "SPZ-compressed, classes as feature IDs, upright in glTF's y-up axes); "
                   "classes.json and georeference.json are read from the input's folder")

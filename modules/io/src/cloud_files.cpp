@@ -89,11 +89,11 @@ pcl::PointCloud<GaussianPoint> readGaussians(const std::string& path,
 
 void writeGaussians(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".sog" || isCompressedPlyName(path)) {
+  if (isCompressedPlyName(path)) {
     throw Error(path, "file name",
-                "an output sadsplat writes: .ply, .pcd, .splat or .spz (PlayCanvas' .sog and "
-                ".compressed.ply are read only: write .ply and convert it with splat-transform)",
-                "not supported: writing " + std::string(ext == ".sog" ? ".sog" : ".compressed.ply"));
+                "an output sadsplat writes: .ply, .pcd, .splat, .spz or .sog (PlayCanvas' "
+                ".compressed.ply is read only: write .ply and convert it with splat-transform)",
+                "not supported: writing .compressed.ply");
   }
   if (ext == ".ply") {
     writeGaussianPly(path, cloud);
@@ -103,6 +103,8 @@ void writeGaussians(const std::string& path, const pcl::PointCloud<GaussianPoint
     writeSplat(path, cloud);
   } else if (ext == ".spz") {
     writeSpz(path, cloud);
+  } else if (ext == ".sog") {
+    writeSog(path, cloud);
   } else {
     unknownExtension(path, "Gaussian cloud");
   }

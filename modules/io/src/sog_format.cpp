@@ -5,6 +5,8 @@
 // (three components around 0.5 in units of 1/sqrt(2), alpha = 252 + index of the largest);
 // sh0 {codebook[256], files} (r g b codebook indices, alpha = 255 sigmoid(opacity)); shN
 // {count, bands, codebook[256], files [centroids, labels]} (optional). Axes as the PLY.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,6 +16,7 @@
 
 #if SADSPLAT_HAVE_WEBP
 #include <webp/decode.h>
+#include <webp/encode.h>
 #endif
 
 #include "sadsplat/common/error.h"
@@ -252,12 +255,205 @@ pcl::PointCloud<GaussianPoint> readSog(const std::string& path, SogFileInfo* inf
   return cloud;
 }
 
+namespace {
+
+constexpr std::size_t kCodebook = 256;
+constexpr std::size_t kMaxPalette = 65536;
+
+// 256 values that stand for `values` with the least squared error (1D k-means: quantiles, then
+// Lloyd's iterations on the sorted values), ascending.
+std::vector<float> codebookOf(std::vector<float> values) {
+  std::sort(values.begin(), values.end());
+  std::vector<double> prefix(values.size() + 1, 0.0);
+  for (std::size_t i = 0; i < values.size(); ++i) prefix[i + 1] = prefix[i] + values[i];
+  std::vector<float> book(kCodebook);
+  for (std::size_t k = 0; k < kCodebook; ++k) {
+    book[k] = values[std::min(values.size() - 1, (2 * k + 1) * values.size() / (2 * kCodebook))];
+  }
+  for (int iteration = 0; iteration < 16; ++iteration) {
+    std::size_t from = 0;
+    for (std::size_t k = 0; k < kCodebook; ++k) {
+      const std::size_t to =
+          k + 1 == kCodebook
+              ? values.size()
+              : static_cast<std::size_t>(std::upper_bound(values.begin(), values.end(),
+                                                          0.5f * (book[k] + book[k + 1])) -
+                                         values.begin());
+      if (to > from) book[k] = static_cast<float>((prefix[to] - prefix[from]) / (to - from));
+      from = std::max(from, to);
+    }
+    std::sort(book.begin(), book.end());
+  }
+  return book;
+}
+
+// The index of the codebook entry nearest to v (the book ascending).
+std::uint8_t nearestEntry(const std::vector<float>& book, float v) {
+  const auto it = std::lower_bound(book.begin(), book.end(), v);
+  std::size_t k = static_cast<std::size_t>(it - book.begin());
+  if (k == book.size() || (k > 0 && v - book[k - 1] < book[k] - v)) --k;
+  return static_cast<std::uint8_t>(k);
+}
+
+// A lossless WebP of an RGBA image.
+std::string encodeWebp(const std::string& path, const std::vector<std::uint8_t>& rgba, int width,
+                       int height, const std::string& name) {
+  std::uint8_t* out = nullptr;
+  const std::size_t size = WebPEncodeLosslessRGBA(rgba.data(), width, height, width * 4, &out);
+  if (size == 0 || out == nullptr) {
+    throw Error(path, "ZIP entry " + name, "a WebP image libwebp can encode",
+                std::to_string(width) + "x" + std::to_string(height) + " failed");
+  }
+  std::string bytes(reinterpret_cast<const char*>(out), size);
+  WebPFree(out);
+  return bytes;
+}
+
+}  // namespace
+
+void writeSog(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
+              const SogWriteOptions& options) {
+  if (options.sh_degree < 0 || options.sh_degree > kMaxShDegree) {
+    throw Error(path, "SH degree option", "0..3", std::to_string(options.sh_degree));
+  }
+  checkWritableGaussians(path, cloud);
+  const std::size_t n = cloud.size();
+  if (n == 0) throw Error(path, "Gaussians", "at least one", "an empty cloud");
+  if (n > kMaxCount) throw Error(path, "Gaussian count", "at most 2^28", std::to_string(n));
+  // One pixel per Gaussian, row-major, in images 4-pixel aligned.
+  const int width = static_cast<int>((static_cast<std::size_t>(std::ceil(std::sqrt(double(n)))) + 3) / 4 * 4);
+  const int height = static_cast<int>((n + width - 1) / width);
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  auto image = [&] { return std::vector<std::uint8_t>(4 * pixels, 0); };
+
+  // Means: sign(x) log(1 + |x|) per axis, 16 bits between its min and max (low and high bytes).
+  std::array<float, 3> lo{}, hi{};
+  lo.fill(std::numeric_limits<float>::max());
+  hi.fill(std::numeric_limits<float>::lowest());
+  const auto logOf = [](float v) { return v < 0 ? -std::log1p(-v) : std::log1p(v); };
+  for (const GaussianPoint& p : cloud) {
+    const float xyz[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], logOf(xyz[k]));
+      hi[k] = std::max(hi[k], logOf(xyz[k]));
+    }
+  }
+  std::vector<std::uint8_t> means_l = image(), means_u = image(), quats = image(),
+                            scales = image(), sh0 = image();
+  std::vector<float> scale_values, colour_values;
+  scale_values.reserve(3 * n);
+  colour_values.reserve(3 * n);
+  for (const GaussianPoint& p : cloud) {
+    for (int k = 0; k < 3; ++k) {
+      scale_values.push_back(p.scale[k]);
+      colour_values.push_back(p.f_dc[k]);
+    }
+  }
+  const std::vector<float> scale_book = codebookOf(scale_values);
+  const std::vector<float> colour_book = codebookOf(colour_values);
+  for (std::size_t i = 0; i < n; ++i) {
+    const GaussianPoint& p = cloud[i];
+    const std::size_t o = 4 * i;
+    const float xyz[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      const float span = hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1.0f;
+      const auto q = static_cast<std::uint32_t>(
+          std::lround(std::clamp((logOf(xyz[k]) - lo[k]) / span, 0.0f, 1.0f) * 65535.0f));
+      means_l[o + k] = static_cast<std::uint8_t>(q & 0xff);
+      means_u[o + k] = static_cast<std::uint8_t>(q >> 8);
+      scales[o + k] = nearestEntry(scale_book, p.scale[k]);
+      sh0[o + k] = nearestEntry(colour_book, p.f_dc[k]);
+    }
+    means_l[o + 3] = means_u[o + 3] = scales[o + 3] = 255;
+    sh0[o + 3] = splat_codec::toByte(255.0f * splat_codec::sigmoid(p.opacity));
+    // Quaternion (w, x, y, z): the largest component made positive and left out, the other three
+    // in units of 1/sqrt(2) around 0.5, the alpha 252 + the largest's index.
+    auto q = splat_codec::unitQuaternion(p);
+    int largest = 0;
+    for (int k = 1; k < 4; ++k) {
+      if (std::fabs(q[k]) > std::fabs(q[largest])) largest = k;
+    }
+    if (q[largest] < 0) {
+      for (float& v : q) v = -v;
+    }
+    int j = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (k == largest) continue;
+      quats[o + j++] = splat_codec::toByte((q[k] * std::sqrt(2.0f) * 0.5f + 0.5f) * 255.0f);
+    }
+    quats[o + 3] = static_cast<std::uint8_t>(252 + largest);
+  }
+  nlohmann::json meta = {
+      {"version", 2},
+      {"count", n},
+      {"means", {{"mins", lo}, {"maxs", hi}, {"files", {"means_l.webp", "means_u.webp"}}}},
+      {"scales", {{"codebook", scale_book}, {"files", {"scales.webp"}}}},
+      {"quats", {{"files", {"quats.webp"}}}},
+      {"sh0", {{"codebook", colour_book}, {"files", {"sh0.webp"}}}}};
+  std::vector<std::pair<std::string, std::string>> entries = {
+      {"means_l.webp", encodeWebp(path, means_l, width, height, "means_l.webp")},
+      {"means_u.webp", encodeWebp(path, means_u, width, height, "means_u.webp")},
+      {"quats.webp", encodeWebp(path, quats, width, height, "quats.webp")},
+      {"scales.webp", encodeWebp(path, scales, width, height, "scales.webp")},
+      {"sh0.webp", encodeWebp(path, sh0, width, height, "sh0.webp")}};
+  // Higher SH degrees: a palette of one entry per Gaussian (exact up to the 8-bit codebook)
+  // while there are at most 65536 Gaussians; beyond, none (said by the returned note).
+  const int coeffs = options.sh_degree == 1 ? 3 : options.sh_degree == 2 ? 8 : options.sh_degree == 3 ? 15 : 0;
+  if (coeffs > 0 && n <= kMaxPalette) {
+    std::vector<float> values;
+    values.reserve(3 * coeffs * n);
+    for (const GaussianPoint& p : cloud) {
+      for (int ch = 0; ch < 3; ++ch) {
+        for (int k = 0; k < coeffs; ++k) values.push_back(p.f_rest[ch * kShRestPerChannel + k]);
+      }
+    }
+    const std::vector<float> book = codebookOf(values);
+    const int centroid_width = 64 * coeffs;
+    const int centroid_height = static_cast<int>((n + 63) / 64);
+    std::vector<std::uint8_t> centroids(4 * static_cast<std::size_t>(centroid_width) * centroid_height, 0);
+    std::vector<std::uint8_t> labels = image();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t row = i / 64;
+      for (int k = 0; k < coeffs; ++k) {
+        const std::size_t x = (i % 64) * coeffs + k;
+        std::uint8_t* px = centroids.data() + 4 * (row * centroid_width + x);
+        for (int ch = 0; ch < 3; ++ch) {
+          px[ch] = nearestEntry(book, cloud[i].f_rest[ch * kShRestPerChannel + k]);
+        }
+        px[3] = 255;
+      }
+      labels[4 * i] = static_cast<std::uint8_t>(i & 0xff);
+      labels[4 * i + 1] = static_cast<std::uint8_t>(i >> 8);
+      labels[4 * i + 3] = 255;
+    }
+    meta["shN"] = {{"count", n},
+                   {"bands", options.sh_degree},
+                   {"codebook", book},
+                   {"files", {"shN_centroids.webp", "shN_labels.webp"}}};
+    entries.emplace_back("shN_centroids.webp", encodeWebp(path, centroids, centroid_width,
+                                                          centroid_height, "shN_centroids.webp"));
+    entries.emplace_back("shN_labels.webp",
+                         encodeWebp(path, labels, width, height, "shN_labels.webp"));
+  }
+  entries.insert(entries.begin(), {"meta.json", meta.dump()});
+  const std::string zip = storedZip(path, entries);
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(zip.data(), static_cast<std::streamsize>(zip.size()));
+  });
+}
+
 #else
 
 bool haveSogSupport() { return false; }
 
 pcl::PointCloud<GaussianPoint> readSog(const std::string& path, SogFileInfo*) {
   throw Error(path, "file type", "a build with libwebp (Debian: libwebp-dev) to read .sog",
+              "not supported: built without libwebp");
+}
+
+void writeSog(const std::string& path, const pcl::PointCloud<GaussianPoint>&,
+              const SogWriteOptions&) {
+  throw Error(path, "file type", "a build with libwebp (Debian: libwebp-dev) to write .sog",
               "not supported: built without libwebp");
 }
 

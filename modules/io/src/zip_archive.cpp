@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <zlib.h>
+
 #include "compression.h"
 #include "sadsplat/common/error.h"
 
@@ -134,6 +136,70 @@ std::vector<std::uint8_t> ZipArchive::read(const std::string& name, std::size_t 
   }
   throw Error(path_, field, "method 0 (stored) or 8 (deflate)",
               "not supported: method " + std::to_string(e.method));
+}
+
+namespace {
+
+void put16(std::string& out, std::uint16_t v) { out.append(reinterpret_cast<const char*>(&v), 2); }
+void put32(std::string& out, std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); }
+
+}  // namespace
+
+std::string storedZip(const std::string& path,
+                      const std::vector<std::pair<std::string, std::string>>& entries) {
+  std::string out, directory;
+  for (const auto& [name, content] : entries) {
+    if (out.size() + content.size() + name.size() + 30 >= 0xffffffffu) {
+      throw Error(path, "ZIP archive", "under 4 GiB (no ZIP64)", "larger");
+    }
+    const auto crc = static_cast<std::uint32_t>(
+        crc32(0L, reinterpret_cast<const Bytef*>(content.data()), static_cast<uInt>(content.size())));
+    const auto offset = static_cast<std::uint32_t>(out.size());
+    const auto size = static_cast<std::uint32_t>(content.size());
+    // Local header: version 2.0, no flags, stored, no time, sizes, name.
+    put32(out, kLocalHeader);
+    put16(out, 20);
+    put16(out, 0);
+    put16(out, 0);
+    put16(out, 0);
+    put16(out, 0x21);  // 1980-01-01
+    put32(out, crc);
+    put32(out, size);
+    put32(out, size);
+    put16(out, static_cast<std::uint16_t>(name.size()));
+    put16(out, 0);
+    out += name;
+    out += content;
+    put32(directory, kDirectoryEntry);
+    put16(directory, 20);
+    put16(directory, 20);
+    put16(directory, 0);
+    put16(directory, 0);
+    put16(directory, 0);
+    put16(directory, 0x21);
+    put32(directory, crc);
+    put32(directory, size);
+    put32(directory, size);
+    put16(directory, static_cast<std::uint16_t>(name.size()));
+    put16(directory, 0);
+    put16(directory, 0);
+    put16(directory, 0);
+    put16(directory, 0);
+    put32(directory, 0);
+    put32(directory, offset);
+    directory += name;
+  }
+  const auto directory_offset = static_cast<std::uint32_t>(out.size());
+  out += directory;
+  put32(out, kEndOfDirectory);
+  put16(out, 0);
+  put16(out, 0);
+  put16(out, static_cast<std::uint16_t>(entries.size()));
+  put16(out, static_cast<std::uint16_t>(entries.size()));
+  put32(out, static_cast<std::uint32_t>(directory.size()));
+  put32(out, directory_offset);
+  put16(out, 0);
+  return out;
 }
 
 }  // namespace io

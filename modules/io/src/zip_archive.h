@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sadsplat {
@@ -36,6 +37,13 @@ class ZipArchive {
   const std::string& bytes_;
   std::vector<Entry> entries_;
 };
+
+/// \brief A ZIP archive of `entries` (name, content) stored without compression (method 0, as
+/// PlayCanvas' .sog writes its already compressed WebP images), with CRC-32s and a central
+/// directory. No ZIP64: the archive must stay under 4 GiB.
+/// \throws sadsplat::Error naming `path` when it would not
+std::string storedZip(const std::string& path,
+                      const std::vector<std::pair<std::string, std::string>>& entries);
 
 }  // namespace io
 }  // namespace sadsplat

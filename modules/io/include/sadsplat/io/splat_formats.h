@@ -29,7 +29,7 @@
 ///
 /// `.sog` (PlayCanvas' streamed format, version 2: a ZIP of meta.json and lossless WebP images,
 /// positions as 16-bit log-encoded values, scales and colours through 256-entry codebooks, SH
-/// through a palette): read only (splat-transform writes it). Axes as the PLY.
+/// through a palette): read and written. Axes as the PLY.
 ///
 /// `.compressed.ply` (PlayCanvas/SuperSplat: chunks of 256 Gaussians with min/max ranges, packed
 /// 32-bit position, rotation, scale and colour, optional uint8 SH): read only. Axes as the PLY.
@@ -108,8 +108,24 @@ struct SogFileInfo {
   std::size_t clamped_opacities = 0;
 };
 
-/// \brief Whether this build reads `.sog` (it needs libwebp).
+/// \brief How to write `.sog`.
+struct SogWriteOptions {
+  /// SH degree kept, 0..3; degrees 1..3 are written (as a palette of one entry per Gaussian) only
+  /// for models of at most 65536 Gaussians
+  int sh_degree = kMaxShDegree;
+};
+
+/// \brief Whether this build reads and writes `.sog` (it needs libwebp).
 bool haveSogSupport();
+/// \brief Writes PlayCanvas' `.sog` version 2 (atomically): a stored ZIP of meta.json and lossless
+/// WebP images, one pixel per Gaussian: positions as 16-bit sign(x) log(1 + |x|) between the
+/// per-axis min and max, log-scales and SH-0 colours through 256-entry codebooks (1D k-means),
+/// opacity as 8 bits, the quaternion as its three smaller components (see readSog); SH degrees
+/// 1..3 as a palette with one entry per Gaussian through a 256-entry codebook (models of up to
+/// 65536 Gaussians; larger ones are written with SH degree 0).
+/// \throws sadsplat::Error on bad options, values that are not writable or a build without libwebp
+void writeSog(const std::string& path, const pcl::PointCloud<GaussianPoint>& cloud,
+              const SogWriteOptions& options = {});
 /// \brief Reads PlayCanvas' `.sog` (version 2; a ZIP with meta.json and WebP images).
 /// \throws sadsplat::Error naming the file and the entry or field that is wrong, or "not
 /// supported" for version 1 or a build without libwebp
