@@ -206,14 +206,17 @@ TEST(Cli, CompactTilesAndGlbOfATrainedRun) {
   const std::size_t n = io::readGaussianPly(run + "/model.ply").size();
   ASSERT_GT(n, 20u);
   // compact: a run directory with half the Gaussians that eval scores.
-  ASSERT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --out " + dir.file("half"),
+  ASSERT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --refine 3 --out " +
+                                 dir.file("half"),
                              &out),
             0)
       << out;
+  EXPECT_NE(out.find("refined 3 iterations"), std::string::npos) << out;
   EXPECT_EQ(io::readGaussianPly(dir.file("half") + "/model.ply").size(), (n + 1) / 2);
   ASSERT_EQ(test::runCommand(kCli + " eval " + dir.file("half"), &out), 0) << out;
   EXPECT_NE(out.find("\"num_gaussians\": " + std::to_string((n + 1) / 2)), std::string::npos)
       << out;
+  EXPECT_NE(out.find("\"iterations\": 33"), std::string::npos) << out;  // 30 trained + 3 refined
   // Exactly one of --count / --ratio / --model.
   EXPECT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --count 3 --out " +
                                  dir.file("bad"),

@@ -23,6 +23,11 @@ class CompactCommand : public Command {
     c->add_option("--model", options_.model,
                   "or these Gaussians (a model file in the run's frame, e.g. another tool's "
                   "simplification of the run's model), scored with the run's decoder");
+    c->add_option("--refine", options_.refine,
+                  "then train the smaller model this many iterations more on the run's scene "
+                  "(final learning rates, no densification or drop)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     c->add_flag("!--merge-across-classes", options_.class_aware,
                 "merges may join Gaussians of different classes");
     return c;

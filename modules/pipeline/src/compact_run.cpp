@@ -66,7 +66,13 @@ std::string compactRun(const std::string& run_dir, const std::string& out_dir,
             << ", groups' 90th-percentile extent " << r.group_extent << " scene units"
             << (o.class_aware ? ", class-aware" : "") << ")";
   }
+  if (o.refine < 0) throw Error(out_dir, "--refine", "iterations >= 0", std::to_string(o.refine));
   run.trainer->setGaussians(smaller);
+  for (int i = 0; i < o.refine; ++i) run.trainer->step(/*read_losses=*/false);
+  if (o.refine > 0) {
+    summary << ", refined " << o.refine << " iterations (" << run.trainer->numGaussians()
+            << " Gaussians after)";
+  }
   io::makeDirectory(out_dir);
   const io::RunDirectory out(out_dir);
   io::writeTextFileAtomically(out.config(), run.config.toJson());

@@ -9,7 +9,7 @@
 /// asked count. The run's decoder, configuration and scene stay (Trainer::setGaussians), so the
 /// smaller model is scored with the same classes. `model` instead takes another file's Gaussians
 /// (in the run's frame, e.g. another tool's simplification of the baked model) for a side-by-side
-/// score; its gates are opened likewise.
+/// score; its gates are opened likewise. `refine` trains the result further on the run's scene.
 
 #include <cstddef>
 #include <string>
@@ -23,6 +23,9 @@ struct CompactOptions {
   double ratio = 0;         ///< or this share of the model's count, in (0, 1]
   std::string model;        ///< or these Gaussians (a model file), no merge
   bool class_aware = true;  ///< merges keep classes apart
+  /// then train the smaller model this many iterations more on the run's scene (its training
+  /// views, the final learning rates; no densification or drop: their schedules have ended)
+  int refine = 0;
 };
 
 /// \brief Writes the compacted run into `out_dir`; returns a summary line.
