@@ -148,6 +148,22 @@ TEST(GltfSplats, BadFilesAreRefusedByName) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("cut.glb"), std::string::npos);
   }
+  // A container whose JSON lacks a field the reader needs: an Error naming the file, no crash.
+  std::string text =
+      R"({"meshes":[{"primitives":[{"attributes":{"POSITION":0},)"
+      R"("extensions":{"KHR_gaussian_splatting":{}}}]}]})";
+  while (text.size() % 4 != 0) text += ' ';
+  std::string bare(20, '\0');
+  const std::uint32_t header[5] = {0x46546c67u, 2, static_cast<std::uint32_t>(20 + text.size()),
+                                   static_cast<std::uint32_t>(text.size()), 0x4e4f534au};
+  std::memcpy(bare.data(), header, 20);
+  test::writeFile(dir.file("bare.glb"), bare + text);
+  try {
+    io::readSplatGlb(dir.file("bare.glb"));
+    FAIL() << "a glTF without accessors was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bare.glb"), std::string::npos) << e.what();
+  }
   o.sh_degree = 4;
   EXPECT_THROW(io::encodeSplatGlb("<test>", someSplats(), o), Error);
   EXPECT_THROW(io::encodeSplatGlb("<test>", pcl::PointCloud<GaussianPoint>(), {}), Error);

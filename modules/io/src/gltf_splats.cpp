@@ -355,7 +355,10 @@ class GlbReader {
 
 }  // namespace
 
-pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatInfo* info) {
+namespace {
+
+// readSplatGlb's work; json::exception (a missing or mistyped field) is turned into an Error there.
+pcl::PointCloud<GaussianPoint> readSplatGlbFields(const std::string& path, GltfSplatInfo* info) {
   const GlbReader glb(path, readWholeFile(path));
   const json& gltf = glb.gltf();
   const json* primitive = nullptr;
@@ -364,22 +367,22 @@ pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatIn
   } catch (const json::exception&) {
     throw Error(path, "meshes[0].primitives[0]", "a primitive", "none");
   }
-  if (!primitive->contains("extensions") || !(*primitive)["extensions"].contains(kSplat)) {
+  if (!primitive->contains("extensions") || !primitive->at("extensions").contains(kSplat)) {
     throw Error(path, "primitive extensions", kSplat, "missing (not Gaussian splats)");
   }
   const json& attributes = primitive->at("attributes");
   if (!attributes.contains("POSITION")) {
     throw Error(path, "attribute POSITION", "present", "missing");
   }
-  const std::size_t n = gltf["accessors"].at(attributes["POSITION"].get<std::size_t>()).at("count");
+  const std::size_t n = gltf.at("accessors").at(attributes.at("POSITION").get<std::size_t>()).at("count");
   int degree = 0;
   while (degree < kMaxShDegree && attributes.contains(shName(degree + 1, 0))) ++degree;
-  const json& splat = (*primitive)["extensions"][kSplat];
-  const bool spz = splat.contains("extensions") && splat["extensions"].contains(kSpz);
+  const json& splat = primitive->at("extensions").at(kSplat);
+  const bool spz = splat.contains("extensions") && splat.at("extensions").contains(kSpz);
   pcl::PointCloud<GaussianPoint> cloud;
   if (spz) {
     SpzFileInfo spz_info;
-    cloud = decodeSpz(path, glb.view(splat["extensions"][kSpz].at("bufferView"), kSpz), &spz_info,
+    cloud = decodeSpz(path, glb.view(splat.at("extensions").at(kSpz).at("bufferView"), kSpz), &spz_info,
                       true);
     if (cloud.size() != n) {
       throw Error(path, "SPZ payload", std::to_string(n) + " Gaussians (POSITION's count)",
@@ -388,7 +391,7 @@ pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatIn
   } else {
     auto floats = [&](const std::string& semantic, std::size_t per) {
       if (!attributes.contains(semantic)) throw Error(path, "attribute " + semantic, "present", "missing");
-      return glb.values<float>(attributes[semantic], semantic, kFloat, per, n);
+      return glb.values<float>(attributes.at(semantic), semantic, kFloat, per, n);
     };
     const std::vector<float> position = floats("POSITION", 3);
     const std::vector<float> rotation = floats(std::string(kPrefix) + "ROTATION", 4);
@@ -428,7 +431,7 @@ pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatIn
   GltfSplatInfo result;
   if (attributes.contains("_FEATURE_ID_0")) {
     const std::vector<float> ids =
-        glb.values<float>(attributes["_FEATURE_ID_0"], "_FEATURE_ID_0", kFloat, 1, n);
+        glb.values<float>(attributes.at("_FEATURE_ID_0"), "_FEATURE_ID_0", kFloat, 1, n);
     for (std::size_t i = 0; i < n; ++i) {
       if (!(ids[i] >= 0 && ids[i] <= kNullFeature) || ids[i] != std::floor(ids[i])) {
         throw Error(path, "_FEATURE_ID_0 of splat " + std::to_string(i), "a whole number 0..65535",
@@ -465,6 +468,16 @@ pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatIn
     *info = result;
   }
   return cloud;
+}
+
+}  // namespace
+
+pcl::PointCloud<GaussianPoint> readSplatGlb(const std::string& path, GltfSplatInfo* info) {
+  try {
+    return readSplatGlbFields(path, info);
+  } catch (const json::exception& e) {
+    throw Error(path, "glTF JSON", "the fields and types of a glTF of Gaussian splats", e.what());
+  }
 }
 
 }  // namespace io
