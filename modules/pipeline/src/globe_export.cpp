@@ -26,13 +26,6 @@ namespace sadsplat {
 namespace pipeline {
 namespace {
 
-// (x, y, z) -> (x, z, -y): z-up to glTF's y-up.
-Eigen::Matrix3d zUpToGltf() {
-  Eigen::Matrix3d m;
-  m << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return m;
-}
-
 // Where a client should look: the median centre of the Gaussians (floaters do not move it) and
 // the half-diagonal of the middle half of them (the dense scene, not its outliers), z-up frame.
 std::array<double, 4> lookAt(const pcl::PointCloud<GaussianPoint>& cloud) {
@@ -184,7 +177,7 @@ std::string exportGlb(const std::string& model_or_run, const std::string& out_pa
                       io::GltfSplatOptions options) {
   const UprightModel m = openUprightModel(model_or_run);
   pcl::PointCloud<GaussianPoint> gltf;
-  filters::transformGaussians(m.cloud, gltf, zUpToGltf());
+  filters::transformGaussians(m.cloud, gltf, tiles::zUpToGltfAxes());
   options.classes = m.classes;
   io::writeSplatGlb(out_path, gltf, options);
   return "glTF axes (y up) of the frame: " + m.frame;

@@ -18,15 +18,6 @@ namespace {
 
 using json = nlohmann::json;
 
-// glTF axes of a z-up point: (x, y, z) -> (x, z, -y), a rotation (det +1).
-Eigen::Matrix3d zUpToYUp() {
-  Eigen::Matrix3d m;
-  m << 1, 0, 0,  //
-      0, 0, 1,   //
-      0, -1, 0;
-  return m;
-}
-
 json boxOf(const Tile& t) {
   json box = json::array();
   for (int k = 0; k < 3; ++k) box.push_back(0.5 * (t.lo[k] + t.hi[k]));
@@ -37,6 +28,14 @@ json boxOf(const Tile& t) {
 }
 
 }  // namespace
+
+Eigen::Matrix3d zUpToGltfAxes() {
+  Eigen::Matrix3d m;
+  m << 1, 0, 0,  //
+      0, 0, 1,   //
+      0, -1, 0;
+  return m;
+}
 
 TilesetSummary writeTileset(const std::string& dir, const TileTree& tree,
                             const TilesetOptions& options) {
@@ -55,7 +54,7 @@ TilesetSummary writeTileset(const std::string& dir, const TileTree& tree,
   summary.leaves = tree.leaves();
   summary.depth = tree.depth();
   std::vector<json> nodes(tree.tiles.size());
-  const Eigen::Matrix3d to_gltf = zUpToYUp();
+  const Eigen::Matrix3d to_gltf = zUpToGltfAxes();
   for (std::size_t i = 0; i < tree.tiles.size(); ++i) {
     const Tile& t = tree.tiles[i];
     const std::string uri =

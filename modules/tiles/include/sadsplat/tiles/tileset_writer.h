@@ -8,6 +8,7 @@
 /// reads to take the content as Gaussian splats). The content of each tile is turned from the
 /// z-up frame to glTF's y-up axes ((x, y, z) -> (x, z, -y)), which 3D Tiles clients turn back.
 
+#include <Eigen/Core>
 #include <array>
 #include <optional>
 #include <string>
@@ -25,6 +26,9 @@ struct TilesetOptions {
   io::GltfSplatOptions content;  ///< SPZ or plain, SH degree, class names
   std::string extras_json = "{}";  ///< a JSON object written as tileset.json's extras
 };
+
+/// \brief The rotation from a z-up frame to glTF's y-up axes: (x, y, z) -> (x, z, -y).
+Eigen::Matrix3d zUpToGltfAxes();
 
 /// \brief What was written.
 struct TilesetSummary {
