@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/memory_estimate.h"
 #include "sadsplat/geo/block_partition.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_cache.h"
@@ -139,6 +140,62 @@ TEST(BlockRun, MismatchedOptionsAreClearErrors) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("blocks.json"), std::string::npos) << e.what();
   }
+}
+
+// The largest block estimate of a partition into `blocks`.
+std::int64_t largestEstimate(const io::Scene& scene, int blocks,
+                             const gaussians::TrainConfig& config) {
+  geo::BlockOptions options;
+  options.blocks = blocks;
+  std::int64_t largest = 0;
+  for (const geo::Block& b : geo::partitionScene(scene, options, kTinySceneCache).blocks) {
+    largest = std::max(largest, gaussians::estimateTrainingMemory(scene, b.views,
+                                                                  b.points.size(), config)
+                                    .total());
+  }
+  return largest;
+}
+
+// --blocks auto / --max-gpu-memory: the fewest blocks whose largest estimate fits.
+TEST(BlockRun, AMemoryBudgetPicksTheFewestBlocksThatFit) {
+  const io::Scene scene = io::readSceneCache(kTinySceneCache);
+  gaussians::TrainConfig config;
+  const std::int64_t whole = gaussians::estimateTrainingMemory(scene, config).total();
+  const std::int64_t budget = largestEstimate(scene, 4, config);
+  ASSERT_LT(budget, whole);
+  geo::BlockOptions automatic;
+  automatic.blocks = 0;
+  const geo::BlockPartition p =
+      pipeline::partitionForMemory(scene, automatic, config, budget, nullptr, kTinySceneCache);
+  const int n = static_cast<int>(p.blocks.size());
+  ASSERT_GE(n, 2);
+  ASSERT_LE(n, 4);
+  EXPECT_LE(largestEstimate(scene, n, config), budget);
+  for (int fewer = 2; fewer < n; ++fewer) EXPECT_GT(largestEstimate(scene, fewer, config), budget);
+  // What the whole scene needs: one block.
+  EXPECT_EQ(pipeline::partitionForMemory(scene, automatic, config, whole, nullptr, kTinySceneCache)
+                .blocks.size(),
+            1u);
+  // Less than one step's render of a view: an error naming the option.
+  try {
+    pipeline::partitionForMemory(scene, automatic, config, 1000, nullptr, kTinySceneCache);
+    FAIL() << "a budget of 1000 bytes was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-gpu-memory"), std::string::npos) << e.what();
+  }
+  // The command: the budget implies --blocks auto and says its estimates; auto needs a budget.
+  test::TempDir dir;
+  std::string out;
+  const double gib = static_cast<double>(budget) / (1ll << 30);
+  ASSERT_EQ(test::runCommand(kCli + kTrain + " --max-gpu-memory " +
+                                 std::to_string(gib * 1.001) + " --out " + dir.file("run"),
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("the whole scene in one run:"), std::string::npos) << out;
+  EXPECT_NE(out.find("trained in " + std::to_string(n) + " blocks"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + kTrain + " --blocks auto --out " + dir.file("r2"), &out), 1);
+  EXPECT_NE(out.find("--max-gpu-memory"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -52,11 +52,17 @@ class TrainCommand : public Command {
                   "levels off; on real surveys it grows larger models than the default; keys you "
                   "set are kept)")
         ->check(CLI::IsMember({"paper", "long"}));
-    c->add_option("--blocks", blocks_,
-                  "train the scene in N blocks on its ground plane, one after another (or shared "
-                  "by the --nproc ranks), each on the views that see it, and merge them into one "
-                  "model (docs/GUIDE.md: surveys larger than your GPU)")
-        ->check(CLI::Range(1, 4096));
+    c->add_option("--blocks", blocks_text_,
+                  "N or auto: train the scene in N blocks on its ground plane, one after another "
+                  "(or shared by the --nproc ranks), each on the views that see it, and merge "
+                  "them into one model; auto: the fewest blocks whose training fits "
+                  "--max-gpu-memory (docs/GUIDE.md: surveys larger than your GPU)")
+        ->check(CLI::IsMember({"auto"}) | CLI::Range(1, 4096));
+    c->add_option("--max-gpu-memory", max_gpu_memory_gib_,
+                  "GiB a training may hold on its device (estimated from the views, the sparse "
+                  "points and the configuration): cut the scene into as few blocks as fit (implies "
+                  "--blocks auto)")
+        ->check(CLI::Range(1.0e-6, 1.0e6));
     c->add_option("--block-overlap", block_options_.overlap,
                   "with --blocks: a block's cell grown by this share of its size on each side")
         ->check(CLI::Range(0.0, 1.0))
@@ -141,7 +147,7 @@ class TrainCommand : public Command {
     options.schedule.given = given;
     if (batch_schedule_) options.schedule.batch_ranks = rank_env ? rank_env->world_size : 1;
     if (rank_env && config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);
-    if (rank_env && blocks_ == 0) {
+    if (rank_env && blocks_text_.empty() && max_gpu_memory_gib_ <= 0) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
       options.collective = distributed::joinGroup(*rank_env, config.device);
     }
@@ -154,7 +160,12 @@ class TrainCommand : public Command {
     options.progress = quiet_rank ? nullptr : &std::cout;
     options.stop = &g_stop;
     installStopHandlers();
-    if (blocks_ > 0) return trainInBlocks(options, config, rank_env, local_ranks);
+    if (max_gpu_memory_gib_ > 0 && blocks_text_.empty()) blocks_text_ = "auto";
+    if (blocks_text_ == "auto" && max_gpu_memory_gib_ <= 0)
+      throw Error("<command line>", "--max-gpu-memory",
+                  "a budget in GiB with --blocks auto (e.g. --max-gpu-memory 22 for a 24 GB card)",
+                  "none");
+    if (!blocks_text_.empty()) return trainInBlocks(options, config, rank_env, local_ranks);
     const double seconds = pipeline::trainRun(options, config);
     if (local_ranks) local_ranks->waitAll();
     if (!quiet_rank)
@@ -174,7 +185,11 @@ class TrainCommand : public Command {
                   "both");
     pipeline::BlockRunOptions blocks;
     blocks.partition = block_options_;
-    blocks.partition.blocks = blocks_;
+    blocks.partition.blocks = blocks_text_ == "auto" ? 0 : std::stoi(blocks_text_);
+    if (blocks.partition.blocks == 0) {
+      blocks.max_device_bytes = static_cast<std::int64_t>(max_gpu_memory_gib_ * (1ll << 30));
+      blocks.budget_config = gaussians::resolveSchedule(config, options.schedule).config;
+    }
     blocks.rank = rank_env ? rank_env->rank : 0;
     blocks.ranks = rank_env ? rank_env->world_size : 1;
     blocks.wait_for_ranks = !local_ranks && blocks.ranks > 1;
@@ -184,7 +199,7 @@ class TrainCommand : public Command {
     if (local_ranks) local_ranks->waitAll();
     if (blocks.rank != 0) return 0;
     run.merge();
-    std::cout << "trained in " << blocks_ << " blocks in "
+    std::cout << "trained in " << run.partition().blocks.size() << " blocks in "
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
               << " s; model in " << out_ << "/model.ply\n";
     return 0;
@@ -194,7 +209,8 @@ class TrainCommand : public Command {
   double scale_ = 0.5;
   bool resume_ = false, profile_ = false, profile_host_ = false, batch_schedule_ = false;
   int nproc_ = 0;
-  int blocks_ = 0;
+  std::string blocks_text_;  // N or auto; empty: no blocks
+  double max_gpu_memory_gib_ = 0;
   geo::BlockOptions block_options_;
   std::map<const gaussians::TrainOption*, CLI::Option*> flags_;
   std::map<const gaussians::TrainOption*, std::string> values_;

@@ -1,12 +1,16 @@
 #include "sadsplat/pipeline/block_run.h"
 
 #include <algorithm>
+#include <cmath>
+#include <iomanip>
 #include <chrono>
+#include <sstream>
 #include <thread>
 #include <utility>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/block_merge.h"
+#include "sadsplat/gaussians/memory_estimate.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/run_directory.h"
@@ -75,14 +79,93 @@ void waitForOtherRanks(const TrainRunOptions& o, const geo::BlockPartition& part
   }
 }
 
+double gib(std::int64_t bytes) { return static_cast<double>(bytes) / (1ll << 30); }
+
+std::string gibText(std::int64_t bytes) {
+  std::ostringstream text;
+  text << std::setprecision(3) << gib(bytes) << " GiB";
+  return text.str();
+}
+
+// The largest block estimate of a partition.
+gaussians::MemoryEstimate largestBlock(const io::Scene& scene, const geo::BlockPartition& p,
+                                       const gaussians::TrainConfig& config) {
+  gaussians::MemoryEstimate worst;
+  for (const geo::Block& block : p.blocks) {
+    const gaussians::MemoryEstimate e =
+        gaussians::estimateTrainingMemory(scene, block.views, block.points.size(), config);
+    if (e.total() > worst.total()) worst = e;
+  }
+  return worst;
+}
+
+void sayEstimate(std::ostream* out, const std::string& what, const gaussians::MemoryEstimate& e) {
+  if (out == nullptr) return;
+  *out << std::fixed << std::setprecision(2) << what << ": " << gib(e.total())
+       << " GiB estimated (views " << gib(e.views) << ", " << e.peak_gaussians
+       << " Gaussians at the peak " << gib(e.gaussians) << ", render " << gib(e.render)
+       << ", fixed " << gib(e.fixed) << ")\n"
+       << std::defaultfloat << std::setprecision(6);
+}
+
 }  // namespace
+
+geo::BlockPartition partitionForMemory(const io::Scene& scene, geo::BlockOptions options,
+                                       const gaussians::TrainConfig& config,
+                                       std::int64_t max_device_bytes, std::ostream* progress,
+                                       const std::string& origin) {
+  const gaussians::MemoryEstimate whole = gaussians::estimateTrainingMemory(scene, config);
+  sayEstimate(progress, "the whole scene in one run", whole);
+  // What no cut makes smaller: the context and one step's render of the largest view.
+  gaussians::MemoryEstimate floor = whole;
+  floor.views = floor.gaussians = 0;
+  if (floor.total() > max_device_bytes) {
+    throw Error(origin, "--max-gpu-memory",
+                "at least " + gibText(floor.total()) +
+                    " (one step's render of the largest view; smaller images need less)",
+                gibText(max_device_bytes));
+  }
+  // Blocks overlap, so a block holds at least its share of what divides: start there.
+  const double divisible = static_cast<double>(whole.total() - floor.total());
+  const double room = static_cast<double>(max_device_bytes - floor.total());
+  int blocks = std::max(options.blocks, 1);
+  blocks = std::max(blocks, static_cast<int>(std::ceil(divisible / room)));
+  // Blocks overlap and views see several cells, so more blocks do not always make the largest
+  // smaller: up to twice the first count (at least 16 more) are tried.
+  const int first = blocks, last = std::min(4096, std::max(2 * first, first + 16));
+  gaussians::MemoryEstimate smallest;
+  for (; blocks <= last; ++blocks) {
+    options.blocks = blocks;
+    geo::BlockPartition p = geo::partitionScene(scene, options, origin);
+    const gaussians::MemoryEstimate worst = largestBlock(scene, p, config);
+    sayEstimate(progress, std::to_string(blocks) + " blocks, the largest", worst);
+    if (worst.total() <= max_device_bytes) return p;
+    if (blocks == first || worst.total() < smallest.total()) smallest = worst;
+  }
+  std::string hint = "";
+  if (!config.stream_views && smallest.views > smallest.gaussians)
+    hint = "; its views are most of it: --stream-views keeps them in host memory";
+  throw Error(origin, "--max-gpu-memory",
+              "a budget that " + std::to_string(first) + " to " + std::to_string(last) +
+                  " blocks fit (the smallest largest block: " + gibText(smallest.total()) + hint +
+                  ")",
+              gibText(max_device_bytes));
+}
 
 BlockRun::BlockRun(TrainRunOptions options, BlockRunOptions blocks)
     : options_(std::move(options)), blocks_(std::move(blocks)) {
   if (blocks_.ranks < 1 || blocks_.rank < 0 || blocks_.rank >= blocks_.ranks)
     throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(blocks_.rank));
   scene_ = loadScene(options_.scene, options_.scale, options_.progress);
-  partition_ = geo::partitionScene(scene_, blocks_.partition, options_.scene);
+  if (blocks_.partition.blocks == 0) {
+    if (blocks_.max_device_bytes <= 0)
+      throw Error("<block run>", "max_device_bytes", "a memory budget with blocks = 0 (auto)",
+                  std::to_string(blocks_.max_device_bytes));
+    partition_ = partitionForMemory(scene_, blocks_.partition, blocks_.budget_config,
+                                    blocks_.max_device_bytes, options_.progress, options_.scene);
+  } else {
+    partition_ = geo::partitionScene(scene_, blocks_.partition, options_.scene);
+  }
 }
 
 double BlockRun::train(const gaussians::TrainConfig& config) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "sadsplat/geo/block_partition.h"
+#include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/pipeline/train_run.h"
 
 namespace sadsplat {
@@ -24,7 +25,22 @@ struct BlockRunOptions {
   /// Rank 0 waits, after its own blocks, until the other ranks' blocks have finished (ranks
   /// started by torchrun; ranks this process started are waited for as processes instead).
   bool wait_for_ranks = false;
+  /// With partition.blocks == 0 (`--blocks auto`): the fewest blocks whose every block's
+  /// estimated peak device memory (gaussians/memory_estimate.h) for `budget_config` is at most
+  /// this many bytes.
+  std::int64_t max_device_bytes = 0;
+  gaussians::TrainConfig budget_config;
 };
+
+/// \brief The partition with the fewest blocks whose every block's estimated training memory
+/// with `config` fits `max_device_bytes`: from options.blocks or the share that must divide
+/// (whichever is larger) up to twice that count (at least 16 more); says each try on `progress`.
+/// \throws sadsplat::Error naming `origin` when one step's render alone does not fit, or no
+/// count tried fits (with a hint to --stream-views when the views are most of it)
+geo::BlockPartition partitionForMemory(const io::Scene& scene, geo::BlockOptions options,
+                                       const gaussians::TrainConfig& config,
+                                       std::int64_t max_device_bytes, std::ostream* progress,
+                                       const std::string& origin);
 
 /// \brief A scene (options.scene, loaded once) and its partition, trained block by block into
 /// options.out.
