@@ -13,6 +13,9 @@
 #                  xl_1gpu on the views that straddle block borders
 #   xl_blocks_ranks  the same blocks shared by GPUS ranks (--blocks --nproc GPUS)
 #   xl_stream      as xl_1gpu with --stream-views (views in host memory, uploaded per step)
+#   xl_auto        --max-gpu-memory BUDGET (env, GiB, default 22): as few blocks as the estimate
+#                  fits (views held); xl_auto_stream the same with --stream-views
+# PRESET (env, default city-xl; city-xxl: 1,120 views over 16 city tiles) is the large scene.
 # xl_1gpu and xl_1gpu_batch run at the same time on GPUs 0 and 1 when PAIR=1 (default 0).
 # Method: the full drop (--drop full), no pseudo-labels (PSEUDO=1: pseudo-labelled caches, as the
 # paper's full method); SIZE (env, default 800x450) caches made here by synth.
@@ -34,7 +37,7 @@ summary="$out/summary.txt"
 echo "== $(date -u +%F) iterations $iterations, $gpus GPUs: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" | tee -a "$summary"
 
 wanted=" ${RUNS:-xl_1gpu xl_1gpu_batch xl_ranks city_1gpu city_ranks} "
-xl=$(scene_cache city-xl "${SIZE:-800x450}")
+xl=$(scene_cache "${PRESET:-city-xl}" "${SIZE:-800x450}")
 if [ "${PSEUDO:-0}" = 1 ]; then xl=$(pl_cache "$xl"); fi
 if [[ $wanted == *" city_"* ]]; then
   city=$(scene_cache city_0 "${SIZE:-800x450}")
@@ -66,6 +69,11 @@ run() {
 try: m = json.load(open(sys.argv[1])); print(m.get("miou"), m["psnr"], m["num_gaussians"])
 except Exception: print("? ? ?")' "$dir/metrics.json")
   [ -f "$dir/blocks.json" ] && gaussians="gaussians $merged (merged)"
+  # The largest Gaussian count any training (or block) reached, and the estimates it printed.
+  local most; most=$({ cat "$dir"/train_log.jsonl "$dir"/blocks/*/train_log.jsonl 2>/dev/null || true; } |
+    python3 -c 'import json, sys; print(max((json.loads(l).get("gaussians", 0) for l in sys.stdin if l.strip()), default=0))')
+  gaussians="$gaussians, most $most"
+  tr '\r' '\n' < "$out/train_$name.log" | grep -E "GiB estimated" | sed "s/^/  $name /" | tee -a "$summary" || true
   echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
   if [ -f "$dir/blocks.json" ]; then cp "$dir/blocks.json" "$out/blocks_$name.json"; fi
 }
@@ -86,6 +94,8 @@ fi
 [[ $wanted == *" city_1gpu "* ]] && run city_1gpu "$city" 0 --iterations "$iterations"
 [[ $wanted == *" city_ranks "* ]] && run "city_ranks${gpus}x$views" "$city" "$all_gpus" --iterations "$iterations" --nproc "$gpus" --views-per-step "$views" --batch-schedule
 [[ $wanted == *" xl_stream "* ]] && run xl_1gpu_stream "$xl" 0 --iterations "$iterations" --stream-views
+[[ $wanted == *" xl_auto "* ]] && run xl_auto "$xl" 0 --iterations "$iterations" --max-gpu-memory "${BUDGET:-22}"
+[[ $wanted == *" xl_auto_stream "* ]] && run xl_auto_stream "$xl" 0 --iterations "$iterations" --max-gpu-memory "${BUDGET:-22}" --stream-views
 blocks=${BLOCKS:-4}
 [[ $wanted == *" xl_blocks "* ]] && run "xl_blocks$blocks" "$xl" 0 --iterations "$iterations" --blocks "$blocks"
 [[ $wanted == *" xl_blocks_ranks "* ]] && run "xl_blocks${blocks}_ranks$gpus" "$xl" "$all_gpus" --iterations "$iterations" --blocks "$blocks" --nproc "$gpus"

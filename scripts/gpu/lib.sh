@@ -11,7 +11,7 @@
 #                                print the path of the synth scene cache (CAPTURE=grid-oblique
 #                                for synth's drone-mission capture; made once per kind,
 #                                seed and size under /tmp/sadsplat-scenes; KIND_SEED e.g. city_0,
-#                                or city-xl for the large preset)
+#                                or city-xl / city-xxl for the large presets)
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
 #   make_cache PATH LOG CMD...   run CMD (writing PATH.part) once per PATH, one maker per machine
 #   deadline_start SECONDS       the deadline: SECONDS after the first script of this call sourced
@@ -120,7 +120,7 @@ scene_cache() {
   local capture="${CAPTURE:-orbit}" suffix=""
   [ "$capture" = orbit ] || suffix="_$capture"
   local cache="$SCENES_DIR/${scene}_${size}$suffix.cache" args
-  if [ "$scene" = city-xl ]; then args=(--kind city --preset city-xl)
+  if [[ $scene == city-xl || $scene == city-xxl ]]; then args=(--kind city --preset "$scene")
   else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
   args+=(--capture "$capture")
   make_cache "$cache" "$OUT/synth_${scene}_$size.log" "$bin" synth "${args[@]}" \

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 namespace sadsplat {
 namespace gaussians {
@@ -30,6 +32,17 @@ bool hasConfidence(const io::View& v) {
 std::int64_t MemoryEstimate::total() const {
   return static_cast<std::int64_t>(
       std::ceil(static_cast<double>(fixed + views + gaussians + render) * kAllocatorSlack));
+}
+
+std::string MemoryEstimate::describe() const {
+  const auto gib = [](std::int64_t bytes) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(2) << static_cast<double>(bytes) / (1ll << 30);
+    return text.str();
+  };
+  return gib(total()) + " GiB estimated (views " + gib(views) + ", " +
+         std::to_string(peak_gaussians) + " Gaussians at the peak " + gib(gaussians) +
+         ", render " + gib(render) + ", fixed " + gib(fixed) + ")";
 }
 
 std::int64_t bytesPerGaussian(const TrainConfig& c) {

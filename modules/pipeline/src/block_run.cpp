@@ -100,12 +100,7 @@ gaussians::MemoryEstimate largestBlock(const io::Scene& scene, const geo::BlockP
 }
 
 void sayEstimate(std::ostream* out, const std::string& what, const gaussians::MemoryEstimate& e) {
-  if (out == nullptr) return;
-  *out << std::fixed << std::setprecision(2) << what << ": " << gib(e.total())
-       << " GiB estimated (views " << gib(e.views) << ", " << e.peak_gaussians
-       << " Gaussians at the peak " << gib(e.gaussians) << ", render " << gib(e.render)
-       << ", fixed " << gib(e.fixed) << ")\n"
-       << std::defaultfloat << std::setprecision(6);
+  if (out != nullptr) *out << what << ": " << e.describe() << "\n";
 }
 
 }  // namespace

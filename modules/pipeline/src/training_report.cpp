@@ -6,6 +6,7 @@
 
 #include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/initialization.h"
+#include "sadsplat/gaussians/memory_estimate.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -58,6 +59,10 @@ void TrainingReport::started(const io::Scene& scene, const gaussians::TrainConfi
         << (pseudo == 0 ? " (run `sadsplat pseudo-labels` on the scene cache to add them)" : "")
         << "; drop " << config.drop << " with confidence maps of "
         << (pseudo > 0 ? "the pseudo-label backend + ground truth" : "the ground truth only")
+        << "\n";
+  }
+  if (config.device.rfind("cuda", 0) == 0) {
+    out << "device memory: " << gaussians::estimateTrainingMemory(scene, config).describe()
         << "\n";
   }
   if (!resume && gaussians::initialisesRandomly(config.init, scene.points.size())) {

@@ -21,6 +21,7 @@
 /// a planning number, not a bound.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "sadsplat/gaussians/train_config.h"
@@ -42,6 +43,8 @@ struct MemoryEstimate {
   std::int64_t peak_gaussians = 0;  ///< the Gaussian count `gaussians` was estimated for
   /// (fixed + views + gaussians + render) x kAllocatorSlack
   std::int64_t total() const;
+  /// \brief "X GiB estimated (views a, N Gaussians at the peak b, render c, fixed d)"
+  std::string describe() const;
 };
 
 /// \brief Bytes one Gaussian takes on the device during training with `config`.
