@@ -176,6 +176,12 @@ TEST(BlockRun, AMemoryBudgetPicksTheFewestBlocksThatFit) {
   EXPECT_EQ(pipeline::partitionForMemory(scene, automatic, config, whole, nullptr, kTinySceneCache)
                 .blocks.size(),
             1u);
+  // With a count (--blocks N --max-gpu-memory): at least that many.
+  geo::BlockOptions at_least = automatic;
+  at_least.blocks = n + 2;
+  EXPECT_EQ(pipeline::partitionForMemory(scene, at_least, config, whole, nullptr, kTinySceneCache)
+                .blocks.size(),
+            static_cast<std::size_t>(n + 2));
   // Less than one step's render of a view: an error naming the option.
   try {
     pipeline::partitionForMemory(scene, automatic, config, 1000, nullptr, kTinySceneCache);

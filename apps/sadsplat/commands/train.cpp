@@ -61,7 +61,7 @@ class TrainCommand : public Command {
     c->add_option("--max-gpu-memory", max_gpu_memory_gib_,
                   "GiB a training may hold on its device (estimated from the views, the sparse "
                   "points and the configuration): cut the scene into as few blocks as fit (implies "
-                  "--blocks auto)")
+                  "--blocks auto; with --blocks N, at least N blocks)")
         ->check(CLI::Range(1.0e-6, 1.0e6));
     c->add_option("--block-overlap", block_options_.overlap,
                   "with --blocks: a block's cell grown by this share of its size on each side")
@@ -185,8 +185,14 @@ class TrainCommand : public Command {
                   "both");
     pipeline::BlockRunOptions blocks;
     blocks.partition = block_options_;
-    blocks.partition.blocks = blocks_text_ == "auto" ? 0 : std::stoi(blocks_text_);
-    if (blocks.partition.blocks == 0) {
+    blocks.partition.blocks = 0;
+    if (blocks_text_ != "auto") {
+      std::size_t end = 0;
+      blocks.partition.blocks = std::stoi(blocks_text_, &end);
+      if (end != blocks_text_.size())
+        throw Error("<command line>", "--blocks", "a whole number or auto", blocks_text_);
+    }
+    if (max_gpu_memory_gib_ > 0) {  // with --blocks N: at least N blocks
       blocks.max_device_bytes = static_cast<std::int64_t>(max_gpu_memory_gib_ * (1ll << 30));
       blocks.budget_config = gaussians::resolveSchedule(config, options.schedule).config;
     }

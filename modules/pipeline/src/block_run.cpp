@@ -152,10 +152,10 @@ BlockRun::BlockRun(TrainRunOptions options, BlockRunOptions blocks)
   if (blocks_.ranks < 1 || blocks_.rank < 0 || blocks_.rank >= blocks_.ranks)
     throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(blocks_.rank));
   scene_ = loadScene(options_.scene, options_.scale, options_.progress);
-  if (blocks_.partition.blocks == 0) {
-    if (blocks_.max_device_bytes <= 0)
-      throw Error("<block run>", "max_device_bytes", "a memory budget with blocks = 0 (auto)",
-                  std::to_string(blocks_.max_device_bytes));
+  if (blocks_.partition.blocks == 0 && blocks_.max_device_bytes <= 0)
+    throw Error("<block run>", "max_device_bytes", "a memory budget with blocks = 0 (auto)",
+                std::to_string(blocks_.max_device_bytes));
+  if (blocks_.max_device_bytes > 0) {
     partition_ = partitionForMemory(scene_, blocks_.partition, blocks_.budget_config,
                                     blocks_.max_device_bytes, options_.progress, options_.scene);
   } else {

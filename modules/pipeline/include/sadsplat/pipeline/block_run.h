@@ -25,9 +25,9 @@ struct BlockRunOptions {
   /// Rank 0 waits, after its own blocks, until the other ranks' blocks have finished (ranks
   /// started by torchrun; ranks this process started are waited for as processes instead).
   bool wait_for_ranks = false;
-  /// With partition.blocks == 0 (`--blocks auto`): the fewest blocks whose every block's
-  /// estimated peak device memory (gaussians/memory_estimate.h) for `budget_config` is at most
-  /// this many bytes.
+  /// When > 0 (`--max-gpu-memory`): the fewest blocks, at least partition.blocks (0 = auto),
+  /// whose every block's estimated peak device memory (gaussians/memory_estimate.h) for
+  /// `budget_config` is at most this many bytes.
   std::int64_t max_device_bytes = 0;
   gaussians::TrainConfig budget_config;
 };
