@@ -202,6 +202,14 @@ TEST(BlockRun, AMemoryBudgetPicksTheFewestBlocksThatFit) {
   EXPECT_NE(out.find("trained in " + std::to_string(n) + " blocks"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(kCli + kTrain + " --blocks auto --out " + dir.file("r2"), &out), 1);
   EXPECT_NE(out.find("--max-gpu-memory"), std::string::npos) << out;
+  // info SCENE.cache says what training it would hold on a CUDA device, held and streamed.
+  ASSERT_EQ(test::runCommand(kCli + " info " + kTinySceneCache, &out), 0) << out;
+  config.device = "cuda";
+  EXPECT_NE(out.find("views held:      " + gaussians::estimateTrainingMemory(scene, config)
+                                               .describe()),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("--stream-views:"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -1,12 +1,30 @@
 // `sadsplat info FILE`: what a cloud, scene directory or scene cache holds.
 #include <iostream>
+#include <sstream>
 
 #include "commands.h"
+#include "sadsplat/gaussians/memory_estimate.h"
 #include "sadsplat/io/file_info.h"
+#include "sadsplat/io/scene_cache.h"
 
 namespace sadsplat {
 namespace cli {
 namespace {
+
+// What training the scene with the defaults would hold on a CUDA device, views held and
+// streamed (gaussians/memory_estimate.h): whether it fits a card before it is trained.
+std::string trainingMemory(const io::Scene& scene) {
+  gaussians::TrainConfig config;
+  config.device = "cuda";
+  std::ostringstream out;
+  out << "training memory on a CUDA device (defaults, estimated):\n"
+      << "  views held:      " << gaussians::estimateTrainingMemory(scene, config).describe()
+      << "\n";
+  config.stream_views = true;
+  out << "  --stream-views:  " << gaussians::estimateTrainingMemory(scene, config).describe()
+      << "\n  (train --max-gpu-memory GiB cuts the scene into as few blocks as fit)\n";
+  return out.str();
+}
 
 class InfoCommand : public Command {
  public:
@@ -20,7 +38,14 @@ class InfoCommand : public Command {
     return c;
   }
   int run(const Invocation&) override {
-    std::cout << (cameras_ ? io::describeCameras(path_) : io::describeFile(path_));
+    if (cameras_) {
+      std::cout << io::describeCameras(path_);
+    } else if (io::isSceneCache(path_)) {
+      const io::Scene scene = io::readSceneCache(path_);
+      std::cout << io::describeSceneCache(path_, scene) << trainingMemory(scene);
+    } else {
+      std::cout << io::describeFile(path_);
+    }
     return 0;
   }
 

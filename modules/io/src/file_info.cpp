@@ -283,8 +283,7 @@ std::string describeFile(const std::string& path) {
   requireRegularFile(path);  // a FIFO or device would block the reads below
   const std::string ext = lowerExtension(path);
   if (isSceneCache(path)) {
-    out << path << ": scene cache (version " << sceneCacheVersion(path) << ")\n";
-    describeScene(out, readSceneCache(path));
+    out << describeSceneCache(path, readSceneCache(path));
   } else if ((ext == ".ply" || ext == ".pcd") && cloudKind(path) == CloudKind::kSemantic) {
     out << path << ": semantic point cloud (x y z colour label)\n";
     describeSemantic(out, readSemanticCloud(path));
@@ -360,6 +359,13 @@ std::string describeFile(const std::string& path) {
     shown += printable(text.substr(start, nl - start)) + "\n";
   }
   return shown + printable(text.substr(start));
+}
+
+std::string describeSceneCache(const std::string& path, const Scene& scene) {
+  std::ostringstream out;
+  out << path << ": scene cache (version " << sceneCacheVersion(path) << ")\n";
+  describeScene(out, scene);
+  return out.str();
 }
 
 std::string describeCameras(const std::string& path) {

@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "sadsplat/io/scene.h"
+
 namespace sadsplat {
 namespace io {
 
@@ -11,6 +13,9 @@ namespace io {
 /// counts, SH degree, bounding box, classes, views.
 /// \throws sadsplat::Error if the file is of none of these kinds or is invalid
 std::string describeFile(const std::string& path);
+
+/// \brief describeFile's summary of the scene cache at `path` whose contents are `scene`.
+std::string describeSceneCache(const std::string& path, const Scene& scene);
 
 /// \brief The cameras of a scene cache or scene directory as CSV, one line per view after a
 /// header: name, width, height, fx, fy, cx, cy (pixels, centres at +0.5), qw qx qy qz and
