@@ -147,7 +147,14 @@ class TrainCommand : public Command {
     options.schedule.given = given;
     if (batch_schedule_) options.schedule.batch_ranks = rank_env ? rank_env->world_size : 1;
     if (rank_env && config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);
-    if (rank_env && blocks_text_.empty() && max_gpu_memory_gib_ <= 0) {
+    // A budget alone means --blocks auto.
+    if (max_gpu_memory_gib_ > 0 && blocks_text_.empty()) blocks_text_ = "auto";
+    const bool in_blocks = !blocks_text_.empty();
+    if (blocks_text_ == "auto" && max_gpu_memory_gib_ <= 0)
+      throw Error("<command line>", "--max-gpu-memory",
+                  "a budget in GiB with --blocks auto (e.g. --max-gpu-memory 22 for a 24 GB card)",
+                  "none");
+    if (rank_env && !in_blocks) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
       options.collective = distributed::joinGroup(*rank_env, config.device);
     }
@@ -160,12 +167,7 @@ class TrainCommand : public Command {
     options.progress = quiet_rank ? nullptr : &std::cout;
     options.stop = &g_stop;
     installStopHandlers();
-    if (max_gpu_memory_gib_ > 0 && blocks_text_.empty()) blocks_text_ = "auto";
-    if (blocks_text_ == "auto" && max_gpu_memory_gib_ <= 0)
-      throw Error("<command line>", "--max-gpu-memory",
-                  "a budget in GiB with --blocks auto (e.g. --max-gpu-memory 22 for a 24 GB card)",
-                  "none");
-    if (!blocks_text_.empty()) return trainInBlocks(options, config, rank_env, local_ranks);
+    if (in_blocks) return trainInBlocks(options, config, rank_env, local_ranks);
     const double seconds = pipeline::trainRun(options, config);
     if (local_ranks) local_ranks->waitAll();
     if (!quiet_rank)

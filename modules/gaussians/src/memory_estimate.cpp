@@ -5,6 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "sadsplat/gaussians/initialization.h"
+
 namespace sadsplat {
 namespace gaussians {
 
@@ -85,9 +87,9 @@ MemoryEstimate estimateTrainingMemory(const io::Scene& scene, const TrainConfig&
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
     if (scene.views[i].train) views.push_back(static_cast<int>(i));
   }
-  const bool random = c.init == "random" || (c.init == "auto" && scene.points.size() < 4);
-  const std::size_t points =
-      random ? static_cast<std::size_t>(c.init_random_count) : scene.points.size();
+  const std::size_t points = initialisesRandomly(c.init, scene.points.size())
+                                 ? static_cast<std::size_t>(c.init_random_count)
+                                 : scene.points.size();
   return estimateTrainingMemory(scene, views, points, c);
 }
 

@@ -1,9 +1,9 @@
 #include "sadsplat/pipeline/block_run.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
-#include <chrono>
 #include <sstream>
 #include <thread>
 #include <utility>
