@@ -12,7 +12,8 @@
 #                  (--blocks), each for ITERATIONS steps; then scripts/block_borders.py against
 #                  xl_1gpu on the views that straddle block borders
 #   xl_blocks_ranks  the same blocks shared by GPUS ranks (--blocks --nproc GPUS)
-#   xl_stream      as xl_1gpu with --stream-views (views in host memory, uploaded per step)
+#   xl_stream      as xl_1gpu with --stream-views (views read from the scene cache ahead of the
+#                  steps that use them, uploaded per step)
 #   xl_auto        --max-gpu-memory BUDGET (env, GiB, default 22): as few blocks as the estimate
 #                  fits (views held); xl_auto_stream the same with --stream-views
 # PRESET (env, default city-xl; city-xxl: 1,120 views over 16 city tiles) is the large scene.
@@ -22,7 +23,8 @@
 # VIEWS (env, default 1): views per step and rank in the batched runs (global batch GPUS x VIEWS).
 # EXTRA_FLAGS (env) go to every training, e.g. --profile (then $OUT gets profile_<run>.md).
 # Output names carry the shape: xl_ranks4x2 (4 ranks x 2 views), xl_1gpu_batch8 (8 views a step).
-# $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, mIoU / PSNR), the logs
+# $OUT gets summary.txt (wall time, Gaussians, peak GPU memory per GPU, peak host memory of
+# rank 0's process, mIoU / PSNR), the logs
 # and the metrics.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"   # NVLink multicast off (inherited by the ranks), build, scene caches
@@ -74,7 +76,7 @@ except Exception: print("? ? ?")' "$dir/metrics.json")
     python3 -c 'import json, sys; print(max((json.loads(l).get("gaussians", 0) for l in sys.stdin if l.strip()), default=0))')
   gaussians="$gaussians, most $most"
   tr '\r' '\n' < "$out/train_$name.log" | grep -E "GiB estimated" | sed "s/^/  $name /" | tee -a "$summary" || true
-  echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
+  echo "$name: wall ${wall} ms, $(grep -o 'trained in [0-9.]* s' "$out/train_$name.log" || true), $gaussians, peak $(peak_memory "$out/mem_$name.csv"), $(grep -o 'peak host memory [0-9]* MiB' "$out/train_$name.log" || true), mIoU $miou, PSNR $psnr, flags: $*" | tee -a "$summary"
   if [ -f "$dir/blocks.json" ]; then cp "$dir/blocks.json" "$out/blocks_$name.json"; fi
 }
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/io/scene_cache.h"
@@ -245,6 +246,109 @@ TEST(SceneCache, DamagedCompressedImagesAreErrors) {
   fixChecksum(huge);
   test::writeFile(dir.file("huge.cache"), huge);
   expectCacheError(dir.file("huge.cache"), "truncated or corrupt");
+}
+
+// A view with pseudo-labels: view 1 of syntheticScene (no label map) gets two targets.
+io::Scene sceneWithPseudoLabels() {
+  io::Scene scene = syntheticScene();
+  io::View& v = scene.views[1];
+  io::ViewPseudoLabels& p = v.pseudo;
+  p.backend = "builtin";
+  p.num_targets = 2;
+  p.num_classes = 2;
+  p.feature_dim = 1;
+  const auto n = static_cast<std::size_t>(v.camera.width * v.camera.height);
+  for (std::size_t k = 0; k < n; ++k) p.region.push_back(static_cast<std::int32_t>(k % 3) - 1);
+  p.scores = {0.25f, 0.75f, 0.5f, 0.5f};
+  p.features = {0.125f, -2.0f};
+  p.kept = {1, 0};
+  return scene;
+}
+
+// A cache read without pixels holds what the whole read holds but the pixels; each view read on
+// its own is the whole read's view, for version 3 and for the version-1 fixture.
+TEST(SceneCache, ViewsReadOneAtATimeAreTheWholeReadsViews) {
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("s.cache"), sceneWithPseudoLabels());
+  for (const std::string& path :
+       {dir.file("s.cache"), std::string(SADSPLAT_TEST_DATA_DIR) + "/tiny_scene.cache"}) {
+    const io::Scene whole = io::readSceneCache(path);
+    const io::Scene lazy = io::readSceneCacheWithoutPixels(path);
+    EXPECT_EQ(lazy.source, whole.source);
+    ASSERT_EQ(lazy.classes.size(), whole.classes.size());
+    ASSERT_EQ(lazy.points.size(), whole.points.size());
+    EXPECT_EQ(lazy.points.back().xyz, whole.points.back().xyz);
+    ASSERT_EQ(lazy.views.size(), whole.views.size());
+    int with_pseudo = 0;
+    for (std::size_t i = 0; i < whole.views.size(); ++i) {
+      const io::View &a = whole.views[i], &b = lazy.views[i];
+      EXPECT_EQ(b.name, a.name);
+      EXPECT_EQ(b.camera.tvec, a.camera.tvec);
+      EXPECT_EQ(b.train, a.train);
+      EXPECT_EQ(b.labelled, a.labelled);
+      EXPECT_TRUE(b.rgb.empty() && b.mask.empty() && b.labels.empty() && b.pseudo.empty());
+      ASSERT_TRUE(b.pixels_in_cache != nullptr);
+      EXPECT_EQ(b.hasLabels(), a.hasLabels());
+      EXPECT_EQ(b.hasPseudoLabels(), a.hasPseudoLabels());
+      const io::View c = io::readViewPixels(b);
+      EXPECT_TRUE(c.pixels_in_cache == nullptr);
+      EXPECT_EQ(c.rgb.pixels, a.rgb.pixels) << path << " " << a.name;
+      EXPECT_EQ(c.mask.pixels, a.mask.pixels);
+      EXPECT_EQ(c.labels.pixels, a.labels.pixels);
+      EXPECT_EQ(c.pseudo.region, a.pseudo.region);
+      EXPECT_EQ(c.pseudo.scores, a.pseudo.scores);
+      EXPECT_EQ(c.pseudo.features, a.pseudo.features);
+      EXPECT_EQ(c.pseudo.kept, a.pseudo.kept);
+      with_pseudo += !c.pseudo.empty();
+    }
+    if (path == dir.file("s.cache")) EXPECT_EQ(with_pseudo, 1);
+  }
+}
+
+// Damage: the whole file's checksum is checked when it is opened; a damaged image whose checksum
+// was made valid again is found when its view is read, naming the file and the image; a file
+// that changed after the open is an error naming the view.
+TEST(SceneCache, ViewsReadOneAtATimeReportDamage) {
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("s.cache"), sceneWithPseudoLabels());
+  const std::string good = test::readFile(dir.file("s.cache"));
+  const auto expectError = [](const std::function<void()>& read, const std::string& file,
+                              const std::string& needle) {
+    try {
+      read();
+      ADD_FAILURE() << "expected an error containing " << needle;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.file(), file);
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  std::string bytes = good;
+  bytes[bytes.size() - 20] ^= 0x40;
+  test::writeFile(dir.file("flip.cache"), bytes);
+  expectError([&] { io::readSceneCacheWithoutPixels(dir.file("flip.cache")); },
+              dir.file("flip.cache"), "checksum");
+  test::writeFile(dir.file("short.cache"), good.substr(0, good.size() - 7));
+  expectError([&] { io::readSceneCacheWithoutPixels(dir.file("short.cache")); },
+              dir.file("short.cache"), "truncated");
+  expectError([&] { io::readSceneCacheWithoutPixels(dir.file("none.cache")); },
+              dir.file("none.cache"), "existing, readable file");
+
+  // The first view's rgb block zeroed (see DamagedCompressedImagesAreErrors).
+  const std::size_t block = good.find("VIEW") + 4 + 8 + 4 + 6 + 8 + 11 * 8 + 2;
+  std::uint64_t size;
+  std::memcpy(&size, &good[block], 8);
+  bytes = good;
+  std::memset(&bytes[block + 8], 0, size);
+  fixChecksum(bytes);
+  test::writeFile(dir.file("zeroed.cache"), bytes);
+  const io::Scene zeroed = io::readSceneCacheWithoutPixels(dir.file("zeroed.cache"));
+  EXPECT_NO_THROW(io::readViewPixels(zeroed.views[1]));
+  expectError([&] { io::readViewPixels(zeroed.views[0]); }, dir.file("zeroed.cache"), "rgb");
+
+  const io::Scene opened = io::readSceneCacheWithoutPixels(dir.file("s.cache"));
+  test::writeFile(dir.file("s.cache"), good.substr(0, good.size() / 2));
+  expectError([&] { io::readViewPixels(opened.views[2]); }, dir.file("s.cache"),
+              "view v2.png VIEW chunk: expected the bytes found when the cache was opened");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 // `sadsplat train SCENE --out RUN`: train semantic Gaussians. The training flags come from the
 // option table (gaussians/train_options.h); a --config JSON file is applied first, flags on top.
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -25,6 +27,13 @@
 namespace sadsplat {
 namespace cli {
 namespace {
+
+// This process's peak resident host memory (the kernel's high-water mark).
+std::string peakHostMemoryText() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return "peak host memory unknown";
+  return "peak host memory " + std::to_string(usage.ru_maxrss / 1024) + " MiB";  // KiB on Linux
+}
 
 class TrainCommand : public Command {
  public:
@@ -171,7 +180,8 @@ class TrainCommand : public Command {
     const double seconds = pipeline::trainRun(options, config);
     if (local_ranks) local_ranks->waitAll();
     if (!quiet_rank)
-      std::cout << "trained in " << seconds << " s; model in " << out_ << "/model.ply\n";
+      std::cout << "trained in " << seconds << " s; model in " << out_ << "/model.ply; "
+                << peakHostMemoryText() << "\n";
     return 0;
   }
 
@@ -198,6 +208,7 @@ class TrainCommand : public Command {
       blocks.max_device_bytes = static_cast<std::int64_t>(max_gpu_memory_gib_ * (1ll << 30));
       blocks.budget_config = gaussians::resolveSchedule(config, options.schedule).config;
     }
+    blocks.pixels_on_disk = config.stream_views;
     blocks.rank = rank_env ? rank_env->rank : 0;
     blocks.ranks = rank_env ? rank_env->world_size : 1;
     blocks.wait_for_ranks = !local_ranks && blocks.ranks > 1;
@@ -209,7 +220,7 @@ class TrainCommand : public Command {
     run.merge();
     std::cout << "trained in " << run.partition().blocks.size() << " blocks in "
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-              << " s; model in " << out_ << "/model.ply\n";
+              << " s; model in " << out_ << "/model.ply; " << peakHostMemoryText() << "\n";
     return 0;
   }
 

@@ -21,12 +21,12 @@ std::int64_t renderFloatsPerPixel(const TrainConfig& c) {
 }
 
 bool supervised(const io::View& v, const TrainConfig& c) {
-  if (v.labelled && !v.labels.empty()) return true;
-  return c.use_pseudo_labels && !v.pseudo.empty();
+  if (v.labelled && v.hasLabels()) return true;
+  return c.use_pseudo_labels && v.hasPseudoLabels();
 }
 
 bool hasConfidence(const io::View& v) {
-  return (v.labelled && !v.labels.empty()) || !v.pseudo.empty();
+  return (v.labelled && v.hasLabels()) || v.hasPseudoLabels();
 }
 
 }  // namespace

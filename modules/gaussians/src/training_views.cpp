@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
+#include <thread>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
+#include "sadsplat/io/scene_cache.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -20,12 +22,30 @@ std::vector<int> TrainingViews::guardProbeViews() const {
 
 DeviceView TrainingViews::onDevice(int v) const {
   if (!streamed) return {images[v], masks[v], labels[v]};
+  HostView host;
+  if (loader) {
+    host = loader->take(v);
+  } else {
+    host.image = images[v];
+    host.mask = masks[v];
+    host.labels = labels[v];
+  }
   // The conversions of loadTrainingViews, on the device: the same values.
   DeviceView d;
-  d.image = images[v].to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
-  d.mask = masks[v].to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
-  if (labels[v].defined()) d.labels = labels[v].to(device, /*non_blocking=*/true).to(at::kLong);
+  d.image = host.image.to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
+  d.mask = host.mask.to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
+  if (host.labels.defined())
+    d.labels = host.labels.to(device, /*non_blocking=*/true).to(at::kLong);
   return d;
+}
+
+void TrainingViews::prefetch(const TrainConfig& config, int it, int rank, int ranks) {
+  if (!loader) return;
+  for (int k = std::max(prefetched_until + 1, it); k <= it + kPrefetchSteps; ++k) {
+    for (int v : drawStepViews(*this, config, k, rank, ranks, false).views) loader->request(v, k);
+  }
+  prefetched_until = std::max(prefetched_until, it + kPrefetchSteps);
+  loader->forgetBefore(it);
 }
 
 std::vector<RasterCamera> TrainingViews::trainingCameras() const {
@@ -36,7 +56,7 @@ std::vector<RasterCamera> TrainingViews::trainingCameras() const {
 
 ViewRole TrainingViews::role(int v, const TrainConfig& config) const {
   ViewRole r;
-  r.semantic = labels[v].defined() && semantic_weight[v] > 0 && config.feature_dim > 0;
+  r.semantic = supervised[v] && semantic_weight[v] > 0 && config.feature_dim > 0;
   // Ground truth always trains the decoder; pseudo-labels when the configuration says so.
   const bool ground_truth =
       std::find(labelled_views.begin(), labelled_views.end(), v) != labelled_views.end();
@@ -91,15 +111,83 @@ StepViews drawStepViews(const TrainingViews& s, const TrainConfig& c, int it, in
   return step;
 }
 
+namespace {
+
+// View `v` (holding its pixels) as host tensors; with `summaries` also the confidence map and
+// flags the trainer keeps of it.
+HostView hostView(const io::View& v, const TrainConfig& config, bool pin, bool summaries) {
+  const int H = v.camera.height, W = v.camera.width;
+  // A host copy the device can read asynchronously: page-locked for a CUDA device.
+  const auto host = [&](const at::Tensor& t) { return pin ? t.pin_memory() : t.clone(); };
+  HostView h;
+  const at::Tensor rgb8 = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
+                                        {H, W, 3}, at::TensorOptions().dtype(at::kByte));
+  const at::Tensor mask8 = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()), {H, W},
+                                         at::TensorOptions().dtype(at::kByte));
+  h.image = host(rgb8);
+  h.mask = host(mask8);
+  // Semantic supervision (ground truth wins, then kept pseudo-labels).
+  h.ground_truth = v.labelled && !v.labels.empty();
+  const std::vector<std::int16_t> sup = io::supervisionLabels(v, config.use_pseudo_labels);
+  if (std::any_of(sup.begin(), sup.end(), [](std::int16_t l) { return l >= 0; })) {
+    h.labels = host(at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W},
+                                  at::TensorOptions().dtype(at::kShort)));
+  }
+  if (!summaries) return h;
+  h.mask_is_full = std::all_of(v.mask.pixels.begin(), v.mask.pixels.end(),
+                               [](std::uint8_t m) { return m == 255; });
+  // The confidence map of the drop: 1 on ground-truth pixels, else the pseudo-label backend's
+  // max class score.
+  if (!v.pseudo.empty()) {
+    const std::vector<float> best = v.pseudo.maxScoreMap();
+    h.confidence = at::from_blob(const_cast<float*>(best.data()), {H, W}, at::kFloat).clone();
+  }
+  if (h.ground_truth) {
+    const at::Tensor gt_valid =
+        (at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
+                       at::TensorOptions().dtype(at::kByte)) != io::kIgnoreLabel) &
+        (mask8.to(at::kFloat).div(255.0) >= 0.5);
+    h.confidence = at::where(gt_valid, at::ones({H, W}),
+                             h.confidence.defined() ? h.confidence : at::zeros({H, W}));
+  }
+  return h;
+}
+
+int loaderThreads() {
+  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+}
+
+}  // namespace
+
 TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& config,
                                 const at::Device& device) {
   TrainingViews s;
-  s.streamed = config.stream_views;
   s.device = device;
-  // A host copy the device can read asynchronously: page-locked for a CUDA device.
-  const auto host = [&](const at::Tensor& t) {
-    return device.is_cuda() ? t.pin_memory() : t.clone();
+  const bool pin = device.is_cuda() && config.stream_views;
+  // Views whose pixels wait in a scene cache are read on loader threads, a window at a time;
+  // streamed, they are read again for each step that uses them.
+  std::vector<io::View> waiting(scene.views.size());
+  bool from_cache = false;
+  for (std::size_t i = 0; i < scene.views.size(); ++i) {
+    if (!scene.views[i].train || !scene.views[i].pixels_in_cache) continue;
+    waiting[i] = scene.views[i];
+    from_cache = true;
+  }
+  s.streamed = config.stream_views;
+  const auto loaderFor = [&](bool summaries) {
+    return std::make_shared<ViewLoader>(
+        [waiting, config, pin, summaries](int v) {
+          return hostView(io::readViewPixels(waiting[v]), config, pin, summaries);
+        },
+        loaderThreads());
   };
+  std::shared_ptr<ViewLoader> first_read;
+  std::vector<int> order;  // the training views, for the first read's window
+  for (std::size_t i = 0; i < scene.views.size(); ++i)
+    if (scene.views[i].train) order.push_back(static_cast<int>(i));
+  if (from_cache) first_read = loaderFor(true);
+  const int window = 2 * loaderThreads();
+  std::size_t next = 0;
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
     const io::View& v = scene.views[i];
     s.cameras.push_back(RasterCamera::fromPinhole(v.camera));
@@ -108,55 +196,50 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
       s.masks.emplace_back();
       s.mask_is_full.push_back(0);
       s.labels.emplace_back();
+      s.supervised.push_back(0);
       s.semantic_weight.push_back(0.0);
       s.confidence_maps.emplace_back();
       continue;
     }
-    const int H = v.camera.height, W = v.camera.width;
-    const at::Tensor rgb8 = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
-                                          {H, W, 3}, at::TensorOptions().dtype(at::kByte));
-    const at::Tensor mask8 = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()),
-                                           {H, W}, at::TensorOptions().dtype(at::kByte));
-    const at::Tensor mask = mask8.to(at::kFloat).div(255.0);
-    s.images.push_back(s.streamed ? host(rgb8) : rgb8.to(at::kFloat).div(255.0).to(device));
-    s.masks.push_back(s.streamed ? host(mask8) : mask.to(device));
-    s.mask_is_full.push_back(std::all_of(v.mask.pixels.begin(), v.mask.pixels.end(),
-                                         [](std::uint8_t m) { return m == 255; }));
-    // Semantic supervision (ground truth wins, then kept pseudo-labels) and the confidence map
-    // of the drop (1 on ground-truth pixels, else the pseudo-label backend's max class score).
-    at::Tensor labels, confidence;
-    const bool gt = v.labelled && !v.labels.empty();
-    const std::vector<std::int16_t> sup = io::supervisionLabels(v, config.use_pseudo_labels);
-    if (std::any_of(sup.begin(), sup.end(), [](std::int16_t l) { return l >= 0; })) {
-      labels = at::from_blob(const_cast<std::int16_t*>(sup.data()), {H, W},
-                             at::TensorOptions().dtype(at::kShort));
-      labels = s.streamed ? host(labels) : labels.to(at::kLong);
-      if (gt) {
+    HostView h;
+    if (v.pixels_in_cache) {
+      for (; next < order.size() && order[next] < static_cast<int>(i) + window; ++next)
+        first_read->request(order[next], order[next]);
+      h = first_read->take(static_cast<int>(i));
+      first_read->forgetBefore(static_cast<int>(i) + 1);
+    } else {
+      h = hostView(v, config, pin, true);
+    }
+    if (h.labels.defined()) {
+      if (h.ground_truth) {
         s.labelled_views.push_back(static_cast<int>(i));
       } else {
         ++s.pseudo_labelled_views;
       }
     }
-    if (!v.pseudo.empty()) {
-      const std::vector<float> best = v.pseudo.maxScoreMap();
-      confidence = at::from_blob(const_cast<float*>(best.data()), {H, W}, at::kFloat).clone();
+    s.mask_is_full.push_back(h.mask_is_full);
+    s.supervised.push_back(h.labels.defined());
+    s.semantic_weight.push_back(h.ground_truth ? config.lambda_semantic : config.lambda_pseudo);
+    s.confidence_maps.push_back(h.confidence.defined() ? h.confidence.to(device) : h.confidence);
+    if (s.streamed && v.pixels_in_cache) {  // read again for each step
+      s.images.emplace_back();
+      s.masks.emplace_back();
+      s.labels.emplace_back();
+    } else if (s.streamed) {
+      s.images.push_back(h.image);
+      s.masks.push_back(h.mask);
+      s.labels.push_back(h.labels);
+    } else {
+      s.images.push_back(h.image.to(at::kFloat).div(255.0).to(device));
+      s.masks.push_back(h.mask.to(at::kFloat).div(255.0).to(device));
+      s.labels.push_back(h.labels.defined() ? h.labels.to(at::kLong).to(device) : h.labels);
     }
-    if (gt) {
-      const at::Tensor gt_valid =
-          (at::from_blob(const_cast<std::uint8_t*>(v.labels.pixels.data()), {H, W},
-                         at::TensorOptions().dtype(at::kByte)) != io::kIgnoreLabel) &
-          (mask >= 0.5);
-      confidence = at::where(gt_valid, at::ones({H, W}),
-                             confidence.defined() ? confidence : at::zeros({H, W}));
-    }
-    s.labels.push_back(labels.defined() && !s.streamed ? labels.to(device) : labels);
-    s.semantic_weight.push_back(gt ? config.lambda_semantic : config.lambda_pseudo);
-    s.confidence_maps.push_back(confidence.defined() ? confidence.to(device) : confidence);
     s.train_views.push_back(static_cast<int>(i));
   }
   if (s.train_views.empty()) {
     throw Error(scene.source, "split", "at least one training view", "none");
   }
+  if (s.streamed && from_cache) s.loader = loaderFor(false);
   return s;
 }
 

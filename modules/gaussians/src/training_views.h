@@ -4,11 +4,13 @@
 
 #include <ATen/ATen.h>
 
+#include <memory>
 #include <vector>
 
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/scene.h"
+#include "view_loader.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -29,17 +31,25 @@ struct DeviceView {
   at::Tensor labels;  // [H, W] int64, -1 = not supervised (or undefined)
 };
 
+// How many steps ahead the loader reads the views of a scene read without pixels.
+constexpr int kPrefetchSteps = 16;
+
 struct TrainingViews {
   // Held (the default): images, masks and labels are the DeviceView tensors, on the device.
   // Streamed (TrainConfig::stream_views): they are host copies in 8 / 8 / 16 bits (pinned for a
-  // CUDA device) that onDevice uploads and converts each time a step uses the view.
+  // CUDA device) that onDevice uploads and converts each time a step uses the view. Streamed
+  // from a scene read without pixels (io::readSceneCacheWithoutPixels): `loader` reads them from
+  // the cache ahead of the steps (prefetch) and images / masks / labels stay undefined.
   bool streamed = false;
+  std::shared_ptr<ViewLoader> loader;
+  int prefetched_until = -1;  // the last step whose views the loader was asked for
   at::Device device{at::kCPU};
   std::vector<RasterCamera> cameras;        // every view of the scene
   std::vector<at::Tensor> images;           // training views only (see above)
   std::vector<at::Tensor> masks;
   std::vector<char> mask_is_full;           // every pixel valid: the mask multiplies nothing
   std::vector<at::Tensor> labels;           // undefined where a view supervises no class
+  std::vector<char> supervised;             // some pixel of the view has a class to learn
   std::vector<double> semantic_weight;      // lambda_semantic (ground truth) or lambda_pseudo
   std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (or undefined)
   int pseudo_labelled_views = 0;
@@ -49,6 +59,9 @@ struct TrainingViews {
   // queued on the current stream: the host does not wait for it).
   DeviceView onDevice(int v) const;
   std::vector<RasterCamera> trainingCameras() const;
+  // Asks the loader (if any) for the views of steps `it` .. it + kPrefetchSteps and forgets
+  // those of earlier steps.
+  void prefetch(const TrainConfig& config, int it, int rank, int ranks);
   // The training views the drop's guard renders (a fixed set, so its readings are comparable):
   // up to kGuardProbeViews spread evenly over the training views.
   std::vector<int> guardProbeViews() const;

@@ -154,6 +154,107 @@ Image8 readImage(ByteReader& r, std::uint32_t version, int w, int h, int channel
   return image;
 }
 
+// The scene's classes (chunk CLAS).
+std::vector<ClassInfo> readClassChunk(ByteReader& c, const std::string& path) {
+  const auto n = c.get<std::uint32_t>("class count");
+  // Label maps are bytes with 255 = ignore: at most 255 classes (as classes.json); 0 is a scene
+  // without classes (plain 3DGS).
+  if (n > 255) throw Error(path, "chunk CLAS class count", "0 to 255 classes", std::to_string(n));
+  std::vector<ClassInfo> classes;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    ClassInfo cls;
+    cls.name = c.getString("class name");
+    for (auto& v : cls.color) v = c.get<std::uint8_t>("class colour");
+    cls.prompt = c.getString("class prompt");
+    classes.push_back(cls);
+  }
+  return classes;
+}
+
+// A VIEW chunk up to its images: name, camera (checked) and roles; `has_labels` whether a label
+// map follows the mask.
+View readViewHead(ByteReader& c, const std::string& path, bool* has_labels) {
+  View v;
+  v.name = c.getString("view name");
+  v.camera.width = static_cast<int>(c.get<std::uint32_t>("width"));
+  v.camera.height = static_cast<int>(c.get<std::uint32_t>("height"));
+  v.camera.fx = c.getFinite("fx");
+  v.camera.fy = c.getFinite("fy");
+  v.camera.cx = c.getFinite("cx");
+  v.camera.cy = c.getFinite("cy");
+  for (double& q : v.camera.qvec) q = c.getFinite("qvec");
+  for (double& t : v.camera.tvec) t = c.getFinite("tvec");
+  const auto roles = c.get<std::uint8_t>("roles");
+  v.train = roles & 1;
+  v.test = roles & 2;
+  v.labelled = roles & 4;
+  *has_labels = c.get<std::uint8_t>("has labels") != 0;
+  v.camera.validate(path, "view " + v.name + " camera");
+  return v;
+}
+
+// The sparse points (chunk PNTS).
+std::vector<ScenePoint> readPointChunk(ByteReader& c, const std::string& path) {
+  const auto n = c.get<std::uint64_t>("point count");
+  if (n > c.remaining() / 15) {
+    throw Error(path, "chunk PNTS point count", "a count that fits the chunk", std::to_string(n));
+  }
+  std::vector<ScenePoint> points(n);
+  for (auto& p : points) {
+    for (float& x : p.xyz) {
+      x = c.get<float>("point xyz");
+      if (!std::isfinite(x)) throw Error(path, "point xyz", "finite coordinates", std::to_string(x));
+    }
+    for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
+  }
+  return points;
+}
+
+// A PSLB chunk into `view.pseudo`, but for a version-3 region map: its deflated block, returned
+// for decodeRegionBlock (null for versions 1-2, whose raw map is read here). `view`: the view read
+// just before the chunk (null: none).
+std::pair<const std::uint8_t*, std::size_t> readPseudoChunk(ByteReader& c, std::uint32_t version,
+                                                            std::size_t classes, View* view,
+                                                            const std::string& path) {
+  const std::string name = c.getString("view name");
+  if (view == nullptr || view->name != name) {
+    throw Error(path, "chunk PSLB view", "the view read just before it", name);
+  }
+  ViewPseudoLabels& p = view->pseudo;
+  p.backend = c.getString("backend");
+  p.num_targets = static_cast<int>(c.get<std::uint32_t>("target count"));
+  p.num_classes = static_cast<int>(c.get<std::uint32_t>("class count"));
+  p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
+  const std::size_t pixels = static_cast<std::size_t>(view->camera.width) * view->camera.height;
+  std::pair<const std::uint8_t*, std::size_t> region_block{nullptr, 0};
+  if (version >= 3) {
+    region_block = c.getBlock("region map");
+  } else {
+    p.region = c.getArray<std::int32_t>(pixels, "region map");
+  }
+  p.scores = c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
+  p.features =
+      c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.feature_dim, "features");
+  p.kept = c.getBytes(p.num_targets, "kept flags");
+  if (p.num_classes != static_cast<int>(classes)) {
+    throw Error(path, "view " + name + " pseudo-labels class count", std::to_string(classes),
+                std::to_string(p.num_classes));
+  }
+  return region_block;
+}
+
+// The region map of `view`'s pseudo-labels from its block (if any), then their checks.
+void finishPseudoLabels(View& view, std::pair<const std::uint8_t*, std::size_t> region_block,
+                        const std::string& path) {
+  const std::size_t pixels = static_cast<std::size_t>(view.camera.width) * view.camera.height;
+  if (region_block.first != nullptr) {
+    view.pseudo.region =
+        planes::decodeRegions(path, "chunk PSLB region map of view " + view.name,
+                              region_block.first, region_block.second, pixels, view.camera.width);
+  }
+  view.pseudo.validate(path + " (view " + view.name + ")", pixels);
+}
+
 }  // namespace
 
 namespace {
@@ -284,34 +385,57 @@ std::uint32_t sceneCacheVersion(const std::string& path) {
   return version;
 }
 
-Scene readSceneCache(const std::string& path) {
-  const std::string bytes = readWholeFile(path);
+namespace {
+
+struct CacheHeader {
+  std::uint32_t version = 0;
+  std::uint64_t payload_size = 0;
+  std::uint64_t checksum = 0;
+};
+
+// The header at the start of `bytes` (at least its first 32 bytes) of a file of `file_size`
+// bytes: magic, a version this reader knows, a payload size that matches the file.
+CacheHeader readCacheHeader(const std::string& path, const std::string& bytes,
+                            std::uint64_t file_size) {
   ByteReader head(path, bytes.data(), bytes.size(), "header");
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kSceneMagic, 8) != 0) {
     throw Error(path, "magic", "a sadsplat scene cache starting with \"SADSCENE\"",
                 "other bytes");
   }
   head.getBytes(8, "magic");
-  const auto version = head.get<std::uint32_t>("version");
-  if (version < 1 || version > kSceneCacheVersion) {
+  CacheHeader h;
+  h.version = head.get<std::uint32_t>("version");
+  if (h.version < 1 || h.version > kSceneCacheVersion) {
     throw Error(path, "version",
                 "1 to " + std::to_string(kSceneCacheVersion) +
                     " (a newer sadsplat wrote it, or it is damaged: re-import the scene)",
-                std::to_string(version));
+                std::to_string(h.version));
   }
   head.get<std::uint32_t>("flags");
-  const auto payload_size = head.get<std::uint64_t>("payload size");
-  const auto checksum = head.get<std::uint64_t>("checksum");
-  if (payload_size != bytes.size() - kHeaderSize) {
-    throw Error(path, "payload size", std::to_string(payload_size) + " bytes after the header",
-                std::to_string(bytes.size() - kHeaderSize) + " (file truncated or padded)");
+  h.payload_size = head.get<std::uint64_t>("payload size");
+  h.checksum = head.get<std::uint64_t>("checksum");
+  if (h.payload_size != file_size - kHeaderSize) {
+    throw Error(path, "payload size", std::to_string(h.payload_size) + " bytes after the header",
+                std::to_string(file_size - kHeaderSize) + " (file truncated or padded)");
   }
+  return h;
+}
+
+void throwChecksumMismatch(const std::string& path) {
+  throw Error(path, "checksum", "the FNV-1a hash stored in the header", "a mismatch (corrupt)");
+}
+
+}  // namespace
+
+Scene readSceneCache(const std::string& path) {
+  const std::string bytes = readWholeFile(path);
+  const CacheHeader header = readCacheHeader(path, bytes, bytes.size());
+  const std::uint32_t version = header.version;
+  const std::uint64_t payload_size = header.payload_size;
   const char* body = bytes.data() + kHeaderSize;
   const std::uint64_t hash = version == 1 ? fnv1aWithBasis(body, payload_size, kVersion1Basis)
                                           : fnv1a64(body, payload_size);
-  if (hash != checksum) {
-    throw Error(path, "checksum", "the FNV-1a hash stored in the header", "a mismatch (corrupt)");
-  }
+  if (hash != header.checksum) throwChecksumMismatch(path);
 
   Scene scene;
   // Version 3's images and region maps are decoded after the chunks are read, on every core
@@ -327,38 +451,12 @@ Scene readSceneCache(const std::string& path) {
     if (tag == "SRCE") {
       scene.source = c.getString("source");
     } else if (tag == "CLAS") {
-      const auto n = c.get<std::uint32_t>("class count");
-      // Label maps are bytes with 255 = ignore: at most 255 classes (as classes.json); 0 is a
-      // scene without classes (plain 3DGS).
-      if (n > 255) {
-        throw Error(path, "chunk CLAS class count", "0 to 255 classes", std::to_string(n));
-      }
-      for (std::uint32_t i = 0; i < n; ++i) {
-        ClassInfo cls;
-        cls.name = c.getString("class name");
-        for (auto& v : cls.color) v = c.get<std::uint8_t>("class colour");
-        cls.prompt = c.getString("class prompt");
-        scene.classes.push_back(cls);
-      }
+      scene.classes = readClassChunk(c, path);
       have_classes = true;
     } else if (tag == "VIEW") {
-      View v;
-      v.name = c.getString("view name");
-      v.camera.width = static_cast<int>(c.get<std::uint32_t>("width"));
-      v.camera.height = static_cast<int>(c.get<std::uint32_t>("height"));
-      v.camera.fx = c.getFinite("fx");
-      v.camera.fy = c.getFinite("fy");
-      v.camera.cx = c.getFinite("cx");
-      v.camera.cy = c.getFinite("cy");
-      for (double& q : v.camera.qvec) q = c.getFinite("qvec");
-      for (double& t : v.camera.tvec) t = c.getFinite("tvec");
-      const auto roles = c.get<std::uint8_t>("roles");
-      v.train = roles & 1;
-      v.test = roles & 2;
-      v.labelled = roles & 4;
-      const bool has_labels = c.get<std::uint8_t>("has labels") != 0;
+      bool has_labels = false;
+      View v = readViewHead(c, path, &has_labels);
       const int w = v.camera.width, h = v.camera.height;
-      v.camera.validate(path, "view " + v.name + " camera");
       if (has_labels && !have_classes) {
         throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
       }
@@ -385,21 +483,95 @@ Scene readSceneCache(const std::string& path) {
       if (has_labels) image(&View::labels, 1, "labels", true);
       scene.views.push_back(std::move(v));
     } else if (tag == "PNTS") {
-      const auto n = c.get<std::uint64_t>("point count");
-      if (n > c.remaining() / 15) {
-        throw Error(path, "chunk PNTS point count", "a count that fits the chunk",
-                    std::to_string(n));
+      scene.points = readPointChunk(c, path);
+    } else if (tag == "GEOR") {
+      scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
+    } else if (tag == "PSLB") {
+      const auto region_block = readPseudoChunk(c, version, scene.classes.size(),
+                                                scene.views.empty() ? nullptr : &scene.views.back(),
+                                                path);
+      const std::size_t index = scene.views.size() - 1;
+      const auto finish = [&scene, &path, index, region_block] {
+        finishPseudoLabels(scene.views[index], region_block, path);
+      };
+      if (version >= 3) {
+        decoding.push_back(finish);
+      } else {
+        finish();
       }
-      scene.points.resize(n);
-      for (auto& p : scene.points) {
-        for (float& x : p.xyz) {
-          x = c.get<float>("point xyz");
-          if (!std::isfinite(x)) {
-            throw Error(path, "point xyz", "finite coordinates", std::to_string(x));
-          }
-        }
-        for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
+    }
+    // Unknown chunks are skipped: later versions may add chunks readers can ignore.
+  }
+  if (!have_classes) throw Error(path, "chunk CLAS", "present", "missing");
+  runJobsInParallel(decoding);
+  return scene;
+}
+
+}  // namespace io
+}  // namespace sadsplat
+
+namespace sadsplat {
+namespace io {
+
+Scene readSceneCacheWithoutPixels(const std::string& path) {
+  requireRegularFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "file", "an existing, readable file", "cannot be opened");
+  in.seekg(0, std::ios::end);
+  const auto file_size = static_cast<std::uint64_t>(in.tellg());
+  in.seekg(0);
+  std::string head(kHeaderSize, '\0');
+  in.read(&head[0], kHeaderSize);
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const CacheHeader header = readCacheHeader(path, head, file_size);
+  // The payload one chunk at a time, hashed as it is read.
+  std::uint64_t hash = header.version == 1 ? kVersion1Basis : 14695981039346656037ull;
+  std::uint64_t pos = kHeaderSize;
+  std::string buffer;
+  const auto readBytes = [&](std::uint64_t n, const char* field) -> const std::string& {
+    if (n > file_size - pos) {
+      throw Error(path, std::string("payload ") + field,
+                  "more data (file is truncated or corrupt)",
+                  std::to_string(file_size - pos) + " bytes left");
+    }
+    buffer.resize(static_cast<std::size_t>(n));
+    if (n > 0 && !in.read(&buffer[0], static_cast<std::streamsize>(n))) {
+      throw Error(path, field, "readable bytes", "a read error");
+    }
+    hash = fnv1aWithBasis(buffer.data(), buffer.size(), hash);
+    pos += n;
+    return buffer;
+  };
+  Scene scene;
+  bool have_classes = false;
+  while (pos < file_size) {
+    const std::string tag_and_size = readBytes(12, "chunk tag");
+    const std::string tag = tag_and_size.substr(0, 4);
+    std::uint64_t size;
+    std::memcpy(&size, tag_and_size.data() + 4, 8);
+    const std::uint64_t offset = pos;
+    const std::string& content = readBytes(size, "chunk");
+    ByteReader c(path, content.data(), content.size(), "chunk " + tag);
+    if (tag == "SRCE") {
+      scene.source = c.getString("source");
+    } else if (tag == "CLAS") {
+      scene.classes = readClassChunk(c, path);
+      have_classes = true;
+    } else if (tag == "VIEW") {
+      auto at = std::make_shared<ViewPixelsInCache>();
+      View v = readViewHead(c, path, &at->has_labels);
+      if (at->has_labels && !have_classes) {
+        throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
       }
+      at->path = path;
+      at->version = header.version;
+      at->classes = scene.classes.size();
+      at->view_offset = offset;
+      at->view_size = size;
+      v.pixels_in_cache = std::move(at);
+      scene.views.push_back(std::move(v));
+    } else if (tag == "PNTS") {
+      scene.points = readPointChunk(c, path);
     } else if (tag == "GEOR") {
       scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
     } else if (tag == "PSLB") {
@@ -408,48 +580,53 @@ Scene readSceneCache(const std::string& path) {
         throw Error(path, "chunk PSLB view", "the view read just before it", name);
       }
       View& v = scene.views.back();
-      ViewPseudoLabels& p = v.pseudo;
-      p.backend = c.getString("backend");
-      p.num_targets = static_cast<int>(c.get<std::uint32_t>("target count"));
-      p.num_classes = static_cast<int>(c.get<std::uint32_t>("class count"));
-      p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
-      const std::size_t pixels = static_cast<std::size_t>(v.camera.width) * v.camera.height;
-      std::pair<const std::uint8_t*, std::size_t> region_block{nullptr, 0};
-      if (version >= 3) {
-        region_block = c.getBlock("region map");
-      } else {
-        p.region = c.getArray<std::int32_t>(pixels, "region map");
-      }
-      p.scores =
-          c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.num_classes, "scores");
-      p.features =
-          c.getArray<float>(static_cast<std::size_t>(p.num_targets) * p.feature_dim, "features");
-      p.kept = c.getBytes(p.num_targets, "kept flags");
-      if (p.num_classes != static_cast<int>(scene.classes.size())) {
-        throw Error(path, "view " + name + " pseudo-labels class count",
-                    std::to_string(scene.classes.size()), std::to_string(p.num_classes));
-      }
-      const std::size_t index = scene.views.size() - 1;
-      const auto check = [&scene, &path, index, name, pixels, region_block] {
-        View& view = scene.views[index];
-        if (region_block.first != nullptr) {
-          view.pseudo.region = planes::decodeRegions(
-              path, "chunk PSLB region map of view " + name, region_block.first,
-              region_block.second, pixels, view.camera.width);
-        }
-        view.pseudo.validate(path + " (view " + name + ")", pixels);
-      };
-      if (version >= 3) {
-        decoding.push_back(check);
-      } else {
-        check();
-      }
+      auto at = std::make_shared<ViewPixelsInCache>(*v.pixels_in_cache);
+      at->pseudo_offset = offset;
+      at->pseudo_size = size;
+      v.pixels_in_cache = std::move(at);
     }
-    // Unknown chunks are skipped: later versions may add chunks readers can ignore.
   }
+  if (hash != header.checksum) throwChecksumMismatch(path);
   if (!have_classes) throw Error(path, "chunk CLAS", "present", "missing");
-  runJobsInParallel(decoding);
   return scene;
+}
+
+View readViewPixels(const View& view) {
+  if (!view.pixels_in_cache) return view;
+  const ViewPixelsInCache& at = *view.pixels_in_cache;
+  std::ifstream in(at.path, std::ios::binary);
+  const auto chunk = [&](std::uint64_t offset, std::uint64_t size, const char* what) {
+    std::string bytes(static_cast<std::size_t>(size), '\0');
+    in.seekg(static_cast<std::streamoff>(offset));
+    if (!in || !in.read(&bytes[0], static_cast<std::streamsize>(size))) {
+      throw Error(at.path, "view " + view.name + " " + what,
+                  "the bytes found when the cache was opened", "a shorter file (it changed since)");
+    }
+    return bytes;
+  };
+  const std::string view_bytes = chunk(at.view_offset, at.view_size, "VIEW chunk");
+  ByteReader c(at.path, view_bytes.data(), view_bytes.size(), "chunk VIEW");
+  bool has_labels = false;
+  const View head = readViewHead(c, at.path, &has_labels);
+  if (head.name != view.name || has_labels != at.has_labels) {
+    throw Error(at.path, "view " + view.name, "the view found when the cache was opened",
+                "view " + head.name + " (the file changed since)");
+  }
+  View out = view;
+  out.pixels_in_cache = nullptr;
+  const int w = out.camera.width, h = out.camera.height;
+  out.rgb = readImage(c, at.version, w, h, 3, "rgb");
+  out.mask = readImage(c, at.version, w, h, 1, "mask");
+  if (has_labels) {
+    out.labels = readImage(c, at.version, w, h, 1, "labels");
+    checkLabels(at.path, out, at.classes);
+  }
+  if (at.pseudo_size > 0) {
+    const std::string pseudo_bytes = chunk(at.pseudo_offset, at.pseudo_size, "PSLB chunk");
+    ByteReader q(at.path, pseudo_bytes.data(), pseudo_bytes.size(), "chunk PSLB");
+    finishPseudoLabels(out, readPseudoChunk(q, at.version, at.classes, &out, at.path), at.path);
+  }
+  return out;
 }
 
 }  // namespace io

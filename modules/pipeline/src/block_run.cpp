@@ -36,7 +36,7 @@ void sayBlock(std::ostream* out, const geo::Block& block, const geo::BlockPartit
        << " sparse points: " << what << "\n";
   if (scene.classes.empty() || (what != "training" && what != "resuming")) return;
   const bool supervised = std::any_of(block.views.begin(), block.views.end(), [&](int v) {
-    return scene.views[v].labelled || !scene.views[v].pseudo.empty();
+    return scene.views[v].labelled || scene.views[v].hasPseudoLabels();
   });
   if (!supervised) {
     *out << "  warning: no labelled or pseudo-labelled view trains this block: its Gaussians' "
@@ -151,7 +151,8 @@ BlockRun::BlockRun(TrainRunOptions options, BlockRunOptions blocks)
     : options_(std::move(options)), blocks_(std::move(blocks)) {
   if (blocks_.ranks < 1 || blocks_.rank < 0 || blocks_.rank >= blocks_.ranks)
     throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(blocks_.rank));
-  scene_ = loadScene(options_.scene, options_.scale, options_.progress);
+  scene_ = loadScene(options_.scene, options_.scale, options_.progress,
+                     blocks_.pixels_on_disk ? ScenePixels::kLeftOnDisk : ScenePixels::kRead);
   if (blocks_.partition.blocks == 0 && blocks_.max_device_bytes <= 0)
     throw Error("<block run>", "max_device_bytes", "a memory budget with blocks = 0 (auto)",
                 std::to_string(blocks_.max_device_bytes));

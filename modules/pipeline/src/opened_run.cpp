@@ -14,7 +14,8 @@
 namespace sadsplat {
 namespace pipeline {
 
-io::Scene loadScene(const std::string& path, double scale, std::ostream* progress) {
+io::Scene loadScene(const std::string& path, double scale, std::ostream* progress,
+                    ScenePixels pixels) {
   if (io::isDirectory(path)) {
     io::ImportOptions options;
     options.scale = scale;
@@ -23,6 +24,11 @@ io::Scene loadScene(const std::string& path, double scale, std::ostream* progres
                 << " (--scale; `sadsplat import` writes a scene cache to skip this step)\n";
     }
     return io::importScene(path, options);
+  }
+  if (pixels == ScenePixels::kLeftOnDisk) {
+    if (progress != nullptr)
+      *progress << "views read from " << path << " as the training needs them (--stream-views)\n";
+    return io::readSceneCacheWithoutPixels(path);
   }
   return io::readSceneCache(path);
 }

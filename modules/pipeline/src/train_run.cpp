@@ -181,7 +181,9 @@ TrainingInterrupted::TrainingInterrupted(const std::string& run, int iteration)
       iteration_(iteration) {}
 
 double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config) {
-  return trainRun(o, config, loadScene(o.scene, o.scale, o.progress));
+  return trainRun(o, config,
+                  loadScene(o.scene, o.scale, o.progress,
+                            config.stream_views ? ScenePixels::kLeftOnDisk : ScenePixels::kRead));
 }
 
 void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,

@@ -49,9 +49,9 @@ void TrainingReport::started(const io::Scene& scene, const gaussians::TrainConfi
     int labelled = 0, pseudo = 0;
     for (const io::View& v : scene.views) {
       if (!v.train) continue;
-      if (v.labelled && !v.labels.empty())
+      if (v.labelled && v.hasLabels())
         ++labelled;
-      else if (!v.pseudo.empty())
+      else if (v.hasPseudoLabels())
         ++pseudo;
     }
     out << "semantic supervision: " << labelled << " labelled views, "

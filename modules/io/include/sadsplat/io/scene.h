@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,6 +80,19 @@ struct ViewPseudoLabels {
   void validate(const std::string& origin, std::size_t pixels) const;
 };
 
+/// \brief Where the pixels of a view wait in a scene cache read by readSceneCacheWithoutPixels
+/// (scene_cache.h): the file and the byte ranges of the view's chunks; readViewPixels reads them.
+struct ViewPixelsInCache {
+  std::string path;
+  std::uint32_t version = 0;
+  std::size_t classes = 0;          ///< the scene's class count (label ids are checked against it)
+  std::uint64_t view_offset = 0;    ///< the VIEW chunk's content: offset in the file, size
+  std::uint64_t view_size = 0;
+  std::uint64_t pseudo_offset = 0;  ///< the PSLB chunk's content (size 0: no pseudo-labels)
+  std::uint64_t pseudo_size = 0;
+  bool has_labels = false;
+};
+
 /// \brief One posed image of the scene.
 struct View {
   std::string name;         ///< image file name, relative to images/
@@ -90,6 +104,16 @@ struct View {
   bool test = false;        ///< in the test set
   bool labelled = false;    ///< a training view whose label map supervises training
   ViewPseudoLabels pseudo;  ///< empty until `sadsplat pseudo-labels` ran on the scene
+  /// Set when the scene was read without pixels: rgb, mask, labels and pseudo are then empty and
+  /// wait in the cache (io::readViewPixels).
+  std::shared_ptr<const ViewPixelsInCache> pixels_in_cache;
+
+  /// \brief Whether the view has a label map, held or waiting in a cache.
+  bool hasLabels() const { return !labels.empty() || (pixels_in_cache && pixels_in_cache->has_labels); }
+  /// \brief Whether the view has pseudo-labels, held or waiting in a cache.
+  bool hasPseudoLabels() const {
+    return !pseudo.empty() || (pixels_in_cache && pixels_in_cache->pseudo_size > 0);
+  }
 };
 
 /// \brief The class ids that supervise the semantic loss on a view, -1 = none: on a labelled view

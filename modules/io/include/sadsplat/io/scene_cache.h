@@ -25,6 +25,19 @@ void writeSceneCache(const std::string& path, const Scene& scene);
 /// mismatch, non-finite camera values or label ids outside the class list
 Scene readSceneCache(const std::string& path);
 
+/// \brief Reads a scene cache's classes, cameras, roles, sparse points and georeference, and
+/// where each view's pixels are, leaving the pixels in the file (every View's pixels_in_cache
+/// set, its images and pseudo-labels empty): host memory of one chunk at a time. The whole file
+/// is read once to check its checksum; the pixels are checked when readViewPixels reads them.
+/// \throws sadsplat::Error as readSceneCache, except for errors inside images and pseudo-labels
+Scene readSceneCacheWithoutPixels(const std::string& path);
+
+/// \brief `view` with its pixels: itself when it holds them, else its images and pseudo-labels
+/// read and decoded from its cache (safe to call from several threads at once).
+/// \throws sadsplat::Error naming the cache and the view when the file cannot be read, changed
+/// size, or the view's chunks are damaged (as readSceneCache checks them)
+View readViewPixels(const View& view);
+
 /// \brief The format version in a scene cache's header.
 /// \throws sadsplat::Error when `path` is not a scene cache
 std::uint32_t sceneCacheVersion(const std::string& path);

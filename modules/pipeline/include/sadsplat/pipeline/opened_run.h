@@ -13,9 +13,17 @@
 namespace sadsplat {
 namespace pipeline {
 
+/// \brief What loadScene does with a scene cache's pixels.
+enum class ScenePixels {
+  kRead,        ///< read them all into host memory
+  kLeftOnDisk,  ///< leave them in the file (io::readSceneCacheWithoutPixels): the training reads
+                ///< each view as its steps need it; a scene directory is imported whole anyway
+};
+
 /// \brief Loads a scene directory (imported at `scale`, needs OpenCV; said on `progress` when
 /// not null) or a scene cache file.
-io::Scene loadScene(const std::string& path, double scale = 0.5, std::ostream* progress = nullptr);
+io::Scene loadScene(const std::string& path, double scale = 0.5, std::ostream* progress = nullptr,
+                    ScenePixels pixels = ScenePixels::kRead);
 
 /// \brief A trained run opened for rendering: its scene, configuration and model (the trainer
 /// restored from checkpoint.bin).
