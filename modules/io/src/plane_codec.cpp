@@ -13,11 +13,11 @@ namespace {
 // zlib level 6 (for images the level hardly matters: Huffman coding only).
 constexpr int kLevel = 6;
 
+// MED: min(left, up) if up_left >= max, max(left, up) if up_left <= min, else the gradient
+// left + up - up_left; which is the gradient clamped to [min, max] (no branch to mispredict).
 inline int medPrediction(int left, int up, int up_left) {
   const int lo = std::min(left, up), hi = std::max(left, up);
-  if (up_left >= hi) return lo;
-  if (up_left <= lo) return hi;
-  return left + up - up_left;
+  return std::clamp(left + up - up_left, lo, hi);
 }
 
 // The MED prediction of pixel (x, y) of plane `p` (row-major, `w` wide) from decoded neighbours;
@@ -77,13 +77,25 @@ Image8 decodeImage(const std::string& path, const std::string& field, const std:
   std::vector<std::uint8_t> plane(n);
   for (int ch = 0; ch < channels; ++ch) {
     const std::uint8_t* in = residual.data() + ch * n;
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * width + x;
-        plane[i] = static_cast<std::uint8_t>(in[i] + predict(plane.data(), width, x, y));
+    // predict() unrolled by case: the first row from the left, the first column from above, the
+    // rest the MED of left, above and above-left (the same values, without the per-pixel tests).
+    std::uint8_t* p = plane.data();
+    int left = 0;
+    for (int x = 0; x < width; ++x) left = p[x] = static_cast<std::uint8_t>(in[x] + left);
+    for (int y = 1; y < height; ++y) {
+      const std::uint8_t* up = p + static_cast<std::size_t>(y - 1) * width;
+      std::uint8_t* row = p + static_cast<std::size_t>(y) * width;
+      const std::uint8_t* r = in + static_cast<std::size_t>(y) * width;
+      left = row[0] = static_cast<std::uint8_t>(r[0] + up[0]);
+      for (int x = 1; x < width; ++x) {
+        left = row[x] = static_cast<std::uint8_t>(r[x] + medPrediction(left, up[x], up[x - 1]));
       }
     }
-    for (std::size_t i = 0; i < n; ++i) image.pixels[i * channels + ch] = plane[i];
+    if (channels == 1) {
+      std::copy(plane.begin(), plane.end(), image.pixels.begin());
+    } else {
+      for (std::size_t i = 0; i < n; ++i) image.pixels[i * channels + ch] = plane[i];
+    }
   }
   if (channels == 3) {
     // Undo the colour transform: R = (R - G) + G, B = (B - G) + G; G is plane 0.
