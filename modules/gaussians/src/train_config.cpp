@@ -155,9 +155,9 @@ const std::vector<TrainOption> kOptions = {
     {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
     {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
     {"stream_views", &C::stream_views,
-     "keep the training views in host memory (8 bits) and upload each step's views when it "
-     "renders them: GPU memory for the model and a step's views instead of every view as floats "
-     "(the same values)",
+     "upload each step's views when it renders them, read from the scene cache on loader "
+     "threads ahead of the step (an imported directory: kept in host memory in 8 bits): GPU "
+     "memory for the model and a step's views, host memory for a few views (the same values)",
      "--stream-views"},
     {"max_gaussians", &C::max_gaussians, "densification stops growing past this", nullptr, 1, kInf},
     {"prune_floaters", &C::prune_floaters,
