@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 
@@ -173,6 +174,47 @@ TEST(StreamedViews, TrainLikeHeldViewsOnTheCpu) { expectStreamedViewsTrainLikeHe
 TEST(StreamedViews, TrainLikeHeldViewsOnAGpu) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
   expectStreamedViewsTrainLikeHeldViews("cuda");
+}
+
+// A view damaged inside a cache whose checksum is valid (a crafted file) is found by a loader
+// thread when the streamed training first reads it: an error naming the cache and the image,
+// raised in the training's thread, not a crash or a hang.
+TEST(StreamedViews, ADamagedViewInTheCacheIsAClearError) {
+  test::TempDir dir;
+  io::writeSceneCache(dir.file("v3.cache"), io::readSceneCache(kCache));
+  std::string bytes = test::readFile(dir.file("v3.cache"));
+  // Every VIEW chunk: tag, size, name (u32 length + bytes), width, height, 11 doubles, roles,
+  // has-labels, then the rgb block (u64 size + deflate stream), zeroed here.
+  int damaged = 0;
+  for (std::size_t at = bytes.find("VIEW"); at != std::string::npos;
+       at = bytes.find("VIEW", at + 4)) {
+    std::uint32_t name_length;
+    std::memcpy(&name_length, &bytes[at + 12], 4);
+    const std::size_t block = at + 4 + 8 + 4 + name_length + 8 + 11 * 8 + 2;
+    std::uint64_t size;
+    std::memcpy(&size, &bytes[block], 8);
+    if (block + 8 + size > bytes.size()) continue;  // "VIEW" inside other bytes
+    std::memset(&bytes[block + 8], 0, size);
+    ++damaged;
+  }
+  ASSERT_GT(damaged, 0);
+  const std::uint64_t sum = io::fnv1a64(bytes.data() + 32, bytes.size() - 32);
+  std::memcpy(&bytes[24], &sum, 8);
+  test::writeFile(dir.file("damaged.cache"), bytes);
+  TrainConfig config;
+  config.iterations = 10;
+  config.stream_views = true;
+  config.checkpoint_interval = 0;
+  pipeline::TrainRunOptions o;
+  o.scene = dir.file("damaged.cache");
+  o.out = dir.file("run");
+  try {
+    pipeline::trainRun(o, config);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.file(), dir.file("damaged.cache"));
+    EXPECT_NE(std::string(e.what()).find("rgb"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
