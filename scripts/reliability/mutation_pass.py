@@ -4,7 +4,8 @@ Starts from a good input of every reader (scripts/reliability/inputs.py's seeds,
 the fixture scene), makes mutated copies (JSON: a value replaced by another type, an extreme
 number, a control character, a key removed; binary: header fields set to extreme values, bytes
 flipped, the file cut; images: a header claiming a huge size), runs the command that reads each
-(`import`, `info`) and classifies the outcome:
+(`import`, `info`, `train --stream-views` for the scene cache read view by view) and
+classifies the outcome:
 
   ok     exit 0, at most one line on stderr (and, for import, a cache that `info` reads back)
   clean  exit 1 with exactly one line "sadsplat: error: ..." on stderr
@@ -13,7 +14,7 @@ flipped, the file cut; images: a header claiming a huge size), runs the command 
          an import that exits 0 but writes a cache `info` refuses
 
     python3 scripts/reliability/mutation_pass.py --sadsplat build/bin/sadsplat --out .deps/mutation
-        [--per-seed 40] [--jobs 2] [--seed 1]
+        [--per-seed 40] [--jobs 2] [--seed 1] [--only READER]
 
 Prints the table per reader and every BAD input (kept under --out/inputs/). Not part of CI: it
 runs for minutes. Standard library only.
@@ -219,6 +220,13 @@ def place_file(name):
     return place
 
 
+def place_streamed_training(work, data):
+    path = os.path.join(work, "m.cache")
+    open(path, "wb").write(data)
+    return [["train", path, "--stream-views", "--iterations", "2", "--out",
+             os.path.join(work, "run")]]
+
+
 def corpus(path):
     return open(os.path.join(ROOT, "fuzz", "corpus", path), "rb").read()
 
@@ -263,6 +271,9 @@ def readers():
          place_in_scene("sparse/0/cameras.txt")),
         ("COLMAP images.txt", [fixture("sparse/0/images.txt")], mutate_text_numbers,
          place_in_scene("sparse/0/images.txt")),
+        # The cache read without pixels, its views on loader threads (train --stream-views).
+        ("scene cache streamed", [open(FIXTURE + ".cache", "rb").read()], mutate_cache,
+         place_streamed_training),
     ]
 
 
@@ -336,6 +347,7 @@ def main():
     ap.add_argument("--per-seed", type=int, default=40)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--only", default="", help="run only the readers whose name contains this")
     a = ap.parse_args()
     sadsplat = os.path.abspath(a.sadsplat)
     shutil.rmtree(a.out, ignore_errors=True)
@@ -346,8 +358,8 @@ def main():
         for s, seed in enumerate(seeds):
             made = set()
             for i in range(a.per_seed):
-                data = mutate(seed, rng)
-                if data in made:
+                data = mutate(seed, rng)  # drawn for every reader: --only keeps the same inputs
+                if data in made or a.only not in reader:
                     continue
                 made.add(data)
                 jobs.append((reader, place, data, "%s_%d_%03d" % (reader.split()[0], s, i)))
