@@ -301,7 +301,9 @@ TEST(SceneCache, ViewsReadOneAtATimeAreTheWholeReadsViews) {
       EXPECT_EQ(c.pseudo.kept, a.pseudo.kept);
       with_pseudo += !c.pseudo.empty();
     }
-    if (path == dir.file("s.cache")) EXPECT_EQ(with_pseudo, 1);
+    if (path == dir.file("s.cache")) {
+      EXPECT_EQ(with_pseudo, 1);
+    }
   }
 }
 
