@@ -177,10 +177,13 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
     from_cache = true;
   }
   s.streamed = config.stream_views;
+  // The first read keeps only the summaries of a streamed view (no page-locked copies); the
+  // loader of the steps only the pictures.
   const auto loaderFor = [&](bool summaries) {
+    const bool pin_copies = pin && !summaries;
     return std::make_shared<ViewLoader>(
-        [waiting, config, pin, summaries](int v) {
-          return hostView(io::readViewPixels(waiting[v]), config, pin, summaries);
+        [waiting, config, pin_copies, summaries](int v) {
+          return hostView(io::readViewPixels(waiting[v]), config, pin_copies, summaries);
         },
         loaderThreads());
   };
