@@ -399,7 +399,8 @@ StepStats Trainer::step(bool read_losses) {
   pass.read_losses = read_losses;
   const int rank = s.collective ? s.collective->rank() : 0;
   s.views.prefetch(c, it, rank, pass.ranks);  // views read from a scene cache: the coming steps'
-  const StepViews step_views = drawStepViews(s.views, c, it, rank, pass.ranks, s.collective != nullptr);
+  const StepViews step_views =
+      drawStepViews(s.views, c, it, rank, pass.ranks, s.collective != nullptr);
   pass.views = step_views.views;
   pass.settings.sh_degree = s.shDegree();
   pass.settings.background = c.background;

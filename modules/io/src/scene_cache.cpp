@@ -203,7 +203,9 @@ std::vector<ScenePoint> readPointChunk(ByteReader& c, const std::string& path) {
   for (auto& p : points) {
     for (float& x : p.xyz) {
       x = c.get<float>("point xyz");
-      if (!std::isfinite(x)) throw Error(path, "point xyz", "finite coordinates", std::to_string(x));
+      if (!std::isfinite(x)) {
+        throw Error(path, "point xyz", "finite coordinates", std::to_string(x));
+      }
     }
     for (auto& v : p.rgb) v = c.get<std::uint8_t>("point rgb");
   }

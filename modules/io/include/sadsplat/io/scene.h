@@ -109,7 +109,9 @@ struct View {
   std::shared_ptr<const ViewPixelsInCache> pixels_in_cache;
 
   /// \brief Whether the view has a label map, held or waiting in a cache.
-  bool hasLabels() const { return !labels.empty() || (pixels_in_cache && pixels_in_cache->has_labels); }
+  bool hasLabels() const {
+    return !labels.empty() || (pixels_in_cache && pixels_in_cache->has_labels);
+  }
   /// \brief Whether the view has pseudo-labels, held or waiting in a cache.
   bool hasPseudoLabels() const {
     return !pseudo.empty() || (pixels_in_cache && pixels_in_cache->pseudo_size > 0);
