@@ -172,8 +172,8 @@ std::vector<ClassInfo> readClassChunk(ByteReader& c, const std::string& path) {
 }
 
 // A VIEW chunk up to its images: name, camera (checked) and roles; `has_labels` whether a label
-// map follows the mask.
-View readViewHead(ByteReader& c, const std::string& path, bool* has_labels) {
+// map follows the mask (which needs the classes read before: `classes_read`).
+View readViewHead(ByteReader& c, const std::string& path, bool classes_read, bool* has_labels) {
   View v;
   v.name = c.getString("view name");
   v.camera.width = static_cast<int>(c.get<std::uint32_t>("width"));
@@ -190,6 +190,9 @@ View readViewHead(ByteReader& c, const std::string& path, bool* has_labels) {
   v.labelled = roles & 4;
   *has_labels = c.get<std::uint8_t>("has labels") != 0;
   v.camera.validate(path, "view " + v.name + " camera");
+  if (*has_labels && !classes_read) {
+    throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
+  }
   return v;
 }
 
@@ -212,22 +215,29 @@ std::vector<ScenePoint> readPointChunk(ByteReader& c, const std::string& path) {
   return points;
 }
 
-// A PSLB chunk into `view.pseudo`, but for a version-3 region map: its deflated block, returned
-// for decodeRegionBlock (null for versions 1-2, whose raw map is read here). `view`: the view read
-// just before the chunk (null: none).
-std::pair<const std::uint8_t*, std::size_t> readPseudoChunk(ByteReader& c, std::uint32_t version,
-                                                            std::size_t classes, View* view,
-                                                            const std::string& path) {
+// The start of a PSLB chunk: the name of its view, which must be `previous` (the view read just
+// before the chunk; null: none).
+View& pseudoChunkView(ByteReader& c, View* previous, const std::string& path) {
   const std::string name = c.getString("view name");
-  if (view == nullptr || view->name != name) {
+  if (previous == nullptr || previous->name != name) {
     throw Error(path, "chunk PSLB view", "the view read just before it", name);
   }
-  ViewPseudoLabels& p = view->pseudo;
+  return *previous;
+}
+
+// The rest of a PSLB chunk (after pseudoChunkView) into `view.pseudo`, but for a version-3 region
+// map: its deflated block, returned for finishPseudoLabels (null for versions 1-2, whose raw map
+// is read here).
+std::pair<const std::uint8_t*, std::size_t> readPseudoChunk(ByteReader& c, std::uint32_t version,
+                                                            std::size_t classes, View& view,
+                                                            const std::string& path) {
+  const std::string& name = view.name;
+  ViewPseudoLabels& p = view.pseudo;
   p.backend = c.getString("backend");
   p.num_targets = static_cast<int>(c.get<std::uint32_t>("target count"));
   p.num_classes = static_cast<int>(c.get<std::uint32_t>("class count"));
   p.feature_dim = static_cast<int>(c.get<std::uint32_t>("feature dim"));
-  const std::size_t pixels = static_cast<std::size_t>(view->camera.width) * view->camera.height;
+  const std::size_t pixels = static_cast<std::size_t>(view.camera.width) * view.camera.height;
   std::pair<const std::uint8_t*, std::size_t> region_block{nullptr, 0};
   if (version >= 3) {
     region_block = c.getBlock("region map");
@@ -255,6 +265,24 @@ void finishPseudoLabels(View& view, std::pair<const std::uint8_t*, std::size_t> 
                               region_block.first, region_block.second, pixels, view.camera.width);
   }
   view.pseudo.validate(path + " (view " + view.name + ")", pixels);
+}
+
+// The chunks about the whole scene (SRCE, CLAS, PNTS, GEOR) into `scene`; false for any other tag.
+bool readSceneChunk(const std::string& tag, ByteReader& c, const std::string& path, Scene& scene,
+                    bool* have_classes) {
+  if (tag == "SRCE") {
+    scene.source = c.getString("source");
+  } else if (tag == "CLAS") {
+    scene.classes = readClassChunk(c, path);
+    *have_classes = true;
+  } else if (tag == "PNTS") {
+    scene.points = readPointChunk(c, path);
+  } else if (tag == "GEOR") {
+    scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
+  } else {
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -450,18 +478,11 @@ Scene readSceneCache(const std::string& path) {
     const std::string tag(tag_bytes.begin(), tag_bytes.end());
     const auto size = r.get<std::uint64_t>("chunk size");
     ByteReader c = r.subReader(size, "chunk " + tag);
-    if (tag == "SRCE") {
-      scene.source = c.getString("source");
-    } else if (tag == "CLAS") {
-      scene.classes = readClassChunk(c, path);
-      have_classes = true;
-    } else if (tag == "VIEW") {
+    if (readSceneChunk(tag, c, path, scene, &have_classes)) continue;
+    if (tag == "VIEW") {
       bool has_labels = false;
-      View v = readViewHead(c, path, &has_labels);
+      View v = readViewHead(c, path, have_classes, &has_labels);
       const int w = v.camera.width, h = v.camera.height;
-      if (has_labels && !have_classes) {
-        throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
-      }
       const std::size_t index = scene.views.size();
       // An image: read here (raw planes) or decoded by a job after this pass (version 3).
       const auto image = [&](Image8 View::*member, int channels, const char* field,
@@ -484,14 +505,10 @@ Scene readSceneCache(const std::string& path) {
       image(&View::mask, 1, "mask", false);
       if (has_labels) image(&View::labels, 1, "labels", true);
       scene.views.push_back(std::move(v));
-    } else if (tag == "PNTS") {
-      scene.points = readPointChunk(c, path);
-    } else if (tag == "GEOR") {
-      scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
     } else if (tag == "PSLB") {
-      const auto region_block = readPseudoChunk(c, version, scene.classes.size(),
-                                                scene.views.empty() ? nullptr : &scene.views.back(),
-                                                path);
+      View& view =
+          pseudoChunkView(c, scene.views.empty() ? nullptr : &scene.views.back(), path);
+      const auto region_block = readPseudoChunk(c, version, scene.classes.size(), view, path);
       const std::size_t index = scene.views.size() - 1;
       const auto finish = [&scene, &path, index, region_block] {
         finishPseudoLabels(scene.views[index], region_block, path);
@@ -554,17 +571,10 @@ Scene readSceneCacheWithoutPixels(const std::string& path) {
     const std::uint64_t offset = pos;
     const std::string& content = readBytes(size, "chunk");
     ByteReader c(path, content.data(), content.size(), "chunk " + tag);
-    if (tag == "SRCE") {
-      scene.source = c.getString("source");
-    } else if (tag == "CLAS") {
-      scene.classes = readClassChunk(c, path);
-      have_classes = true;
-    } else if (tag == "VIEW") {
+    if (readSceneChunk(tag, c, path, scene, &have_classes)) continue;
+    if (tag == "VIEW") {
       auto at = std::make_shared<ViewPixelsInCache>();
-      View v = readViewHead(c, path, &at->has_labels);
-      if (at->has_labels && !have_classes) {
-        throw Error(path, "chunk order", "CLAS before VIEW", "VIEW " + v.name + " first");
-      }
+      View v = readViewHead(c, path, have_classes, &at->has_labels);
       at->path = path;
       at->version = header.version;
       at->classes = scene.classes.size();
@@ -572,16 +582,8 @@ Scene readSceneCacheWithoutPixels(const std::string& path) {
       at->view_size = size;
       v.pixels_in_cache = std::move(at);
       scene.views.push_back(std::move(v));
-    } else if (tag == "PNTS") {
-      scene.points = readPointChunk(c, path);
-    } else if (tag == "GEOR") {
-      scene.georeference = georeferenceFromJson(c.getString("georeference"), path + " (GEOR)");
     } else if (tag == "PSLB") {
-      const std::string name = c.getString("view name");
-      if (scene.views.empty() || scene.views.back().name != name) {
-        throw Error(path, "chunk PSLB view", "the view read just before it", name);
-      }
-      View& v = scene.views.back();
+      View& v = pseudoChunkView(c, scene.views.empty() ? nullptr : &scene.views.back(), path);
       auto at = std::make_shared<ViewPixelsInCache>(*v.pixels_in_cache);
       at->pseudo_offset = offset;
       at->pseudo_size = size;
@@ -609,7 +611,7 @@ View readViewPixels(const View& view) {
   const std::string view_bytes = chunk(at.view_offset, at.view_size, "VIEW chunk");
   ByteReader c(at.path, view_bytes.data(), view_bytes.size(), "chunk VIEW");
   bool has_labels = false;
-  const View head = readViewHead(c, at.path, &has_labels);
+  const View head = readViewHead(c, at.path, /*classes_read=*/true, &has_labels);
   if (head.name != view.name || has_labels != at.has_labels) {
     throw Error(at.path, "view " + view.name, "the view found when the cache was opened",
                 "view " + head.name + " (the file changed since)");
@@ -626,7 +628,8 @@ View readViewPixels(const View& view) {
   if (at.pseudo_size > 0) {
     const std::string pseudo_bytes = chunk(at.pseudo_offset, at.pseudo_size, "PSLB chunk");
     ByteReader q(at.path, pseudo_bytes.data(), pseudo_bytes.size(), "chunk PSLB");
-    finishPseudoLabels(out, readPseudoChunk(q, at.version, at.classes, &out, at.path), at.path);
+    View& view = pseudoChunkView(q, &out, at.path);
+    finishPseudoLabels(view, readPseudoChunk(q, at.version, at.classes, view, at.path), at.path);
   }
   return out;
 }
