@@ -285,6 +285,7 @@ TEST(DropStrategy, L0WeightFollowsItsSchedule) {
 TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
   gaussians::TrainConfig c;
   c.drop = "full";
+  c.drop_rule = "paper";  // the balanced rule has no loss term (its force: test_drop_guard.cpp)
   c.lambda_l0 = 0.5;
   c.lambda_l0_from = 10;
   c.lambda_l0_ramp = 2;
@@ -302,12 +303,17 @@ TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
   // Without the structure term there is no L0 term at all.
   c.drop = "semantic";
   EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100, {}).defined());
+  // Nor under the balanced rule, whose L0 force goes to the gradient instead.
+  c.drop = "full";
+  c.drop_rule = "balanced";
+  EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100, {}).defined());
 }
 
 // Per-Gaussian L0 weights (TrainConfig::l0_importance): lambda * mean(w * P_nonzero), by hand.
 TEST(DropStrategy, WeightedRegularisationIsTheMeanOfWeightTimesPNonZero) {
   gaussians::TrainConfig c;
   c.drop = "full";
+  c.drop_rule = "paper";
   c.lambda_l0 = 0.5;
   const auto drop = makeDropStrategy(c);
   const at::Tensor log_alpha = at::tensor({-2.0f, 0.0f, 1.0f, 4.0f});

@@ -8,7 +8,6 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
-#include "sadsplat/gaussians/l0_force.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -46,55 +45,27 @@ at::Tensor DropState::effectiveOpacity(const ParameterStore& params, int iterati
 }
 
 at::Tensor DropState::regularisation(const ParameterStore& params, int it) const {
-  if (!gated(it) || balanced()) return at::Tensor();
+  if (!gated(it)) return at::Tensor();
   return drop_->regularisation(params["log_alpha"].value, it,
                                options_.l0_importance > 0 ? l0_weights_ : at::Tensor());
 }
 
 void DropState::addL0Gradient(ParameterStore& params, int it) const {
-  if (!gated(it) || !balanced()) return;
-  // The L0 schedule (lambda_l0_from, lambda_l0_ramp) applies to the strength as to lambda_l0.
-  if (it < options_.lambda_l0_from) return;
-  const double strength = options_.l0_strength * guard_.pressure *
-                          l0Ramp(options_.lambda_l0_from, options_.lambda_l0_ramp, it);
+  if (!gated(it)) return;
   Parameter& la = params["log_alpha"];
   at::Tensor grad = la.value.grad();
-  if (strength == 0 || !grad.defined()) return;
-  const at::Tensor direction = drop_->l0Derivative(la.value);
-  if (!direction.defined()) return;
-  // The Gaussians the losses reached this step: visible, with an open gate sample (their
-  // opacity has a gradient; all-reduced, so every rank sees the same set). A gate sample clamped
-  // at 1 gives log_alpha no gradient, but the L0 force acts on it as in the paper's rule.
   const at::Tensor opacity_grad = params["opacity"].value.grad();
-  if (!opacity_grad.defined()) return;
-  addBalancedL0Force(grad, direction, opacity_grad,
-                     options_.l0_importance > 0 ? l0_weights_ : at::Tensor(), strength);
+  if (!grad.defined() || !opacity_grad.defined()) return;
+  drop_->addL0Force(grad, la.value, opacity_grad,
+                    options_.l0_importance > 0 ? l0_weights_ : at::Tensor(), it, guard_);
 }
 
 bool DropState::guardProbeDue(int done) const {
-  // Drop events of the balanced rule start with the L0 force (dropIfDue).
-  return drop_ && balanced() && options_.drop_guard > 0 && done < recoveryStart() &&
-         done >= options_.lambda_l0_from && drop_->dropNow(done);
-}
-
-bool DropState::openedByReset(int from, int to) const {
-  // A reset after iteration r comes after the drop event of r and so after its reading: the
-  // resets between the readings of `from` and `to` are those after from .. to - 1.
-  for (int r = from; r < to; ++r) {
-    if (resetsOpacitiesAfter(densification_, schedule_, r)) return true;
-  }
-  return false;
+  return drop_ && done < recoveryStart() && drop_->guardReadsBefore(done);
 }
 
 void DropState::observeGuardProbe(int done, double probe_mse) {
-  if (!std::isfinite(probe_mse)) return;
-  // The reference is the lowest reading since the last opacity reset: a drop whose cost the
-  // training has not won back by the next event halves the pressure again.
-  const bool fresh =
-      guard_.lowest < 0 || openedByReset(static_cast<int>(guard_.last_reading), done);
-  if (!fresh && probe_mse > guard_.lowest * (1 + options_.drop_guard)) guard_.pressure *= 0.5;
-  guard_.lowest = fresh ? probe_mse : std::min(guard_.lowest, probe_mse);
-  guard_.last_reading = done;
+  if (drop_) drop_->observeGuardReading(guard_, done, probe_mse);
 }
 
 bool DropState::refreshesL0Weights(int it) const {
@@ -116,15 +87,8 @@ DropDecision DropState::dropIfDue(int done, const ParameterStore& params,
                                   std::int64_t* dropped) {
   DropDecision decision;
   if (!drop_->dropNow(done)) return decision;
-  // The balanced rule prunes late when asked: no drop event (and no guard reading) before the L0
-  // force starts, so that densification, opacity resets and the semantic factor alone remove
-  // nothing before it (the paper's rule drops from the start).
-  if (balanced() && done < options_.lambda_l0_from) return decision;
   DropInputs in;
-  if (balanced()) {
-    in.max_removed = static_cast<std::int64_t>(std::floor(
-        options_.drop_max_fraction * guard_.pressure * static_cast<double>(params.rows())));
-  }
+  in.max_removed = drop_->maxRemoved(params.rows(), guard_);
   in.means = params["means"].value.detach();
   in.opacities = at::sigmoid(params["opacity"].value.detach());
   in.log_alpha = params["log_alpha"].value.detach();

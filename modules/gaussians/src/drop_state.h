@@ -5,7 +5,6 @@
 
 #include <ATen/ATen.h>
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -20,34 +19,13 @@
 namespace sadsplat {
 namespace gaussians {
 
-// The balanced rule's guard (DropState::observeGuardProbe): the factor it leaves on the L0
-// strength and the drop cap, the lowest probe reading since the last opacity reset (< 0: none
-// yet) and the iteration of the last reading.
-struct DropGuard {
-  double pressure = 1.0;
-  double lowest = -1.0;
-  double last_reading = 0.0;
-
-  // The checkpoint's form: the three values and kVersion (checkpoints written before the fixed
-  // probe views held a count of training-loss readings >= 0 there).
-  static constexpr double kVersion = -2.0;
-  std::array<double, 4> packed() const { return {pressure, lowest, last_reading, kVersion}; }
-  // From a checkpoint; one of another version keeps its pressure and starts a fresh reading.
-  static DropGuard unpacked(const std::array<double, 4>& v) {
-    if (v[3] != kVersion) return {v[0], -1.0, 0.0};
-    return {v[0], v[1], v[2]};
-  }
-};
-
 class DropState {
  public:
   using Resize = DensificationStrategy::Resize;
 
-  // The drop's own options; the schedule and the densification's only for the run's length and
-  // its opacity resets (the guard's reference starts afresh after one).
-  DropState(const DropOptions& options, const ScheduleOptions& schedule,
-            const DensificationOptions& densification)
-      : options_(options), schedule_(schedule), densification_(densification) {}
+  // The drop's own options; the schedule only for the run's length.
+  DropState(const DropOptions& options, const ScheduleOptions& schedule)
+      : options_(options), schedule_(schedule) {}
   void setStrategy(std::shared_ptr<const DropStrategy> strategy) { drop_ = std::move(strategy); }
   void initialise(std::int64_t rows, const at::TensorOptions& options);
 
@@ -64,22 +42,19 @@ class DropState {
   at::Tensor trainingGate(const ParameterStore& params, int it) const;
   // Activated opacity times the evaluation gate (when there is one).
   at::Tensor effectiveOpacity(const ParameterStore& params, int iteration) const;
-  // The strategy's loss term of `it` (undefined when not gated or none, and under the balanced
-  // rule, whose L0 force is added to the gradient by addL0Gradient instead).
+  // The strategy's loss term of `it` (undefined when not gated or none; the balanced rule has
+  // none: its L0 force is added to the gradient by addL0Gradient instead).
   at::Tensor regularisation(const ParameterStore& params, int it) const;
-  // The balanced rule's L0 force (TrainConfig::drop_rule), after the backward (and the
-  // all-reduce) of iteration `it`: on each Gaussian the losses reached (its opacity has a
-  // gradient), l0_strength x pressure x (the mean |log_alpha gradient| over those Gaussians) x
-  // dP_nonzero / (the mean dP_nonzero over them).
+  // The strategy's L0 force (DropStrategy::addL0Force; the balanced rule's), after the backward
+  // (and the all-reduce) of iteration `it`.
   void addL0Gradient(ParameterStore& params, int it) const;
-  // The balanced rule's guard reads the model before each of its drop events: whether the event
-  // after iteration `done` wants a reading (the trainer then hands it to observeGuardProbe).
+  // Whether the strategy's guard reads the model before the drop event after iteration `done`
+  // (the trainer then hands the reading to observeGuardProbe).
   bool guardProbeDue(int done) const;
   // The reading before the event after iteration `done`: the mean squared error of the probe
   // views (guardProbeViews) rendered as evaluation renders them, so that two readings differ by
-  // what training and dropping changed, not by which views the steps drew. A reading more than
-  // drop_guard above the lowest since the last opacity reset (a reset raises the error by
-  // itself) halves the pressure.
+  // what training and dropping changed, not by which views the steps drew. The strategy updates
+  // the guard kept here (DropStrategy::observeGuardReading).
   void observeGuardProbe(int done, double probe_mse);
   // The factor on the L0 strength and the drop cap that the guard has left (1 at the start).
   double pressure() const { return guard_.pressure; }
@@ -118,13 +93,10 @@ class DropState {
  private:
   DropOptions options_;
   ScheduleOptions schedule_;
-  DensificationOptions densification_;
   std::shared_ptr<const DropStrategy> drop_;
   at::Tensor confidence_;  // [N] last semantic confidence computed by the drop (0 before)
   at::Tensor l0_weights_;  // [N] weight of each Gaussian in the L0 term (l0_importance)
-  bool balanced() const { return balancedDropRule(options_); }
-  bool openedByReset(int from, int to) const;
-  DropGuard guard_;
+  DropGuard guard_;  // the strategy's guard, kept here for the checkpoint
 };
 
 }  // namespace gaussians

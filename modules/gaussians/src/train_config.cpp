@@ -300,12 +300,6 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
   setFromJson(option, value, config, origin);
 }
 
-double l0Ramp(int from, int ramp, int iteration) {
-  if (iteration < from) return 0;
-  if (ramp <= 0) return 1;
-  return std::min(1.0, static_cast<double>(iteration - from + 1) / ramp);
-}
-
 bool balancedDropRule(const DropOptions& options) { return options.drop_rule == "balanced"; }
 
 void TrainConfig::check(const std::string& origin) const {

@@ -68,7 +68,7 @@ struct StepPass {
 struct Trainer::State {
   // The drop state sees the schedule as the trainer runs it (its guard needs the opacity resets).
   explicit State(const TrainConfig& c)
-      : config(resolveDerivedKeys(c)), drop(config, config, config) {}
+      : config(resolveDerivedKeys(c)), drop(config, config) {}
 
   TrainConfig config;
   at::Device device{at::kCPU};

@@ -1,45 +1,82 @@
 #include "sadsplat/semantic_drop/drop_strategy.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/counter_random.h"
+#include "sadsplat/gaussians/densification.h"
+#include "sadsplat/gaussians/schedule.h"
+#include "sadsplat/semantic_drop/l0_force.h"
 #include "sadsplat/semantic_drop/semantic_confidence.h"
 
 namespace sadsplat {
 namespace semantic_drop {
 namespace {
 
+// The paper's rule, or the balanced one (DropOptions::drop_rule): the L0 force in place of the
+// loss term, a cap on each event, the guard, no event before the L0 force starts.
 class SemanticDropStrategy : public gaussians::DropStrategy {
  public:
   SemanticDropStrategy(const gaussians::TrainConfig& c, bool semantic, bool structure,
                        const HardConcreteParams& hc)
-      : semantic_(semantic),
+      : options_(c),
+        schedule_(c),
+        densification_(c),
+        semantic_(semantic),
         structure_(structure),
-        p_base_(c.p_base),
-        interval_(c.drop_interval),
-        iterations_(c.iterations),
-        lambda_l0_(c.lambda_l0),
-        lambda_l0_from_(c.lambda_l0_from),
-        lambda_l0_ramp_(c.lambda_l0_ramp),
-        seed_(c.seed),
         balanced_(gaussians::balancedDropRule(c)),
-        closed_gate_gradients_(c.closed_gate_gradients),
         hc_(hc) {}
 
-  at::Tensor l0Derivative(const at::Tensor& log_alpha) const override {
-    if (!structure_) return {};
-    // P_nonzero = sigmoid(log_alpha - beta logit(t)) (hard_concrete_math.h): dP = P (1 - P).
+  void addL0Force(at::Tensor& grad, const at::Tensor& log_alpha, const at::Tensor& opacity_grad,
+                  const at::Tensor& l0_weights, int it,
+                  const gaussians::DropGuard& guard) const override {
+    if (!balanced_) return;
+    // The L0 schedule (lambda_l0_from, lambda_l0_ramp) applies to the strength as to lambda_l0.
+    if (it < options_.lambda_l0_from) return;
+    const double strength = options_.l0_strength * guard.pressure *
+                            l0Ramp(options_.lambda_l0_from, options_.lambda_l0_ramp, it);
+    if (strength == 0 || !structure_) return;
+    // The force's direction: d P_nonzero / d log_alpha; P_nonzero = sigmoid(log_alpha - beta
+    // logit(t)) (hard_concrete_math.h), so dP = P (1 - P). The Gaussians the losses reached this
+    // step are those whose opacity has a gradient (all-reduced, so every rank sees the same set):
+    // a gate sample clamped at 1 gives log_alpha no gradient, but the L0 force acts on it as in
+    // the paper's rule.
     const at::Tensor p = probabilityNonZero(log_alpha.detach(), hc_);
-    return p * (1 - p);
+    addBalancedL0Force(grad, p * (1 - p), opacity_grad, l0_weights, strength);
+  }
+
+  std::int64_t maxRemoved(std::int64_t rows, const gaussians::DropGuard& guard) const override {
+    if (!balanced_) return -1;
+    return static_cast<std::int64_t>(
+        std::floor(options_.drop_max_fraction * guard.pressure * static_cast<double>(rows)));
+  }
+
+  bool guardReadsBefore(int done) const override {
+    return balanced_ && options_.drop_guard > 0 && dropNow(done);
+  }
+
+  void observeGuardReading(gaussians::DropGuard& guard, int done,
+                           double probe_mse) const override {
+    if (!std::isfinite(probe_mse)) return;
+    // The reference is the lowest reading since the last opacity reset (a reset raises the error
+    // by itself): a drop whose cost the training has not won back by the next event halves the
+    // pressure again.
+    const bool fresh =
+        guard.lowest < 0 || openedByReset(static_cast<int>(guard.last_reading), done);
+    if (!fresh && probe_mse > guard.lowest * (1 + options_.drop_guard)) guard.pressure *= 0.5;
+    guard.lowest = fresh ? probe_mse : std::min(guard.lowest, probe_mse);
+    guard.last_reading = done;
   }
 
   at::Tensor trainingGate(const at::Tensor& log_alpha, int iteration) const override {
     if (!structure_) return {};
     // Counter-based noise on the parameters' device: nothing drawn on the host and copied.
-    return sampleCounterGate(log_alpha, seed_,
+    return sampleCounterGate(log_alpha, schedule_.seed,
                              gaussians::purposeKey(gaussians::RandomPurpose::kGateNoise),
-                             static_cast<std::uint64_t>(iteration), hc_, closed_gate_gradients_);
+                             static_cast<std::uint64_t>(iteration), hc_,
+                             options_.closed_gate_gradients);
   }
 
   at::Tensor evaluationGate(const at::Tensor& log_alpha) const override {
@@ -49,9 +86,11 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   at::Tensor regularisation(const at::Tensor& log_alpha, int iteration,
                             const at::Tensor& l0_weights) const override {
     // L_L0 = mean over Gaussians of P_nonzero (paper), weighted by lambda_L0 (or its schedule);
-    // with per-Gaussian weights (not the paper) the mean of weight x P_nonzero.
-    const double weight =
-        scheduledL0Weight(lambda_l0_, lambda_l0_from_, lambda_l0_ramp_, iteration);
+    // with per-Gaussian weights (not the paper) the mean of weight x P_nonzero. The balanced
+    // rule has no loss term: its force is added to the gradient (addL0Force).
+    if (balanced_) return {};
+    const double weight = scheduledL0Weight(options_.lambda_l0, options_.lambda_l0_from,
+                                            options_.lambda_l0_ramp, iteration);
     if (!structure_ || weight == 0) return {};
     const at::Tensor p_nonzero = probabilityNonZero(log_alpha, hc_);
     if (!l0_weights.defined()) return weight * p_nonzero.mean();
@@ -63,7 +102,12 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   }
 
   bool dropNow(int done) const override {
-    return interval_ > 0 && done % interval_ == 0 && done < iterations_;
+    // The balanced rule prunes late when asked: no drop event (and no guard reading) before the
+    // L0 force starts, so that densification, opacity resets and the semantic factor alone
+    // remove nothing before it (the paper's rule drops from the start).
+    if (balanced_ && done < options_.lambda_l0_from) return false;
+    return options_.drop_interval > 0 && done % options_.drop_interval == 0 &&
+           done < schedule_.iterations;
   }
 
   gaussians::DropDecision decide(const gaussians::DropInputs& in, int done) const override {
@@ -84,11 +128,12 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
       confidence = at::where(seen, confidence, mean_seen.expand_as(confidence));
     }
     const at::Tensor p_nonzero = probabilityNonZero(in.log_alpha, hc_);
-    at::Tensor p_drop = at::full_like(confidence, p_base_);
+    at::Tensor p_drop = at::full_like(confidence, options_.p_base);
     if (semantic_) p_drop = p_drop * (1 - confidence);
     if (structure_) p_drop = p_drop * (1 - p_nonzero);
     p_drop = p_drop.clamp(0, 1);
-    at::Generator gen = gaussians::seededGenerator(seed_, gaussians::RandomPurpose::kDropSample,
+    at::Generator gen = gaussians::seededGenerator(schedule_.seed,
+                                                   gaussians::RandomPurpose::kDropSample,
                                                    static_cast<std::uint64_t>(done));
     const at::Tensor u =
         at::empty({in.means.size(0)}, at::TensorOptions().dtype(opts.dtype().toScalarType()))
@@ -123,26 +168,42 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
   }
 
  private:
+  // Whether an opacity reset came between the guard's readings after `from` and `to`: a reset
+  // after iteration r comes after the drop event of r and so after its reading, so the resets
+  // after from .. to - 1.
+  bool openedByReset(int from, int to) const {
+    for (int r = from; r < to; ++r) {
+      if (gaussians::resetsOpacitiesAfter(densification_, schedule_, r)) return true;
+    }
+    return false;
+  }
+
+  gaussians::DropOptions options_;
+  gaussians::ScheduleOptions schedule_;
+  gaussians::DensificationOptions densification_;  // for its opacity resets (the guard)
   bool semantic_, structure_;
-  double p_base_;
-  int interval_, iterations_;
-  double lambda_l0_;
-  int lambda_l0_from_, lambda_l0_ramp_;
-  std::uint64_t seed_;
   bool balanced_;
-  bool closed_gate_gradients_;
   HardConcreteParams hc_;
 };
 
 }  // namespace
 
-double scheduledL0Weight(double lambda, int from, int ramp, int iteration) {
-  return lambda * gaussians::l0Ramp(from, ramp, iteration);
+double l0Ramp(int from, int ramp, int iteration) {
+  if (iteration < from) return 0;
+  if (ramp <= 0) return 1;
+  return std::min(1.0, static_cast<double>(iteration - from + 1) / ramp);
 }
 
-std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(const gaussians::TrainConfig& c,
-                                                                const HardConcreteParams& hc) {
-  c.check();  // ranges and choices of every option, the drop's included
+double scheduledL0Weight(double lambda, int from, int ramp, int iteration) {
+  return lambda * l0Ramp(from, ramp, iteration);
+}
+
+std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(
+    const gaussians::TrainConfig& config, const HardConcreteParams& hc) {
+  config.check();  // ranges and choices of every option, the drop's included
+  // The guard needs the opacity resets, so the densification keys whose -1 derives from the
+  // iterations are resolved (as the trainer resolves them; resolving twice changes nothing).
+  const gaussians::TrainConfig c = gaussians::resolveDerivedKeys(config);
   if (c.drop == "none") return nullptr;
   if (c.drop == "semantic") return std::make_shared<SemanticDropStrategy>(c, true, false, hc);
   if (c.drop == "structure") return std::make_shared<SemanticDropStrategy>(c, false, true, hc);

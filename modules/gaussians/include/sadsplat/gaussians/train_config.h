@@ -165,11 +165,6 @@ struct DropOptions {
   bool closed_gate_gradients = false;
 };
 
-/// \brief The factor of the L0 schedule in (0-based) `iteration`: 0 before `from`, then rising
-/// linearly to 1 over `ramp` iterations (ramp 0: 1 at once). The L0 weight of the paper's rule
-/// and the L0 force of the balanced rule both follow it (DropOptions::lambda_l0_from / _ramp).
-double l0Ramp(int from, int ramp, int iteration);
-
 /// \brief Whether `options` ask for the balanced drop rule (drop_rule "balanced"), not the
 /// paper's.
 bool balancedDropRule(const DropOptions& options);

@@ -2,7 +2,9 @@
 /// \file drop_strategy.h
 /// \brief The semantic-aware drop during training (paper, "Gaussian Point Drop"): Hard Concrete
 /// gates on the opacity, the L0 term, and every N iterations the removal of each Gaussian with
-/// probability P_drop = clamp(P_base (1 - P_conf) P_learned, 0, 1).
+/// probability P_drop = clamp(P_base (1 - P_conf) P_learned, 0, 1). Under the balanced rule
+/// (DropOptions::drop_rule, the default) also the L0 force in place of the term, the cap on each
+/// event and the quality guard (docs/GUIDE.md, "The drop rule").
 
 #include <memory>
 
@@ -12,6 +14,11 @@
 
 namespace sadsplat {
 namespace semantic_drop {
+
+/// \brief The factor of the L0 schedule in (0-based) `iteration`: 0 before `from`, then rising
+/// linearly to 1 over `ramp` iterations (ramp 0: 1 at once). The L0 weight of the paper's rule
+/// and the L0 force of the balanced rule both follow it (DropOptions::lambda_l0_from / _ramp).
+double l0Ramp(int from, int ramp, int iteration);
 
 /// \brief The weight of L_L0 in (0-based) `iteration`: 0 before `from`, then rising linearly to
 /// `lambda` over `ramp` iterations (ramp 0: `lambda` at once; from 0, ramp 0: the paper's

@@ -3,13 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/gaussians/l0_force.h"
+#include "sadsplat/semantic_drop/l0_force.h"
 
 namespace sadsplat {
 namespace {
 
-using gaussians::addBalancedL0Force;
-using gaussians::addBalancedL0ForceReference;
+using semantic_drop::addBalancedL0Force;
+using semantic_drop::addBalancedL0ForceReference;
 
 TEST(L0Force, ReachedGaussiansGetTheDirectionScaledToTheMeanLossGradient) {
   // Reached: 0 and 2 (opacity gradient != 0). sum |grad| = 0.2 + 0.6 = 0.8, sum direction =

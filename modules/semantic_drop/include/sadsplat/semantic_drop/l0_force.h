@@ -13,7 +13,7 @@
 #include <ATen/ATen.h>
 
 namespace sadsplat {
-namespace gaussians {
+namespace semantic_drop {
 
 /// \brief Adds the force to `grad` in place.
 /// \param[in,out] grad [N] float gradient of log_alpha
@@ -30,5 +30,5 @@ void addBalancedL0ForceReference(at::Tensor& grad, const at::Tensor& direction,
                                  const at::Tensor& opacity_grad, const at::Tensor& weights,
                                  double strength);
 
-}  // namespace gaussians
+}  // namespace semantic_drop
 }  // namespace sadsplat

@@ -6,7 +6,7 @@
 #include "sadsplat/common/cuda_support.h"
 
 namespace sadsplat {
-namespace gaussians {
+namespace semantic_drop {
 namespace l0_force {
 namespace {
 
@@ -81,5 +81,5 @@ void addCuda(float* grad, const float* direction, const float* opacity_grad, con
 }
 
 }  // namespace l0_force
-}  // namespace gaussians
+}  // namespace semantic_drop
 }  // namespace sadsplat

@@ -1,4 +1,4 @@
-#include "sadsplat/gaussians/l0_force.h"
+#include "sadsplat/semantic_drop/l0_force.h"
 
 #if SADSPLAT_HAVE_CUDA
 #include <c10/cuda/CUDAGuard.h>
@@ -10,7 +10,7 @@
 #include "sadsplat/common/error.h"
 
 namespace sadsplat {
-namespace gaussians {
+namespace semantic_drop {
 
 #if SADSPLAT_HAVE_CUDA
 namespace l0_force {
@@ -75,5 +75,5 @@ void addBalancedL0Force(at::Tensor& grad, const at::Tensor& direction,
   addBalancedL0ForceReference(grad, direction, opacity_grad, weights, strength);
 }
 
-}  // namespace gaussians
+}  // namespace semantic_drop
 }  // namespace sadsplat
