@@ -19,7 +19,9 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEB
   -DCMAKE_C_FLAGS_DEBUG="-O0 -g1" -DSADSPLAT_SANITIZE=address,undefined \
   -DSADSPLAT_WITH_CUDA=OFF -DSADSPLAT_BUILD_BENCHMARKS=OFF -DCMAKE_UNITY_BUILD=ON \
   -DSADSPLAT_PRECOMPILE_HEADERS=OFF >/dev/null
+start=$SECONDS
 cmake --build build-asan
+echo "[stage] sanitizer build: $(( SECONDS - start )) s"
 supp=$(pwd)/tests/sanitizers
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_odr_violation=0:allocator_may_return_null=1"
 export LSAN_OPTIONS="suppressions=$supp/lsan_suppressions.txt:print_suppressions=0"

@@ -45,7 +45,7 @@ class EventsEvery : public gaussians::DropStrategy {
 
 TrainConfig guardConfig() {
   TrainConfig c;
-  c.drop = "full";
+  c.drop = gaussians::DropMode::kFull;
   c.iterations = 7000;
   c.drop_interval = 500;
   return c;

@@ -68,12 +68,13 @@ TEST(Initialization, RandomPointsLieInTheCamerasCommonView) {
 }
 
 TEST(Initialization, TheInitChoice) {
-  EXPECT_FALSE(gaussians::initialisesRandomly("auto", 4));
-  EXPECT_TRUE(gaussians::initialisesRandomly("auto", 3));
-  EXPECT_TRUE(gaussians::initialisesRandomly("random", 1000));
-  EXPECT_FALSE(gaussians::initialisesRandomly("points", 4));
-  EXPECT_THROW(gaussians::initialisesRandomly("points", 0), Error);
-  EXPECT_THROW(gaussians::initialisesRandomly("sfm", 100), Error);
+  using gaussians::InitMode;
+  EXPECT_FALSE(gaussians::initialisesRandomly(InitMode::kAuto, 4));
+  EXPECT_TRUE(gaussians::initialisesRandomly(InitMode::kAuto, 3));
+  EXPECT_TRUE(gaussians::initialisesRandomly(InitMode::kRandom, 1000));
+  EXPECT_FALSE(gaussians::initialisesRandomly(InitMode::kPoints, 4));
+  EXPECT_THROW(gaussians::initialisesRandomly(InitMode::kPoints, 0), Error);
+  EXPECT_THROW(gaussians::parseChoice<InitMode>("sfm", "test", "init"), Error);
 }
 
 TEST(Initialization, TooFewPointsIsAnError) {

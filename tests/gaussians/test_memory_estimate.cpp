@@ -98,7 +98,7 @@ TEST(MemoryEstimate, GaussiansGrowFromThePointsUpToTheCap) {
   wider.feature_dim += 1;
   EXPECT_GE(gaussians::bytesPerGaussian(wider) - gaussians::bytesPerGaussian(config), 16);
   // A CUDA device adds its context; the total is the parts with the allocator's slack.
-  config.device = "cuda";
+  config.device = gaussians::TrainDevice::kCuda;
   e = gaussians::estimateTrainingMemory(scene, config);
   EXPECT_EQ(e.fixed, gaussians::kFixedDeviceBytes);
   EXPECT_GE(e.total(), e.fixed + e.views + e.gaussians + e.render);

@@ -46,7 +46,7 @@ class TrainerTest : public ::testing::Test {
     c.feature_dim = 8;
     c.densify_from = 100000;  // off unless a test turns it on
     c.checkpoint_interval = 0;
-    c.device = device;
+    c.device = gaussians::parseChoice<gaussians::TrainDevice>(device, "test", "device");
     return c;
   }
   io::Scene scene_;
@@ -87,9 +87,9 @@ TEST_P(TrainerOnDevice, ASceneWithoutPointsTrainsFromRandomPoints) {
   io::Scene scene = scene_;
   scene.points.clear();
   TrainConfig config = small(240);
-  config.init = "points";
+  config.init = gaussians::InitMode::kPoints;
   EXPECT_THROW(Trainer(scene, config), Error);
-  config.init = "auto";
+  config.init = gaussians::InitMode::kAuto;
   config.init_random_count = 3000;
   Trainer trainer(scene, config);
   EXPECT_EQ(trainer.numGaussians(), 3000);
@@ -451,7 +451,7 @@ TEST_P(TrainerOnDevice, RecoveryFoldsTheGatesIntoTheOpacitiesAndTrainsWithoutThe
   TrainConfig c = small(20);
   c.recovery_iterations = 5;
   c.lr_opacity = 0;       // the opacities change only by the folding
-  c.drop_rule = "paper";  // the L0 term is in the loss
+  c.drop_rule = gaussians::DropRule::kPaper;  // the L0 term is in the loss
   Trainer trainer(scene_, c);
   auto gates = std::make_shared<ThirdsGates>();
   trainer.setDropStrategy(gates);
@@ -547,7 +547,7 @@ TEST_F(TrainerTest, L0WeightsFollowTheContributionsFromTheScheduleStartOnEveryDr
   c.l0_importance = 1.0;
   c.lambda_l0_from = 3;
   c.drop_interval = 2;
-  c.drop_rule = "paper";  // the weights reach the L0 term of the loss
+  c.drop_rule = gaussians::DropRule::kPaper;  // the weights reach the L0 term of the loss
   Trainer trainer(scene_, c);
   auto recorder = std::make_shared<L0WeightRecorder>();
   trainer.setDropStrategy(recorder);
@@ -579,7 +579,7 @@ TEST_F(TrainerTest, L0WeightsFollowTheContributionsFromTheScheduleStartOnEveryDr
 
 TEST_F(TrainerTest, WithoutL0ImportanceTheL0TermGetsNoWeights) {
   TrainConfig c = small(3);
-  c.drop_rule = "paper";  // the L0 term of the loss
+  c.drop_rule = gaussians::DropRule::kPaper;  // the L0 term of the loss
   Trainer trainer(scene_, c);
   auto recorder = std::make_shared<L0WeightRecorder>();
   trainer.setDropStrategy(recorder);
@@ -593,7 +593,7 @@ TEST_F(TrainerTest, ResumeBetweenL0WeightUpdatesIsExact) {
   c.l0_importance = 2.0;
   c.lambda_l0_from = 2;
   c.drop_interval = 4;
-  c.drop_rule = "paper";  // the weights reach the L0 term of the loss
+  c.drop_rule = gaussians::DropRule::kPaper;  // the weights reach the L0 term of the loss
   auto run = [&](Trainer& t, int steps) {
     auto recorder = std::make_shared<L0WeightRecorder>();
     t.setDropStrategy(recorder);
@@ -740,7 +740,7 @@ TEST_F(TrainerTest, CudaTileListsSizedFromEarlierRendersTrainAsExactLists) {
   c.densify_grad_threshold = 0;
   c.percent_dense = 1e6;
   c.min_opacity = 0;
-  c.drop = "full";  // gated renders: the second pass samples the same gates
+  c.drop = gaussians::DropMode::kFull;  // gated renders: the second pass samples the same gates
   c.tile_list_margin = 1.0;
   TrainConfig exact_config = c;
   exact_config.tile_list_margin = 0;
@@ -799,8 +799,7 @@ TEST_F(TrainerTest, BadCheckpointsAndConfigsAreClearErrors) {
   EXPECT_EQ(back.background[1], 0.25f);
   EXPECT_EQ(back.lambda_l0_from, 3500);
   EXPECT_EQ(back.lambda_l0_ramp, 700);
-  c.device = "tpu";
-  EXPECT_THROW(Trainer(scene_, c), Error);
+  EXPECT_THROW(TrainConfig::fromJson("{\"device\": \"tpu\"}", "x"), Error);
 }
 
 // densify_until -1: 2/7 of the iterations, so the 7000-iteration schedule has no opacity reset
@@ -955,7 +954,7 @@ TEST(TrainConfigLong, TheLongScheduleIsLongerPrunesLateAndRefinesKeepingGivenKey
   EXPECT_EQ(net1.lambda_l0_from, 0);    // no drop: no gate keys
   EXPECT_EQ(net1.recovery_iterations, 0);
   EXPECT_EQ(changed.size(), 2u);
-  c.drop = "full";
+  c.drop = gaussians::DropMode::kFull;
   const TrainConfig full = longSchedule(c, {});
   EXPECT_EQ(full.densify_until, 7500);
   EXPECT_EQ(full.lambda_l0_from, 7500);  // after the densification

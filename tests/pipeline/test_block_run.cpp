@@ -220,7 +220,7 @@ TEST(BlockRun, AMemoryBudgetPicksTheFewestBlocksThatFit) {
   EXPECT_NE(out.find("--max-gpu-memory"), std::string::npos) << out;
   // info SCENE.cache says what training it would hold on a CUDA device, held and streamed.
   ASSERT_EQ(test::runCommand(kCli + " info " + kTinySceneCache, &out), 0) << out;
-  config.device = "cuda";
+  config.device = gaussians::TrainDevice::kCuda;
   EXPECT_NE(out.find("views held:      " + gaussians::estimateTrainingMemory(scene, config)
                                                .describe()),
             std::string::npos)

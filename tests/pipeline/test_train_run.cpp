@@ -49,7 +49,7 @@ TEST_P(ScheduleAgreement, PrintedRecordedAndRunScheduleAreOne) {
   TrainConfig asked;
   asked.iterations = k.iterations;
   asked.views_per_step = k.views_per_step;
-  asked.drop = "full";
+  asked.drop = gaussians::DropMode::kFull;
   pipeline::TrainRunOptions o;
   o.scene = kCache;
   o.out = dir.file("run");
@@ -140,8 +140,8 @@ void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
   pipeline::pseudoLabelRun(labelling);
   TrainConfig config;
   config.iterations = 40;
-  config.device = device;
-  config.drop = "full";
+  config.device = gaussians::parseChoice<gaussians::TrainDevice>(device, "test", "device");
+  config.drop = gaussians::DropMode::kFull;
   config.drop_interval = 20;
   config.checkpoint_interval = 0;
   pipeline::TrainRunOptions o;

@@ -32,12 +32,13 @@ io::Scene tinyScene() {
 // A short training on the tiny scene with a drop every `drop_interval` iterations; no
 // densification, no checkpoints.
 gaussians::TrainConfig tinyDropConfig(int iterations, const std::string& drop, int drop_interval) {
+  using gaussians::DropMode;
   gaussians::TrainConfig c;
   c.iterations = iterations;
   c.feature_dim = 8;
   c.densify_from = 100000;
   c.checkpoint_interval = 0;
-  c.drop = drop;
+  c.drop = gaussians::parseChoice<DropMode>(drop, "test", "drop");
   c.drop_interval = drop_interval;
   return c;
 }
@@ -187,9 +188,9 @@ TEST(DropStrategy, DecisionCountsTheReasonsOfTheRemovals) {
   in.cameras = {cam};
   in.confidence_maps = {at::ones({4, 4}, opts)};
   gaussians::TrainConfig c;
-  c.drop = "full";
+  c.drop = gaussians::DropMode::kFull;
   c.p_base = 1.5;
-  c.drop_rule = "paper";  // unseen Gaussians have confidence 0
+  c.drop_rule = gaussians::DropRule::kPaper;  // unseen Gaussians have confidence 0
   const gaussians::DropDecision d = makeDropStrategy(c)->decide(in, 500);
   EXPECT_TRUE(d.keep.slice(0, 0, 200).all().item<bool>());
   EXPECT_FALSE(d.keep.slice(0, 200, 400).any().item<bool>());
@@ -199,7 +200,7 @@ TEST(DropStrategy, DecisionCountsTheReasonsOfTheRemovals) {
   EXPECT_EQ(d.removed_closed_gate, 200);
   EXPECT_NEAR(d.confidence[0].item<float>(), 1.0f, 1e-6);
   // Structure only: the semantic reasons are not counted.
-  c.drop = "structure";
+  c.drop = gaussians::DropMode::kStructure;
   const gaussians::DropDecision s = makeDropStrategy(c)->decide(in, 500);
   EXPECT_EQ(s.removed, 200);
   EXPECT_EQ(s.removed_low_confidence, 0);
@@ -234,9 +235,7 @@ TEST(DropStrategy, TrainingWithTheFullDropRemovesGaussiansAndLearnsGates) {
     max_conf = std::max(max_conf, p.confidence);
   }
   EXPECT_GT(max_conf, 0.f);
-  c.drop = "sometimes";
-  EXPECT_THROW(makeDropStrategy(c), Error);
-  c.drop = "full";
+  c.drop = gaussians::DropMode::kFull;
   c.lambda_l0 = -0.1;
   EXPECT_THROW(makeDropStrategy(c), Error);
   c.lambda_l0 = 0.2;
@@ -284,8 +283,9 @@ TEST(DropStrategy, L0WeightFollowsItsSchedule) {
 
 TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
   gaussians::TrainConfig c;
-  c.drop = "full";
-  c.drop_rule = "paper";  // the balanced rule has no loss term (its force: test_drop_guard.cpp)
+  c.drop = gaussians::DropMode::kFull;
+  // The balanced rule has no loss term (its force: test_drop_guard.cpp).
+  c.drop_rule = gaussians::DropRule::kPaper;
   c.lambda_l0 = 0.5;
   c.lambda_l0_from = 10;
   c.lambda_l0_ramp = 2;
@@ -301,19 +301,19 @@ TEST(DropStrategy, RegularisationIsOffBeforeTheScheduleStarts) {
   EXPECT_NEAR(makeDropStrategy(c)->regularisation(log_alpha, 0, {}).item<double>(), 0.5 * mean_p,
               1e-6);
   // Without the structure term there is no L0 term at all.
-  c.drop = "semantic";
+  c.drop = gaussians::DropMode::kSemantic;
   EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100, {}).defined());
   // Nor under the balanced rule, whose L0 force goes to the gradient instead.
-  c.drop = "full";
-  c.drop_rule = "balanced";
+  c.drop = gaussians::DropMode::kFull;
+  c.drop_rule = gaussians::DropRule::kBalanced;
   EXPECT_FALSE(makeDropStrategy(c)->regularisation(log_alpha, 100, {}).defined());
 }
 
 // Per-Gaussian L0 weights (TrainConfig::l0_importance): lambda * mean(w * P_nonzero), by hand.
 TEST(DropStrategy, WeightedRegularisationIsTheMeanOfWeightTimesPNonZero) {
   gaussians::TrainConfig c;
-  c.drop = "full";
-  c.drop_rule = "paper";
+  c.drop = gaussians::DropMode::kFull;
+  c.drop_rule = gaussians::DropRule::kPaper;
   c.lambda_l0 = 0.5;
   const auto drop = makeDropStrategy(c);
   const at::Tensor log_alpha = at::tensor({-2.0f, 0.0f, 1.0f, 4.0f});
@@ -350,8 +350,8 @@ TEST(DropStrategy, BalancedRuleGivesUnseenGaussiansTheMeanConfidence) {
   in.cameras = {cam};
   in.confidence_maps = {at::full({4, 4}, 0.8f, opts)};
   gaussians::TrainConfig c;
-  c.drop = "full";
-  ASSERT_EQ(c.drop_rule, "balanced");  // the default
+  c.drop = gaussians::DropMode::kFull;
+  ASSERT_EQ(c.drop_rule, gaussians::DropRule::kBalanced);  // the default
   gaussians::DropDecision d = makeDropStrategy(c)->decide(in, 500);
   EXPECT_TRUE(at::allclose(d.confidence, at::full({400}, 0.8f, opts)));
   EXPECT_TRUE(at::allclose(d.p_drop, at::full({400}, 0.2f, opts), 1e-5, 1e-6));
@@ -362,7 +362,7 @@ TEST(DropStrategy, BalancedRuleGivesUnseenGaussiansTheMeanConfidence) {
   d = makeDropStrategy(c)->decide(in, 500);
   EXPECT_TRUE(at::allclose(d.confidence, at::full({400}, 0.5f, opts)));
   // The paper's rule: confidence 0 where no map sees, P_drop = P_base.
-  c.drop_rule = "paper";
+  c.drop_rule = gaussians::DropRule::kPaper;
   d = makeDropStrategy(c)->decide(in, 500);
   EXPECT_EQ(d.confidence.abs().max().item<float>(), 0.0f);
   EXPECT_EQ(d.removed, 400);
@@ -378,7 +378,7 @@ TEST(DropStrategy, ACappedEventRemovesTheHighestDropProbabilitiesFirst) {
   // log_alpha from -12 to -2: P_nonzero rises with the index, P_drop falls.
   in.log_alpha = at::linspace(-12, -2, n, opts);
   gaussians::TrainConfig c;
-  c.drop = "structure";
+  c.drop = gaussians::DropMode::kStructure;
   c.p_base = 1.0;
   const auto drop = makeDropStrategy(c);
   const gaussians::DropDecision all = drop->decide(in, 500);
@@ -401,7 +401,7 @@ TEST(DropStrategy, TheBalancedRuleHasNoDropEventBeforeTheL0ForceStarts) {
   const io::Scene scene = tinyScene();
   const auto firstDrop = [&](const std::string& rule) {
     gaussians::TrainConfig c = tinyDropConfig(120, "full", 20);
-    c.drop_rule = rule;
+    c.drop_rule = gaussians::parseChoice<gaussians::DropRule>(rule, "test", "drop_rule");
     c.lambda_l0_from = 70;
     c.log_alpha_init = 0.0;  // P_learned = 0.17: every event removes some
     gaussians::Trainer trainer(scene, c);
@@ -438,7 +438,7 @@ double meanPsnr(const gaussians::Trainer& trainer, const io::Scene& scene) {
 CollapseRun trainUnderPressure(const std::string& drop, const std::string& rule) {
   const io::Scene scene = tinyScene();
   gaussians::TrainConfig c = tinyDropConfig(200, drop, 25);
-  c.drop_rule = rule;
+  c.drop_rule = gaussians::parseChoice<gaussians::DropRule>(rule, "test", "drop_rule");
   c.lambda_l0 = 5.0;
   c.lr_log_alpha = 0.1;
   gaussians::Trainer trainer(scene, c);

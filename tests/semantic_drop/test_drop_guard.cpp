@@ -21,8 +21,8 @@ using gaussians::TrainConfig;
 // 3000 and 6000 up to densify_until 6000, no recovery.
 TrainConfig guardConfig() {
   TrainConfig c;
-  c.drop = "full";
-  c.drop_rule = "balanced";
+  c.drop = gaussians::DropMode::kFull;
+  c.drop_rule = gaussians::DropRule::kBalanced;
   c.iterations = 7000;
   c.drop_interval = 500;
   c.lambda_l0_from = 500;
@@ -59,7 +59,7 @@ TEST(DropGuard, ReadsBeforeEachDropEventOfTheBalancedRuleOnly) {
   off.drop_guard = 0;
   EXPECT_FALSE(Guarded(off).readsBefore(500));
   TrainConfig paper = c;
-  paper.drop_rule = "paper";
+  paper.drop_rule = gaussians::DropRule::kPaper;
   EXPECT_FALSE(Guarded(paper).readsBefore(500));
 }
 
@@ -137,7 +137,7 @@ TEST(BalancedRule, CapsEachEventAtTheFractionTimesThePressureAndThePaperRuleNot)
   guard.pressure = 0.5;
   EXPECT_EQ(rule->maxRemoved(1000, guard), 75);
   EXPECT_EQ(rule->maxRemoved(999, guard), 74);  // floor(74.925)
-  c.drop_rule = "paper";
+  c.drop_rule = gaussians::DropRule::kPaper;
   EXPECT_EQ(semantic_drop::makeDropStrategy(c)->maxRemoved(1000, guard), -1);
 }
 
@@ -146,7 +146,7 @@ TEST(BalancedRule, NoDropEventBeforeTheL0ForceStarts) {
   c.lambda_l0_from = 1500;
   EXPECT_FALSE(semantic_drop::makeDropStrategy(c)->dropNow(1000));
   EXPECT_TRUE(semantic_drop::makeDropStrategy(c)->dropNow(1500));
-  c.drop_rule = "paper";  // the paper's rule drops from the start
+  c.drop_rule = gaussians::DropRule::kPaper;  // the paper's rule drops from the start
   EXPECT_TRUE(semantic_drop::makeDropStrategy(c)->dropNow(1000));
 }
 
@@ -176,10 +176,10 @@ TEST(BalancedRule, TheL0ForceScalesWithStrengthPressureAndRampOnReachedGaussians
   EXPECT_NEAR(forceOf(c, 503)[0].item<double>(), 0.3, 1e-6);  // the ramp's end
   EXPECT_EQ(forceOf(c, 499).abs().sum().item<double>(), 0.0);  // before the L0 force starts
   TrainConfig paper = c;
-  paper.drop_rule = "paper";  // a loss term, no force
+  paper.drop_rule = gaussians::DropRule::kPaper;  // a loss term, no force
   EXPECT_EQ(forceOf(paper, 600).abs().sum().item<double>(), 0.0);
   TrainConfig semantic = c;
-  semantic.drop = "semantic";  // no gates: nothing to push
+  semantic.drop = gaussians::DropMode::kSemantic;  // no gates: nothing to push
   EXPECT_EQ(forceOf(semantic, 600).abs().sum().item<double>(), 0.0);
 }
 

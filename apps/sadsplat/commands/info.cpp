@@ -15,7 +15,7 @@ namespace {
 // streamed (gaussians/memory_estimate.h): whether it fits a card before it is trained.
 std::string trainingMemory(const io::Scene& scene) {
   gaussians::TrainConfig config;
-  config.device = "cuda";
+  config.device = gaussians::TrainDevice::kCuda;
   std::ostringstream out;
   out << "training memory on a CUDA device (defaults, estimated):\n"
       << "  views held:      " << gaussians::estimateTrainingMemory(scene, config).describe()

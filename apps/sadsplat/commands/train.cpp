@@ -105,7 +105,7 @@ class TrainCommand : public Command {
       }
       CLI::Option* flag = c->add_option(o.flag, values_[&o], help);
       // A value outside the table's range or choices is a usage error (exit 2) here already.
-      if (o.choices != nullptr) {
+      if (!gaussians::optionChoices(o).empty()) {
         flag->check(CLI::IsMember(gaussians::optionChoices(o)));
       } else if (!std::holds_alternative<std::string gaussians::TrainConfig::*>(o.member)) {
         const bool real = std::holds_alternative<double gaussians::TrainConfig::*>(o.member);
@@ -155,7 +155,9 @@ class TrainCommand : public Command {
     options.schedule.kind = gaussians::parseScheduleKind(schedule_);
     options.schedule.given = given;
     if (batch_schedule_) options.schedule.batch_ranks = rank_env ? rank_env->world_size : 1;
-    if (rank_env && config.device.rfind("cuda", 0) == 0) distributed::bindLocalGpu(*rank_env);
+    if (rank_env && config.device == gaussians::TrainDevice::kCuda) {
+      distributed::bindLocalGpu(*rank_env);
+    }
     // A budget alone means --blocks auto.
     if (max_gpu_memory_gib_ > 0 && blocks_text_.empty()) blocks_text_ = "auto";
     const bool in_blocks = !blocks_text_.empty();
@@ -165,7 +167,8 @@ class TrainCommand : public Command {
                   "none");
     if (rank_env && !in_blocks) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
-      options.collective = distributed::joinGroup(*rank_env, config.device);
+      options.collective =
+          distributed::joinGroup(*rank_env, gaussians::choiceName(config.device));
     }
     options.scene = scene_;
     options.out = out_;

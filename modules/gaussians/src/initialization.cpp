@@ -139,18 +139,15 @@ std::vector<io::ScenePoint> randomPointsInView(const std::vector<io::PinholeCame
   return points;
 }
 
-bool initialisesRandomly(const std::string& init, std::size_t num_points) {
-  if (init == "random") return true;
-  if (init == "auto") return num_points < 4;
-  if (init == "points") {
-    if (num_points < 4) {
-      throw Error("<scene>", "sparse points",
-                  "at least 4 points to initialise Gaussians (or --init random)",
-                  std::to_string(num_points));
-    }
-    return false;
+bool initialisesRandomly(InitMode init, std::size_t num_points) {
+  if (init == InitMode::kRandom) return true;
+  if (init == InitMode::kAuto) return num_points < 4;
+  if (num_points < 4) {
+    throw Error("<scene>", "sparse points",
+                "at least 4 points to initialise Gaussians (or --init random)",
+                std::to_string(num_points));
   }
-  throw Error("<config>", "init", "auto, points or random", init);
+  return false;
 }
 
 }  // namespace gaussians

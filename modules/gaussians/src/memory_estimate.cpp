@@ -61,7 +61,7 @@ std::int64_t bytesPerGaussian(const TrainConfig& c) {
 MemoryEstimate estimateTrainingMemory(const io::Scene& scene, const std::vector<int>& views,
                                       std::size_t points, const TrainConfig& c) {
   MemoryEstimate e;
-  e.fixed = c.device.rfind("cuda", 0) == 0 ? kFixedDeviceBytes : 0;
+  e.fixed = c.device == TrainDevice::kCuda ? kFixedDeviceBytes : 0;
   std::int64_t largest = 0;
   for (int i : views) {
     const io::View& v = scene.views.at(static_cast<std::size_t>(i));

@@ -134,7 +134,7 @@ TrainConfig longSchedule(const TrainConfig& config, const std::vector<std::strin
   // PSNR than until 15000, 3DGS's half, with and without a drop; docs/measurements/
   // gpu_long_schedule).
   keys.set("densify_until", c.densify_until, c.iterations / 4);
-  if (c.drop != "none") {
+  if (c.drop != DropMode::kNone) {
     keys.set("lambda_l0_from", c.lambda_l0_from, densifyUntilResolved(c));
     keys.set("recovery_iterations", c.recovery_iterations, c.iterations / 6);
   }

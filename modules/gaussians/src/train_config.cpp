@@ -149,11 +149,11 @@ const std::vector<TrainOption> kOptions = {
     {"init", &C::init,
      "initial Gaussians: the scene's sparse points, random points in the cameras' common view, or "
      "auto (points when the scene has at least 4, else random)",
-     "--init", -kInf, kInf, "auto|points|random"},
+     "--init"},
     {"init_random_count", &C::init_random_count, "how many random points --init random places",
      nullptr, 4, kInf},
     {"background", &C::background, "background colour [r, g, b] in [0, 1]"},
-    {"device", &C::device, "where to train", "--device", -kInf, kInf, "cpu|cuda"},
+    {"device", &C::device, "where to train", "--device"},
     {"stream_views", &C::stream_views,
      "upload each step's views when it renders them, read from the scene cache on loader "
      "threads ahead of the step (an imported directory: kept in host memory in 8 bits): GPU "
@@ -166,8 +166,7 @@ const std::vector<TrainOption> kOptions = {
      "--prune-floaters"},
     {"floater_min_views", &C::floater_min_views, "see prune_floaters", nullptr, 0, kInf},
     {"floater_max_scale", &C::floater_max_scale, "see prune_floaters", nullptr, 0, kInf},
-    {"drop", &C::drop, "the semantic-aware drop", "--drop", -kInf, kInf,
-     "none|semantic|structure|full"},
+    {"drop", &C::drop, "the semantic-aware drop", "--drop"},
     {"p_base", &C::p_base, "base drop rate P_base (paper: 1.0)", "--p-base", 0, kInf},
     {"drop_interval", &C::drop_interval, "iterations between drops (paper: 500)", nullptr, 1, kInf},
     {"lambda_l0", &C::lambda_l0, "weight of the L0 sparsity loss", "--lambda-l0", 0, kInf},
@@ -195,7 +194,7 @@ const std::vector<TrainOption> kOptions = {
     {"drop_rule", &C::drop_rule,
      "balanced: L0 force relative to the RGB force, capped drop events, a loss guard (not the "
      "paper); paper: the paper's rule as printed",
-     "--drop-rule", -kInf, kInf, "balanced|paper"},
+     "--drop-rule"},
     {"l0_strength", &C::l0_strength,
      "balanced rule: L0 force on a gate as a share of the mean RGB force on the gates",
      "--l0-strength", 0, kInf},
@@ -211,6 +210,13 @@ const std::vector<TrainOption> kOptions = {
      "masked rasterisation; not the paper)",
      "--closed-gate-gradients"},
 };
+
+// The value of a choice named by a JSON string.
+template <typename Choice>
+Choice choiceNamed(const nlohmann::json& value, const char* key, const std::string& origin) {
+  if (!value.is_string()) throw Error(origin, key, "a string", value.type_name());
+  return parseChoice<Choice>(value.get<std::string>(), origin, key);
+}
 
 std::string numberText(double v) {
   std::ostringstream out;
@@ -229,8 +235,10 @@ void setFromJson(const TrainOption& o, const nlohmann::json& value, TrainConfig&
           c.*member = integer<T>(d, o.key, origin);
         } else if constexpr (std::is_same_v<T, double>) {
           c.*member = real(d, o.key, origin);
-        } else if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::string>) {
+        } else if constexpr (std::is_same_v<T, bool>) {
           c.*member = value.get<T>();
+        } else if constexpr (std::is_enum_v<T>) {
+          c.*member = choiceNamed<T>(value, o.key, origin);
         } else {  // the background colour
           if (!value.is_array() || value.size() != 3) {
             throw Error(
@@ -254,6 +262,8 @@ nlohmann::json toJsonValue(const TrainOption& o, const TrainConfig& c) {
         using T = std::decay_t<decltype(c.*member)>;
         if constexpr (std::is_same_v<T, std::array<float, 3>>) {
           return {(c.*member)[0], (c.*member)[1], (c.*member)[2]};
+        } else if constexpr (std::is_enum_v<T>) {
+          return choiceName(c.*member);
         } else {
           return c.*member;
         }
@@ -265,12 +275,50 @@ nlohmann::json toJsonValue(const TrainOption& o, const TrainConfig& c) {
 
 const std::vector<TrainOption>& trainOptions() { return kOptions; }
 
+const std::vector<std::string>& choiceNames(DropMode) {
+  static const std::vector<std::string> names{"none", "semantic", "structure", "full"};
+  return names;
+}
+const std::vector<std::string>& choiceNames(DropRule) {
+  static const std::vector<std::string> names{"balanced", "paper"};
+  return names;
+}
+const std::vector<std::string>& choiceNames(InitMode) {
+  static const std::vector<std::string> names{"auto", "points", "random"};
+  return names;
+}
+const std::vector<std::string>& choiceNames(TrainDevice) {
+  static const std::vector<std::string> names{"cpu", "cuda"};
+  return names;
+}
+
+template <typename Choice>
+Choice parseChoice(const std::string& name, const std::string& origin, const std::string& key) {
+  const std::vector<std::string>& names = choiceNames(Choice{});
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) {
+    std::string expected;
+    for (const std::string& n : names) expected += (expected.empty() ? "" : ",") + n;
+    throw Error(origin, key, expected, name);
+  }
+  return static_cast<Choice>(it - names.begin());
+}
+template DropMode parseChoice(const std::string&, const std::string&, const std::string&);
+template DropRule parseChoice(const std::string&, const std::string&, const std::string&);
+template InitMode parseChoice(const std::string&, const std::string&, const std::string&);
+template TrainDevice parseChoice(const std::string&, const std::string&, const std::string&);
+
 std::vector<std::string> optionChoices(const TrainOption& option) {
-  std::vector<std::string> choices;
-  if (option.choices == nullptr) return choices;
-  std::stringstream list(option.choices);
-  for (std::string c; std::getline(list, c, '|');) choices.push_back(c);
-  return choices;
+  return std::visit(
+      [](auto member) -> std::vector<std::string> {
+        using T = std::decay_t<decltype(TrainConfig{}.*member)>;
+        if constexpr (std::is_enum_v<T>) {
+          return choiceNames(T{});
+        } else {
+          return {};
+        }
+      },
+      option.member);
 }
 
 std::string optionText(const TrainOption& option, const TrainConfig& config) {
@@ -281,7 +329,7 @@ std::string optionText(const TrainOption& option, const TrainConfig& config) {
 void setOptionFromText(const TrainOption& option, const std::string& text, TrainConfig& config,
                        const std::string& origin) {
   nlohmann::json value;
-  if (std::holds_alternative<std::string TrainConfig::*>(option.member)) {
+  if (!optionChoices(option).empty()) {
     value = text;
   } else {
     value = nlohmann::json::parse(text, nullptr, false);
@@ -300,8 +348,6 @@ void setOptionFromText(const TrainOption& option, const std::string& text, Train
   setFromJson(option, value, config, origin);
 }
 
-bool balancedDropRule(const DropOptions& options) { return options.drop_rule == "balanced"; }
-
 void TrainConfig::check(const std::string& origin) const {
   for (const TrainOption& o : kOptions) {
     const nlohmann::json v = toJsonValue(o, *this);
@@ -310,13 +356,6 @@ void TrainConfig::check(const std::string& origin) const {
                                 : o.min == -kInf ? "<= " + numberText(o.max)
                                                  : numberText(o.min) + " .. " + numberText(o.max);
       throw Error(origin, o.key, range, v.dump());
-    }
-    const std::vector<std::string> choices = optionChoices(o);
-    if (v.is_string() && !choices.empty() &&
-        std::find(choices.begin(), choices.end(), v.get<std::string>()) == choices.end()) {
-      std::string expected;
-      for (const std::string& c : choices) expected += (expected.empty() ? "" : ",") + c;
-      throw Error(origin, o.key, expected, v.get<std::string>());
     }
   }
   if (tile_list_margin > 0 && tile_list_margin < 1) {

@@ -309,7 +309,7 @@ void Trainer::State::readLossValues(const StepPass& pass, StepStats& stats) cons
 Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State(config)) {
   State& s = *state_;
   config.check();
-  s.device = deviceNamed(config.device, "<config>");
+  s.device = deviceNamed(choiceName(config.device), "<config>");
   if (s.device.is_cuda()) {
     if (!at::hasCUDA()) {
       throw Error("<config>", "device", "cpu (no CUDA device or no CUDA build here)", "cuda");

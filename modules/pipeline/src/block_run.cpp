@@ -259,7 +259,8 @@ void BlockRun::merge() const {
   io::makeDirectory(o.out);
   io::writeTextFileAtomically(dir.config(), trainer.config().toJson());
   writeTrainedRun(dir, trainer, scene_,
-                  io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), seconds});
+                  io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
+                                trainer.iteration(), seconds});
   if (o.progress) {
     *o.progress << "merged " << trained.size() << " blocks: " << trainer.numGaussians()
                 << " Gaussians (of " << total << " in the blocks, each keeping its cell's), the "

@@ -51,7 +51,7 @@ int runDemo(const std::string& out_dir, int iterations, std::ostream& out, bool 
       << ")\n";
   gaussians::TrainConfig config;
   config.iterations = iterations;
-  if (!baseline) config.drop = "full";
+  if (!baseline) config.drop = gaussians::DropMode::kFull;
   TrainRunOptions o;
   o.scene = train_scene;
   o.out = out_dir + "/run";

@@ -27,7 +27,7 @@ namespace pipeline {
 namespace {
 
 at::Device deviceOf(const gaussians::TrainConfig& config) {
-  return gaussians::deviceNamed(config.device, "<config>");
+  return gaussians::deviceNamed(gaussians::choiceName(config.device), "<config>");
 }
 
 // The configuration a run trains with: the schedule resolved, or for a resumed run its own
@@ -156,7 +156,7 @@ void checkFinite(const gaussians::StepStats& stats, const std::string& run, int 
 std::string profileTables(const gaussians::StepProfile& profile,
                           gaussians::StepProfile::Clock clock, const gaussians::TrainConfig& config,
                           const io::RunDirectory& dir, bool writer) {
-  const std::string table = "Training time per phase (" + config.device +
+  const std::string table = "Training time per phase (" + gaussians::choiceName(config.device) +
                             (clock == gaussians::StepProfile::Clock::kHost
                                  ? ", the host's clock: no phase waits for the device"
                                  : ", each phase boundary waits for the device") +
@@ -228,7 +228,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     return previous_seconds +
            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  Checkpoints checkpoints(dir, io::RunRecord{o.scene, o.scale, config.device, first, 0}, writer,
+  Checkpoints checkpoints(dir,
+                          io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
+                                        first, 0},
+                          writer,
                           first);
   const int kill_at = faultKillIteration(o);
   report.atCap(o.resume && trainer.numGaussians() >= config.max_gaussians);
@@ -262,7 +265,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   const double total = seconds();
   if (!writer) return total;
   writeTrainedRun(dir, trainer, scene,
-                  io::RunRecord{o.scene, o.scale, config.device, trainer.iteration(), total});
+                  io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
+                                trainer.iteration(), total});
   return total;
 }
 

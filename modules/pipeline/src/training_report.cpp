@@ -43,7 +43,9 @@ void TrainingReport::started(const io::Scene& scene, const gaussians::TrainConfi
   std::ostream& out = *progress_;
   if (scene.classes.empty()) {
     out << "RGB only: the scene has no classes.json, so no semantic head (plain 3DGS"
-        << (config.drop == "none" ? "" : ", drop " + config.drop + " without confidence maps")
+        << (config.drop == gaussians::DropMode::kNone
+                ? ""
+                : ", drop " + gaussians::choiceName(config.drop) + " without confidence maps")
         << ")\n";
   } else {
     int labelled = 0, pseudo = 0;
@@ -57,18 +59,19 @@ void TrainingReport::started(const io::Scene& scene, const gaussians::TrainConfi
     out << "semantic supervision: " << labelled << " labelled views, "
         << (config.use_pseudo_labels ? pseudo : 0) << " pseudo-labelled views"
         << (pseudo == 0 ? " (run `sadsplat pseudo-labels` on the scene cache to add them)" : "")
-        << "; drop " << config.drop << " with confidence maps of "
+        << "; drop " << gaussians::choiceName(config.drop) << " with confidence maps of "
         << (pseudo > 0 ? "the pseudo-label backend + ground truth" : "the ground truth only")
         << "\n";
   }
-  if (config.device.rfind("cuda", 0) == 0) {
+  if (config.device == gaussians::TrainDevice::kCuda) {
     out << "device memory: " << gaussians::estimateTrainingMemory(scene, config).describe()
         << "\n";
   }
   if (!resume && gaussians::initialisesRandomly(config.init, scene.points.size())) {
     out << "initialisation: up to " << config.init_random_count
         << " random points in the training cameras' common view"
-        << (config.init == "random" ? "" : " (the scene has no sparse points)") << "\n";
+        << (config.init == gaussians::InitMode::kRandom ? "" : " (the scene has no sparse points)")
+        << "\n";
   }
 }
 
@@ -135,8 +138,9 @@ void TrainingReport::events(const gaussians::StepStats& stats,
   if (stats.dropped > 0) {
     const gaussians::DropDecision& d = stats.drop;
     out << "\n[drop] iteration " << it << ": removed " << stats.dropped << " Gaussians ("
-        << config.drop << " " << config.drop_rule << ", P_base " << config.p_base
-        << (config.drop_rule == "balanced"
+        << gaussians::choiceName(config.drop) << " " << gaussians::choiceName(config.drop_rule)
+        << ", P_base " << config.p_base
+        << (config.drop_rule == gaussians::DropRule::kBalanced
                 ? ", pressure " + std::to_string(stats.drop_pressure).substr(0, 6)
                 : std::string())
         << "), " << stats.num_gaussians << " left; of the removed: " << d.removed_low_confidence

@@ -26,7 +26,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
         densification_(c),
         semantic_(semantic),
         structure_(structure),
-        balanced_(gaussians::balancedDropRule(c)),
+        balanced_(c.drop_rule == gaussians::DropRule::kBalanced),
         hc_(hc) {}
 
   void addL0Force(at::Tensor& grad, const at::Tensor& log_alpha, const at::Tensor& opacity_grad,
@@ -204,11 +204,11 @@ std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(
   // The guard needs the opacity resets, so the densification keys whose -1 derives from the
   // iterations are resolved (as the trainer resolves them; resolving twice changes nothing).
   const gaussians::TrainConfig c = gaussians::resolveDerivedKeys(config);
-  if (c.drop == "none") return nullptr;
-  if (c.drop == "semantic") return std::make_shared<SemanticDropStrategy>(c, true, false, hc);
-  if (c.drop == "structure") return std::make_shared<SemanticDropStrategy>(c, false, true, hc);
-  if (c.drop == "full") return std::make_shared<SemanticDropStrategy>(c, true, true, hc);
-  throw Error("<config>", "drop", "none, semantic, structure or full", c.drop);
+  using gaussians::DropMode;
+  if (c.drop == DropMode::kNone) return nullptr;
+  const bool semantic = c.drop == DropMode::kSemantic || c.drop == DropMode::kFull;
+  const bool structure = c.drop == DropMode::kStructure || c.drop == DropMode::kFull;
+  return std::make_shared<SemanticDropStrategy>(c, semantic, structure, hc);
 }
 
 }  // namespace semantic_drop

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sadsplat/common/gaussian_point.h"
+#include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/scene.h"
 
 namespace sadsplat {
@@ -40,10 +41,10 @@ pcl::PointCloud<GaussianPoint> initialCloud(const std::vector<io::ScenePoint>& p
 std::vector<io::ScenePoint> randomPointsInView(const std::vector<io::PinholeCamera>& cameras,
                                                int count, std::uint64_t seed);
 
-/// \brief How a training is initialised: "points" (the scene's sparse points), "random"
-/// (randomPointsInView) or "auto" (the points when there are at least 4, else random).
-/// \throws sadsplat::Error for another value, or "points" with fewer than 4 points
-bool initialisesRandomly(const std::string& init, std::size_t num_points);
+/// \brief How a training is initialised: points (the scene's sparse points), random
+/// (randomPointsInView) or auto (the points when there are at least 4, else random).
+/// \throws sadsplat::Error for points with fewer than 4 points
+bool initialisesRandomly(InitMode init, std::size_t num_points);
 
 /// \brief SH DC coefficient that renders `rgb` (0..1) at degree 0: (rgb - 0.5) / C0.
 float rgbToShDc(float rgb);

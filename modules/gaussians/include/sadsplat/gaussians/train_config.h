@@ -4,12 +4,35 @@
 /// the JSON reader builds without it).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace sadsplat {
 namespace gaussians {
+
+/// \brief The training options that choose among named values, as enums: their names (JSON,
+/// flags, logs) are choiceNames', read and written only by the option table (train_options.h).
+enum class DropMode { kNone, kSemantic, kStructure, kFull };  ///< none|semantic|structure|full
+enum class DropRule { kBalanced, kPaper };                     ///< balanced|paper
+enum class InitMode { kAuto, kPoints, kRandom };               ///< auto|points|random
+enum class TrainDevice { kCpu, kCuda };                        ///< cpu|cuda
+
+/// \brief The names of a choice's values, in the enum's order (the argument picks the enum).
+const std::vector<std::string>& choiceNames(DropMode);
+const std::vector<std::string>& choiceNames(DropRule);
+const std::vector<std::string>& choiceNames(InitMode);
+const std::vector<std::string>& choiceNames(TrainDevice);
+/// \brief The name of a value ("full", "balanced", "cuda").
+template <typename Choice>
+const std::string& choiceName(Choice value) {
+  return choiceNames(value)[static_cast<std::size_t>(value)];
+}
+/// \brief The value called `name` (DropMode, DropRule, InitMode or TrainDevice).
+/// \throws sadsplat::Error naming `origin` and `key`, with the names, for another name
+template <typename Choice>
+Choice parseChoice(const std::string& name, const std::string& origin, const std::string& key);
 
 /// \brief The length of the run and the intervals that are not a strategy's own (SH degree, views
 /// per step, checkpoints, the random seed).
@@ -112,7 +135,7 @@ struct DensificationOptions {
 /// \brief The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these,
 /// the strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
 struct DropOptions {
-  std::string drop = "none";  ///< none | semantic | structure | full
+  DropMode drop = DropMode::kNone;
   double p_base = 1.0;        ///< paper: P_base = 1.0
   int drop_interval = 500;    ///< paper: every N = 500 iterations
   /// Weight of L_L0. 0.2 was chosen on city seed 1 (0.1 / 0.2 / 0.4) for >= 5x fewer Gaussians
@@ -154,7 +177,7 @@ struct DropOptions {
   /// of those seen (0.5 when there are no maps).
   /// "paper": L_L0 = lambda_l0 x mean P_nonzero in the loss, P_drop = P_base (1 - P_conf) P_learned
   /// with P_conf = 0 where no map sees a Gaussian, no cap, no guard.
-  std::string drop_rule = "balanced";
+  DropRule drop_rule = DropRule::kBalanced;
   double l0_strength = 1.0;
   double drop_max_fraction = 0.15;
   double drop_guard = 0.05;
@@ -164,10 +187,6 @@ struct DropOptions {
   /// (semantic_drop::sampleGate) — so that a closed gate the views need can open again.
   bool closed_gate_gradients = false;
 };
-
-/// \brief Whether `options` ask for the balanced drop rule (drop_rule "balanced"), not the
-/// paper's.
-bool balancedDropRule(const DropOptions& options);
 
 /// \brief Every training parameter, with the defaults of the paper / 3DGS, in groups that the
 /// trainer's parts receive alone (the densification its DensificationOptions, the drop its
@@ -185,13 +204,13 @@ struct TrainConfig : ScheduleOptions,
   /// again when one was short (gaussians/tile_list_capacity.h): the host does not wait for the
   /// GPU once per render. The same values; 0: lists sized by each render's count (waiting).
   double tile_list_margin = 1.25;
-  /// Initial Gaussians (gaussians/initialization.h): "auto" = the scene's sparse points, or
+  /// Initial Gaussians (gaussians/initialization.h): auto = the scene's sparse points, or
   /// init_random_count random points in the cameras' common view when it has fewer than 4;
-  /// "points"; "random".
-  std::string init = "auto";
+  /// points; random.
+  InitMode init = InitMode::kAuto;
   int init_random_count = 100000;  ///< 3DGS's random initialisation of synthetic scenes
   std::array<float, 3> background{0, 0, 0};
-  std::string device = "cpu";  ///< "cpu" or "cuda"
+  TrainDevice device = TrainDevice::kCpu;
   /// Keep the training views in host memory in their 8-bit form and upload each step's views to
   /// the device when it renders them (device memory: the model and a step's views, not every
   /// view as floats); the same values as views held on the device.

@@ -19,22 +19,23 @@ namespace gaussians {
 
 /// \brief One option: where it lives in TrainConfig and what it accepts.
 struct TrainOption {
-  using Member = std::variant<int TrainConfig::*, double TrainConfig::*, bool TrainConfig::*,
-                              std::string TrainConfig::*, std::uint64_t TrainConfig::*,
-                              std::array<float, 3> TrainConfig::*>;
+  using Member =
+      std::variant<int TrainConfig::*, double TrainConfig::*, bool TrainConfig::*,
+                   std::uint64_t TrainConfig::*, std::array<float, 3> TrainConfig::*,
+                   DropMode TrainConfig::*, DropRule TrainConfig::*, InitMode TrainConfig::*,
+                   TrainDevice TrainConfig::*>;
   const char* key;   ///< JSON key (snake_case)
   Member member;     ///< the TrainConfig field
   const char* help;  ///< one line for --help and the docs; no measured results here
   const char* flag = nullptr;  ///< `sadsplat train` flag ("--lambda-l0"), nullptr: JSON only
   double min = -std::numeric_limits<double>::infinity();  ///< numbers: smallest accepted
   double max = std::numeric_limits<double>::infinity();   ///< numbers: largest accepted
-  const char* choices = nullptr;  ///< strings: accepted values, "|"-separated
 };
 
 /// \brief Every training option, in documentation order.
 const std::vector<TrainOption>& trainOptions();
 
-/// \brief The accepted values of a string option (empty: any).
+/// \brief The accepted names of a choice (an enum option; empty for the others).
 std::vector<std::string> optionChoices(const TrainOption& option);
 
 /// \brief The option's value in `config` as text ("0.2", "true", "cpu", "[0, 0, 0]").

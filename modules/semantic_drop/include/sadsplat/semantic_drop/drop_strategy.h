@@ -29,7 +29,7 @@ double scheduledL0Weight(double lambda, int from, int ramp, int iteration);
 /// none. "semantic" uses only P_conf, "structure" only the gates (P_learned and L0), "full" both.
 /// Until pseudo-label confidence maps exist, P_conf comes from one-hot maps of the labelled
 /// views, so a Gaussian seen in none of them has P_conf = 0.
-/// \throws sadsplat::Error on an unknown mode or a negative P_base / interval / L0 schedule
+/// \throws sadsplat::Error on a negative P_base / interval / L0 schedule
 std::shared_ptr<const gaussians::DropStrategy> makeDropStrategy(
     const gaussians::TrainConfig& config, const HardConcreteParams& hc = {});
 
