@@ -107,7 +107,7 @@ class TrainCommand : public Command {
       // A value outside the table's range or choices is a usage error (exit 2) here already.
       if (!gaussians::optionChoices(o).empty()) {
         flag->check(CLI::IsMember(gaussians::optionChoices(o)));
-      } else if (!std::holds_alternative<std::string gaussians::TrainConfig::*>(o.member)) {
+      } else {
         const bool real = std::holds_alternative<double gaussians::TrainConfig::*>(o.member);
         flag->type_name(real ? "FLOAT" : "INT");
         if (std::isfinite(o.min) || std::isfinite(o.max)) {

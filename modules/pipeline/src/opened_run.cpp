@@ -74,7 +74,7 @@ std::string evalRun(const std::string& run_dir, const std::string& scene_overrid
   facts.num_gaussians = run.trainer->numGaussians();
   facts.iterations = run.trainer->iteration();
   facts.train_seconds = run.train_seconds;
-  facts.device = run.config.device;
+  facts.device = gaussians::choiceName(run.config.device);
   const std::string text = eval::metricsJson(result, run.scene.classes, facts);
   io::writeTextFileAtomically(dir.metrics(), text);
   return text;
