@@ -211,7 +211,6 @@ class TrainCommand : public Command {
       blocks.max_device_bytes = static_cast<std::int64_t>(max_gpu_memory_gib_ * (1ll << 30));
       blocks.budget_config = gaussians::resolveSchedule(config, options.schedule).config;
     }
-    blocks.pixels_on_disk = config.stream_views;
     blocks.rank = rank_env ? rank_env->rank : 0;
     blocks.ranks = rank_env ? rank_env->world_size : 1;
     blocks.wait_for_ranks = !local_ranks && blocks.ranks > 1;

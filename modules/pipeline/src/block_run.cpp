@@ -151,8 +151,9 @@ BlockRun::BlockRun(TrainRunOptions options, BlockRunOptions blocks)
     : options_(std::move(options)), blocks_(std::move(blocks)) {
   if (blocks_.ranks < 1 || blocks_.rank < 0 || blocks_.rank >= blocks_.ranks)
     throw Error("<block run>", "rank", "0 .. ranks - 1", std::to_string(blocks_.rank));
-  scene_ = loadScene(options_.scene, options_.scale, options_.progress,
-                     blocks_.pixels_on_disk ? ScenePixels::kLeftOnDisk : ScenePixels::kRead);
+  // Each block's training reads its views from a scene cache (see trainRun): the scene's pixels
+  // are never all in host memory.
+  scene_ = loadScene(options_.scene, options_.scale, options_.progress, ScenePixels::kLeftOnDisk);
   if (blocks_.partition.blocks == 0 && blocks_.max_device_bytes <= 0)
     throw Error("<block run>", "max_device_bytes", "a memory budget with blocks = 0 (auto)",
                 std::to_string(blocks_.max_device_bytes));

@@ -27,7 +27,7 @@ io::Scene loadScene(const std::string& path, double scale, std::ostream* progres
   }
   if (pixels == ScenePixels::kLeftOnDisk) {
     if (progress != nullptr)
-      *progress << "views read from " << path << " as the training needs them (--stream-views)\n";
+      *progress << "views read from " << path << " one at a time as the training needs them\n";
     return io::readSceneCacheWithoutPixels(path);
   }
   return io::readSceneCache(path);

@@ -181,9 +181,9 @@ TrainingInterrupted::TrainingInterrupted(const std::string& run, int iteration)
       iteration_(iteration) {}
 
 double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config) {
-  return trainRun(o, config,
-                  loadScene(o.scene, o.scale, o.progress,
-                            config.stream_views ? ScenePixels::kLeftOnDisk : ScenePixels::kRead));
+  // The views' pixels stay in a scene cache: the trainer reads each view from the file, holds
+  // it on the device or (stream_views) reads it again for each step that uses it.
+  return trainRun(o, config, loadScene(o.scene, o.scale, o.progress, ScenePixels::kLeftOnDisk));
 }
 
 void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,

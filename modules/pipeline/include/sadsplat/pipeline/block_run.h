@@ -30,9 +30,6 @@ struct BlockRunOptions {
   /// `budget_config` is at most this many bytes.
   std::int64_t max_device_bytes = 0;
   gaussians::TrainConfig budget_config;
-  /// Leave the views' pixels in the scene cache (--stream-views): each block's training reads
-  /// them as its steps need them (see loadScene).
-  bool pixels_on_disk = false;
 };
 
 /// \brief The partition with the fewest blocks whose every block's estimated training memory

@@ -17,7 +17,8 @@ namespace pipeline {
 enum class ScenePixels {
   kRead,        ///< read them all into host memory
   kLeftOnDisk,  ///< leave them in the file (io::readSceneCacheWithoutPixels): the training reads
-                ///< each view as its steps need it; a scene directory is imported whole anyway
+                ///< each view from it (trainRun and BlockRun always do); a scene directory is
+                ///< imported whole anyway
 };
 
 /// \brief Loads a scene directory (imported at `scale`, needs OpenCV; said on `progress` when
