@@ -139,7 +139,7 @@ geo::BlockPartition partitionForMemory(const io::Scene& scene, geo::BlockOptions
   }
   std::string hint = "";
   if (!config.stream_views && smallest.views > smallest.gaussians)
-    hint = "; its views are most of it: --stream-views keeps them in host memory";
+    hint = "; its views are most of it: --stream-views keeps them off the device";
   throw Error(origin, "--max-gpu-memory",
               "a budget that " + std::to_string(first) + " to " + std::to_string(last) +
                   " blocks fit (the smallest largest block: " + gibText(smallest.total()) + hint +
