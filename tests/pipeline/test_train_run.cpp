@@ -10,8 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sadsplat/eval/evaluation.h"
 #include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/schedule.h"
+#include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_cache.h"
@@ -173,6 +175,35 @@ void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
 }
 
 TEST(StreamedViews, TrainLikeHeldViewsOnTheCpu) { expectStreamedViewsTrainLikeHeldViews("cpu"); }
+
+// eval reads the test views from the scene cache one at a time: the same scores as with the
+// whole cache in memory.
+TEST(StreamedViews, EvaluationReadsTheTestViewsOneAtATimeWithTheSameScores) {
+  test::TempDir dir;
+  TrainConfig config;
+  config.iterations = 10;
+  config.checkpoint_interval = 0;
+  pipeline::TrainRunOptions o;
+  o.scene = kCache;
+  o.out = dir.file("run");
+  pipeline::trainRun(o, config);
+  const io::Scene whole = io::readSceneCache(kCache);
+  const io::Scene on_disk = io::readSceneCacheWithoutPixels(kCache);
+  gaussians::Trainer trainer(whole, config);
+  trainer.loadCheckpoint(dir.file("run/checkpoint.bin"));
+  const eval::EvalResult a = eval::evaluate(trainer, whole, "");
+  const eval::EvalResult b = eval::evaluate(trainer, on_disk, "");
+  ASSERT_EQ(a.per_view.size(), b.per_view.size());
+  ASSERT_GT(a.labelled_views, 0);
+  EXPECT_EQ(a.labelled_views, b.labelled_views);
+  for (std::size_t i = 0; i < a.per_view.size(); ++i) {
+    EXPECT_EQ(a.per_view[i].psnr, b.per_view[i].psnr) << a.views[i];
+    EXPECT_EQ(a.per_view[i].ssim, b.per_view[i].ssim) << a.views[i];
+  }
+  EXPECT_EQ(a.confusion.total(), b.confusion.total());
+  EXPECT_EQ(a.confusion.overallAccuracy(), b.confusion.overallAccuracy());
+  EXPECT_EQ(a.psnr_covered, b.psnr_covered);
+}
 
 TEST(StreamedViews, TrainLikeHeldViewsOnAGpu) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";

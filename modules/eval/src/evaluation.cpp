@@ -10,6 +10,7 @@
 #include "sadsplat/gaussians/image_metrics.h"
 #include "sadsplat/gaussians/view_coverage.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/scene_cache.h"
 
 #if SADSPLAT_HAVE_OPENCV
 #include <opencv2/imgcodecs.hpp>
@@ -145,8 +146,12 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   const at::Tensor points = sparsePoints(scene);
   result.covered_depth = "sparse points";
   const bool semantic = !scene.classes.empty();
-  for (const io::View& view : scene.views) {
-    if (any_test && !view.test) continue;
+  for (const io::View& listed : scene.views) {
+    if (any_test && !listed.test) continue;
+    // A view whose pixels wait in the scene cache is read now: one view in memory at a time.
+    io::View read;
+    if (listed.pixels_in_cache) read = io::readViewPixels(listed);
+    const io::View& view = listed.pixels_in_cache ? read : listed;
     const gaussians::RenderResult r = trainer.renderView(view);
     {
       // Render time: r was the warm-up; reading a value back waits for the device.

@@ -33,7 +33,8 @@ io::Scene loadScene(const std::string& path, double scale, std::ostream* progres
   return io::readSceneCache(path);
 }
 
-OpenedRun openRun(const std::string& run_dir, const std::string& scene_override, double scale) {
+OpenedRun openRun(const std::string& run_dir, const std::string& scene_override, double scale,
+                  ScenePixels pixels) {
   const io::RunDirectory dir(run_dir);
   const io::RunRecord record = dir.readRecord(/*scene_required=*/scene_override.empty());
   OpenedRun o;
@@ -42,7 +43,7 @@ OpenedRun openRun(const std::string& run_dir, const std::string& scene_override,
   o.scale = scene_override.empty() ? record.scale : scale;
   o.train_seconds = record.train_seconds;
   o.config = gaussians::TrainConfig::fromJson(io::readWholeFile(dir.config()), dir.config());
-  o.scene = loadScene(o.scene_path, o.scale);
+  o.scene = loadScene(o.scene_path, o.scale, nullptr, pixels);
   o.trainer = std::make_unique<gaussians::Trainer>(o.scene, o.config);
   o.trainer->setDropStrategy(semantic_drop::makeDropStrategy(o.config));
   o.trainer->loadCheckpoint(dir.checkpoint());
@@ -66,7 +67,8 @@ std::string sceneDirectoryOf(const OpenedRun& run) {
 }
 
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
-  const OpenedRun run = openRun(run_dir, scene_override, scale);
+  // The views are read from a scene cache one at a time (the trainer's, then each test view).
+  const OpenedRun run = openRun(run_dir, scene_override, scale, ScenePixels::kLeftOnDisk);
   const io::RunDirectory dir(run_dir);
   io::makeDirectory(dir.panels());
   const eval::EvalResult result = eval::evaluate(*run.trainer, run.scene, dir.panels());

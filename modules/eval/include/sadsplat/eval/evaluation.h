@@ -67,8 +67,9 @@ struct EvalResult {
 /// PSNR / SSIM on all of them, the confusion matrix on those with a label map (none: the class
 /// metrics are null and EvalResult::miou_note says why). If `panel_dir` is not empty and the build
 /// has OpenCV, writes one PNG per view there: image | render | ground truth | prediction | error
-/// mask (image | render without classes).
-/// \throws sadsplat::Error if the scene has no view
+/// mask (image | render without classes). Views whose pixels wait in a scene cache
+/// (io::readSceneCacheWithoutPixels) are read one at a time.
+/// \throws sadsplat::Error if the scene has no view, or a view's pixels cannot be read
 EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
                     const std::string& panel_dir = "");
 

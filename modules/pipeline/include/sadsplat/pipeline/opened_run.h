@@ -39,10 +39,11 @@ struct OpenedRun {
 };
 
 /// \brief Opens a run directory (run.json, config.json, checkpoint.bin) on its scene or on
-/// `scene_override`.
+/// `scene_override`; `pixels`: what happens to a scene cache's pixels (loadScene; the trainer
+/// reads its training views either way).
 /// \throws sadsplat::Error naming the run's file and field
 OpenedRun openRun(const std::string& run_dir, const std::string& scene_override = "",
-                  double scale = 0.5);
+                  double scale = 0.5, ScenePixels pixels = ScenePixels::kRead);
 
 /// \brief The scene directory a run's scene was imported from (its images/ hold the photos at
 /// their imported-from size), or "" when there is none: the run's scene itself, or a cache's
