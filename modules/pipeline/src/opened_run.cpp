@@ -68,7 +68,7 @@ std::string sceneDirectoryOf(const OpenedRun& run) {
 
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
   // The views are read from a scene cache one at a time (the trainer's, then each test view).
-  const OpenedRun run = openRun(run_dir, scene_override, scale, ScenePixels::kLeftOnDisk);
+  const OpenedRun run = openRun(run_dir, scene_override, scale);
   const io::RunDirectory dir(run_dir);
   io::makeDirectory(dir.panels());
   const eval::EvalResult result = eval::evaluate(*run.trainer, run.scene, dir.panels());
