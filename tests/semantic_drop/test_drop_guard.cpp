@@ -61,6 +61,11 @@ TEST(DropGuard, ReadsBeforeEachDropEventOfTheBalancedRuleOnly) {
   TrainConfig paper = c;
   paper.drop_rule = gaussians::DropRule::kPaper;
   EXPECT_FALSE(Guarded(paper).readsBefore(500));
+  Guarded unguarded(paper);  // the paper's rule has no guard: readings change nothing
+  unguarded.observe(500, 1.0);
+  unguarded.observe(1000, 9.0);
+  EXPECT_EQ(unguarded.pressure(), 1.0);
+  EXPECT_LT(unguarded.guard.lowest, 0);
 }
 
 TEST(DropGuard, HalvesThePressureWhileTheErrorStaysAboveItsLowestByMoreThanTheMargin) {

@@ -59,7 +59,7 @@ class SemanticDropStrategy : public gaussians::DropStrategy {
 
   void observeGuardReading(gaussians::DropGuard& guard, int done,
                            double probe_mse) const override {
-    if (!std::isfinite(probe_mse)) return;
+    if (!balanced_ || !std::isfinite(probe_mse)) return;  // the paper's rule has no guard
     // The reference is the lowest reading since the last opacity reset (a reset raises the error
     // by itself): a drop whose cost the training has not won back by the next event halves the
     // pressure again.
