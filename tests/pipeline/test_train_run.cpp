@@ -18,6 +18,7 @@
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/train_log.h"
+#include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/train_run.h"
 #include "test_support/test_support.h"
@@ -175,6 +176,29 @@ void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
 }
 
 TEST(StreamedViews, TrainLikeHeldViewsOnTheCpu) { expectStreamedViewsTrainLikeHeldViews("cpu"); }
+
+// A run opened for rendering (pipeline::openRun) holds only the cameras: it renders what a
+// trainer that holds the views renders, and refuses to train.
+TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrain) {
+  test::TempDir dir;
+  TrainConfig config;
+  config.iterations = 10;
+  config.checkpoint_interval = 0;
+  pipeline::TrainRunOptions o;
+  o.scene = kCache;
+  o.out = dir.file("run");
+  pipeline::trainRun(o, config);
+  const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
+  const pipeline::OpenedRun loaded =
+      pipeline::openRun(dir.file("run"), "", 0.5, pipeline::ScenePixels::kRead,
+                        gaussians::TrainerViews::kLoaded);
+  for (const io::View& v : run.scene.views) {
+    EXPECT_TRUE(run.trainer->renderView(v).rgb.equal(loaded.trainer->renderView(v).rgb))
+        << v.name;
+  }
+  EXPECT_THROW(run.trainer->step(), sadsplat::Error);
+  EXPECT_NO_THROW(loaded.trainer->step());
+}
 
 // eval reads the test views from the scene cache one at a time: the same scores as with the
 // whole cache in memory.

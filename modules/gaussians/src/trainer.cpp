@@ -306,7 +306,8 @@ void Trainer::State::readLossValues(const StepPass& pass, StepStats& stats) cons
   stats.loss = value[0];
 }
 
-Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new State(config)) {
+Trainer::Trainer(const io::Scene& scene, const TrainConfig& config, TrainerViews views)
+    : state_(new State(config)) {
   State& s = *state_;
   config.check();
   s.device = deviceNamed(choiceName(config.device), "<config>");
@@ -321,7 +322,8 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config) : state_(new
   s.num_classes = static_cast<int>(scene.classes.size());
   // A scene without classes trains plain 3DGS: no features, no decoder rows, no semantic loss.
   if (s.num_classes == 0) s.config.feature_dim = 0;
-  s.views = loadTrainingViews(scene, s.config, s.device);
+  s.views = views == TrainerViews::kLoaded ? loadTrainingViews(scene, s.config, s.device)
+                                           : cameraViews(scene, s.device);
   s.extent = sceneExtent(s.views.cameras);
 
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
@@ -380,6 +382,10 @@ GaussianParams Trainer::parameters() const { return state_->params.gaussians(); 
 
 StepStats Trainer::step(bool read_losses) {
   State& s = *state_;
+  if (s.views.cameras_only) {
+    throw Error("<trainer>", "views", "a trainer made with its training views (kLoaded)",
+                "cameras only (made for rendering)");
+  }
   const TrainConfig& c = s.config;
   const int it = s.iteration;
   StepProfile* profile = s.profile.get();

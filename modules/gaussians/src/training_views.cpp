@@ -162,6 +162,28 @@ int loaderThreads() {
 
 }  // namespace
 
+TrainingViews cameraViews(const io::Scene& scene, const at::Device& device) {
+  TrainingViews s;
+  s.device = device;
+  s.cameras_only = true;
+  const std::size_t n = scene.views.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    s.cameras.push_back(RasterCamera::fromPinhole(scene.views[i].camera));
+    if (scene.views[i].train) s.train_views.push_back(static_cast<int>(i));
+  }
+  s.images.resize(n);
+  s.masks.resize(n);
+  s.mask_is_full.assign(n, 0);
+  s.labels.resize(n);
+  s.supervised.assign(n, 0);
+  s.semantic_weight.assign(n, 0.0);
+  s.confidence_maps.resize(n);
+  if (s.train_views.empty()) {
+    throw Error(scene.source, "split", "at least one training view", "none");
+  }
+  return s;
+}
+
 TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& config,
                                 const at::Device& device) {
   TrainingViews s;

@@ -41,6 +41,8 @@ struct TrainingViews {
   // from a scene read without pixels (io::readSceneCacheWithoutPixels): `loader` reads them from
   // the cache ahead of the steps (prefetch) and images / masks / labels stay undefined.
   bool streamed = false;
+  // Only the cameras (cameraViews): a trainer that renders a trained model, never trains.
+  bool cameras_only = false;
   std::shared_ptr<ViewLoader> loader;
   int prefetched_until = -1;  // the last step whose views the loader was asked for
   at::Device device{at::kCPU};
@@ -82,6 +84,11 @@ struct StepViews {
 // `in_group`: also say what the whole group's views train (a group of one included).
 StepViews drawStepViews(const TrainingViews& views, const TrainConfig& config, int it, int rank,
                         int ranks, bool in_group);
+
+/// The cameras of `scene`'s views and which views train, no picture read: for a trainer that
+/// only renders (TrainerViews::kCamerasOnly).
+/// \throws sadsplat::Error when the scene has no training view
+TrainingViews cameraViews(const io::Scene& scene, const at::Device& device);
 
 /// Loads the views of `scene` onto `device`.
 /// \throws sadsplat::Error when the scene has no training view

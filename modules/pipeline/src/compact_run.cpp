@@ -39,7 +39,10 @@ std::string compactRun(const std::string& run_dir, const std::string& out_dir,
   if (std::filesystem::equivalent(out_dir, run_dir, same_error)) {
     throw Error(out_dir, "--out", "another directory than the run", "the run itself");
   }
-  OpenedRun run = openRun(run_dir);
+  // Refining trains: the trainer then reads its training views.
+  OpenedRun run = openRun(run_dir, "", 0.5, ScenePixels::kLeftOnDisk,
+                          o.refine > 0 ? gaussians::TrainerViews::kLoaded
+                                       : gaussians::TrainerViews::kCamerasOnly);
   pcl::PointCloud<GaussianPoint> model = run.trainer->toCloud();
   const at::Tensor opacity = run.trainer->effectiveOpacity().to(at::kFloat).contiguous();
   const float* a = opacity.data_ptr<float>();

@@ -34,7 +34,7 @@ io::Scene loadScene(const std::string& path, double scale, std::ostream* progres
 }
 
 OpenedRun openRun(const std::string& run_dir, const std::string& scene_override, double scale,
-                  ScenePixels pixels) {
+                  ScenePixels pixels, gaussians::TrainerViews views) {
   const io::RunDirectory dir(run_dir);
   const io::RunRecord record = dir.readRecord(/*scene_required=*/scene_override.empty());
   OpenedRun o;
@@ -44,7 +44,7 @@ OpenedRun openRun(const std::string& run_dir, const std::string& scene_override,
   o.train_seconds = record.train_seconds;
   o.config = gaussians::TrainConfig::fromJson(io::readWholeFile(dir.config()), dir.config());
   o.scene = loadScene(o.scene_path, o.scale, nullptr, pixels);
-  o.trainer = std::make_unique<gaussians::Trainer>(o.scene, o.config);
+  o.trainer = std::make_unique<gaussians::Trainer>(o.scene, o.config, views);
   o.trainer->setDropStrategy(semantic_drop::makeDropStrategy(o.config));
   o.trainer->loadCheckpoint(dir.checkpoint());
   return o;
@@ -67,7 +67,7 @@ std::string sceneDirectoryOf(const OpenedRun& run) {
 }
 
 std::string evalRun(const std::string& run_dir, const std::string& scene_override, double scale) {
-  // The views are read from a scene cache one at a time (the trainer's, then each test view).
+  // The test views are read from a scene cache one at a time; the trainer holds only cameras.
   const OpenedRun run = openRun(run_dir, scene_override, scale);
   const io::RunDirectory dir(run_dir);
   io::makeDirectory(dir.panels());

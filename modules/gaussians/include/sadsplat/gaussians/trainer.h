@@ -52,6 +52,10 @@ struct StepStats {
   bool rendered_again = false;
 };
 
+/// \brief What a Trainer holds of its scene's views: everything a training needs, or only the
+/// cameras (a trainer that renders a trained model).
+enum class TrainerViews { kLoaded, kCamerasOnly };
+
 /// \brief Trains Gaussians on a scene.
 ///
 /// Randomness (view order, split samples, feature initialisation) is derived from the seed and
@@ -60,8 +64,12 @@ class Trainer {
  public:
   /// \param[in] scene an imported scene with sparse points and at least one training view
   /// \param[in] config the configuration (validated)
+  /// \param[in] views kLoaded: the training views are read and held (or streamed) for step();
+  /// kCamerasOnly: only the cameras, for rendering a trained model (loadCheckpoint): no view's
+  /// pixels read or held, and step() is an error
   /// \throws sadsplat::Error on an unusable scene or configuration
-  Trainer(const io::Scene& scene, const TrainConfig& config);
+  Trainer(const io::Scene& scene, const TrainConfig& config,
+          TrainerViews views = TrainerViews::kLoaded);
   ~Trainer();
   Trainer(const Trainer&) = delete;
   Trainer& operator=(const Trainer&) = delete;

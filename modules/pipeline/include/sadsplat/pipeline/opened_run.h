@@ -41,11 +41,13 @@ struct OpenedRun {
 /// \brief Opens a run directory (run.json, config.json, checkpoint.bin) on its scene or on
 /// `scene_override`. `pixels`: what happens to a scene cache's pixels (loadScene); by default
 /// they stay in the file (the commands that open a run render the model, and evaluation reads
-/// each test view when it scores it), so a survey's photos are never all in host memory. The
-/// trainer reads its training views either way.
+/// each test view when it scores it), so a survey's photos are never all in host memory.
+/// `views`: the trainer holds only the cameras (it renders; step() is an error), or
+/// (kLoaded) reads its training views to train on.
 /// \throws sadsplat::Error naming the run's file and field
 OpenedRun openRun(const std::string& run_dir, const std::string& scene_override = "",
-                  double scale = 0.5, ScenePixels pixels = ScenePixels::kLeftOnDisk);
+                  double scale = 0.5, ScenePixels pixels = ScenePixels::kLeftOnDisk,
+                  gaussians::TrainerViews views = gaussians::TrainerViews::kCamerasOnly);
 
 /// \brief The scene directory a run's scene was imported from (its images/ hold the photos at
 /// their imported-from size), or "" when there is none: the run's scene itself, or a cache's
