@@ -177,17 +177,23 @@ void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
 
 TEST(StreamedViews, TrainLikeHeldViewsOnTheCpu) { expectStreamedViewsTrainLikeHeldViews("cpu"); }
 
-// A run opened for rendering (pipeline::openRun) holds only the cameras: it renders what a
-// trainer that holds the views renders, and refuses to train.
-TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrain) {
-  test::TempDir dir;
+// A 10-iteration training of the fixture cache into `out`; returns its configuration.
+TrainConfig trainTinyRun(const std::string& out) {
   TrainConfig config;
   config.iterations = 10;
   config.checkpoint_interval = 0;
   pipeline::TrainRunOptions o;
   o.scene = kCache;
-  o.out = dir.file("run");
+  o.out = out;
   pipeline::trainRun(o, config);
+  return config;
+}
+
+// A run opened for rendering (pipeline::openRun) holds only the cameras: it renders what a
+// trainer that holds the views renders, and refuses to train.
+TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrain) {
+  test::TempDir dir;
+  trainTinyRun(dir.file("run"));
   const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
   const pipeline::OpenedRun loaded =
       pipeline::openRun(dir.file("run"), "", 0.5, pipeline::ScenePixels::kRead,
@@ -204,13 +210,7 @@ TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrai
 // whole cache in memory.
 TEST(StreamedViews, EvaluationReadsTheTestViewsOneAtATimeWithTheSameScores) {
   test::TempDir dir;
-  TrainConfig config;
-  config.iterations = 10;
-  config.checkpoint_interval = 0;
-  pipeline::TrainRunOptions o;
-  o.scene = kCache;
-  o.out = dir.file("run");
-  pipeline::trainRun(o, config);
+  const TrainConfig config = trainTinyRun(dir.file("run"));
   const io::Scene whole = io::readSceneCache(kCache);
   const io::Scene on_disk = io::readSceneCacheWithoutPixels(kCache);
   gaussians::Trainer trainer(whole, config);
