@@ -76,6 +76,68 @@ TEST(Contribution, SumsOverTheViewsAndAppliesTheGate) {
   EXPECT_GT(gated[1].item<double>(), a[1].item<double>());
 }
 
+// Alone, a Gaussian's blending weight at a pixel is the rendered alpha there: its weighted sum of
+// any per-pixel values is sum_p alpha(p) values(p, k), computed here from the alpha image.
+TEST(WeightedPixelSums, AreTheAlphaWeightedSumsOfTheValuesForOneGaussian) {
+  const GaussianParams one = gaussiansAt({0.2f, -0.1f, 6});
+  const RasterCamera c = camera();
+  gaussians::RenderSettings s;
+  s.sh_degree = 0;
+  s.features = false;
+  s.depth = false;
+  const at::Tensor alpha = gaussians::render(one, c, s).alpha.to(at::kDouble);
+  // Three channels: 1, the column index, a step that is 1 on the left half only.
+  const at::Tensor column =
+      at::arange(c.width, at::kDouble).view({1, c.width}).expand({c.height, c.width});
+  const at::Tensor left = (column < c.width / 2).to(at::kDouble);
+  const at::Tensor values = at::stack({at::ones_like(column), column, left}, 2).to(at::kFloat);
+  const at::Tensor sums = gaussians::weightedPixelSums(one, c, values).to(at::kDouble);
+  ASSERT_EQ(sums.sizes(), (at::IntArrayRef{1, 3}));
+  for (int k = 0; k < 3; ++k) {
+    const double expected = (alpha * values.select(2, k).to(at::kDouble)).sum().item<double>();
+    EXPECT_NEAR(sums[0][k].item<double>(), expected, 1e-3 * std::abs(expected) + 1e-4) << k;
+  }
+  // The Gaussian sits right of the middle: more of its weight on the right half.
+  EXPECT_LT(sums[0][2].item<double>(), 0.5 * sums[0][0].item<double>());
+  EXPECT_THROW(gaussians::weightedPixelSums(one, c, values.narrow(0, 0, 10)), Error);
+}
+
+// Two Gaussians side by side, a class map that gives the left half class 0 and the right half
+// class 1, and a hidden third one behind the left: each visible Gaussian's weight goes mostly to
+// the class of its side; per camera the classes' weights add up to blendingWeightSums over the
+// labelled pixels; pixels without a class (-1 or >= the count) count for none.
+TEST(ClassWeightSums, GiveEachGaussianTheClassesOfThePixelsItDraws) {
+  const GaussianParams g = gaussiansAt({-1.5f, 0, 5, 1.5f, 0, 5, -1.5f, 0, 30});
+  const RasterCamera c = camera();
+  const at::Tensor column =
+      at::arange(c.width, at::kLong).view({1, c.width}).expand({c.height, c.width});
+  const at::Tensor halves = (column >= c.width / 2).to(at::kLong).contiguous();
+  const at::Tensor w = gaussians::classWeightSums(
+      g, {c}, [&](std::size_t) { return halves; }, 2);
+  ASSERT_EQ(w.sizes(), (at::IntArrayRef{3, 2}));
+  EXPECT_GT(w[0][0].item<double>(), 20 * w[0][1].item<double>());  // left Gaussian: class 0
+  EXPECT_GT(w[1][1].item<double>(), 20 * w[1][0].item<double>());  // right Gaussian: class 1
+  EXPECT_LT(w[2].sum().item<double>(), 0.05 * w[0].sum().item<double>());  // hidden behind
+  const at::Tensor total = gaussians::blendingWeightSums(g, {c});
+  EXPECT_TRUE(at::allclose(w.sum(1), total, 1e-4, 1e-3));
+  // No class on the right half: the right Gaussian keeps only what it draws on the left.
+  const at::Tensor left_only = at::where(halves == 1, at::full_like(halves, -1), halves);
+  const at::Tensor l = gaussians::classWeightSums(
+      g, {c, c},
+      [&](std::size_t k) {
+        return k == 0 ? left_only : at::full_like(halves, 7);  // camera 1: no pixel has a class
+      },
+      2);
+  EXPECT_NEAR(l[1][0].item<double>(), w[1][0].item<double>(), 1e-4);
+  EXPECT_EQ(l[1][1].item<double>(), 0.0);
+  EXPECT_THROW(gaussians::classWeightSums(
+                   g, {c}, [&](std::size_t) { return halves; }, 0),
+               Error);
+  EXPECT_THROW(gaussians::classWeightSums(
+                   g, {c}, [&](std::size_t) { return halves.t(); }, 2),
+               Error);
+}
+
 // The L0 term's weights, by hand: w = (1 + c / median c)^-gamma / mean.
 TEST(InverseContributionWeights, FallWithTheContributionAndAverageOne) {
   // Sorted [0, 1, 1, 3]: the median (lower middle value) is 1; gamma 1 gives 1, 1/2, 1/2, 1/4

@@ -18,6 +18,7 @@
 #include "sadsplat/io/gaussian_ply.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/train_log.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/train_run.h"
@@ -204,6 +205,60 @@ TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrai
   }
   EXPECT_THROW(run.trainer->step(), sadsplat::Error);
   EXPECT_NO_THROW(loaded.trainer->step());
+}
+
+// A run trained on a GPU (config.json: "device": "cuda") opens on a machine without one: the
+// model renders on the CPU, as the same run trained there does.
+TEST(OpenedRun, ARunTrainedOnAGpuOpensOnTheCpuOfAMachineWithoutOne) {
+  if (at::hasCUDA()) GTEST_SKIP() << "this machine has a CUDA device";
+  test::TempDir dir;
+  trainTinyRun(dir.file("run"));
+  const pipeline::OpenedRun cpu = pipeline::openRun(dir.file("run"));
+  std::string config = test::readFile(dir.file("run/config.json"));
+  const std::size_t at = config.find("\"device\": \"cpu\"");
+  ASSERT_NE(at, std::string::npos);
+  config.replace(at, 15, "\"device\": \"cuda\"");
+  io::writeTextFileAtomically(dir.file("run/config.json"), config);
+  const pipeline::OpenedRun gpu_run = pipeline::openRun(dir.file("run"));
+  EXPECT_EQ(gpu_run.config.device, gaussians::TrainDevice::kCpu);
+  const io::View& v = cpu.scene.views.front();
+  EXPECT_TRUE(gpu_run.trainer->renderView(v).rgb.equal(cpu.trainer->renderView(v).rgb));
+}
+
+// What a run hands out (model.ply, model_semantic, extract, eval --3d) labels each Gaussian by
+// the classes its training views render where it draws (pipeline/labelled_cloud.h): the class
+// with the largest blending weight; a Gaussian no training view draws keeps its feature's class;
+// nothing but the label changes, and model.ply holds these labels.
+TEST(LabelledCloud, EachGaussianTakesTheClassTheViewsRenderWhereItDraws) {
+  test::TempDir dir;
+  trainTinyRun(dir.file("run"));
+  const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
+  const auto labelled = pipeline::labelledCloud(*run.trainer, run.scene);
+  const auto own = run.trainer->toCloud();
+  std::vector<gaussians::RasterCamera> cameras;
+  for (const io::View& v : run.scene.views) {
+    if (v.train) cameras.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
+  }
+  const at::Tensor w = run.trainer->renderedClassWeights(cameras);
+  ASSERT_EQ(w.size(0), static_cast<std::int64_t>(labelled.size()));
+  ASSERT_EQ(w.size(1), run.trainer->numClasses());
+  const auto written = io::readGaussianPly(dir.file("run/model.ply"));
+  ASSERT_EQ(written.size(), labelled.size());
+  int seen = 0;
+  for (std::size_t i = 0; i < labelled.size(); ++i) {
+    const at::Tensor row = w[static_cast<std::int64_t>(i)];
+    if (row.sum().item<double>() > 0) {
+      ++seen;
+      EXPECT_EQ(labelled[i].label, static_cast<std::uint32_t>(row.argmax().item<std::int64_t>()))
+          << i;
+    } else {
+      EXPECT_EQ(labelled[i].label, own[i].label) << i;
+    }
+    EXPECT_EQ(labelled[i].x, own[i].x);
+    EXPECT_EQ(labelled[i].opacity, own[i].opacity);
+    EXPECT_EQ(written[i].label, labelled[i].label) << i;
+  }
+  EXPECT_GT(seen, static_cast<int>(labelled.size()) / 2);
 }
 
 // eval reads the test views from the scene cache one at a time: the same scores as with the

@@ -13,6 +13,7 @@
 
 #include "drop_state.h"
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/counter_random.h"
 #include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/device.h"
@@ -508,6 +509,16 @@ SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level, bo
   GaussianParams g = state_->evaluationGaussians();
   if (!features) g.features = at::Tensor();
   return renderSurfaceLayer(g, camera, level);
+}
+
+at::Tensor Trainer::renderedClassWeights(const std::vector<RasterCamera>& cameras) const {
+  if (numClasses() == 0) {
+    throw Error("<trainer>", "classes", "a semantic model to weigh classes", "none");
+  }
+  const auto class_map = [&](std::size_t k) { return predictClasses(renderCamera(cameras[k])); };
+  c10::AutoGradMode no_grad(false);
+  return classWeightSums(state_->evaluationGaussians(), cameras, class_map, numClasses())
+      .to(at::kCPU);
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }

@@ -5,10 +5,11 @@
 #include <cmath>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/common/gaussian_point.h"
 #include "sadsplat/eval/cloud_scores.h"
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/synth/aerial_benchmark.h"
 #include "truth_world.h"
@@ -26,6 +27,19 @@ nlohmann::json perClass(const std::vector<ClassInfo>& classes, const std::vector
     j[classes[c].name] = values[c] < 0 ? nlohmann::json(nullptr) : nlohmann::json(values[c]);
   }
   return j;
+}
+
+std::vector<eval::CloudPoint> cloudPoints(const pcl::PointCloud<GaussianPoint>& cloud,
+                                          int classes) {
+  std::vector<eval::CloudPoint> points(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    points[i].xyz = {cloud[i].x, cloud[i].y, cloud[i].z};
+    points[i].cls = cloud[i].label < static_cast<std::uint32_t>(classes)
+                        ? static_cast<int>(cloud[i].label)
+                        : -1;
+    points[i].opacity = 1.f / (1.f + std::exp(-cloud[i].opacity));
+  }
+  return points;
 }
 
 }  // namespace
@@ -50,17 +64,11 @@ std::string evalCloudRun(const std::string& run_dir) {
                 "a scene made by `sadsplat synth` (its world is the 3D truth)",
                 "\"" + run.scene.source.substr(0, 80) + "\"");
   }
-  // The cloud as PCL users take it: model_semantic's class per Gaussian.
-  const auto cloud = run.trainer->toCloud();
-  const auto semantic = toSemanticCloud(cloud, run.scene.classes);
-  std::vector<eval::CloudPoint> points(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    points[i].xyz = {cloud[i].x, cloud[i].y, cloud[i].z};
-    points[i].cls = semantic[i].label < static_cast<std::uint32_t>(C)
-                        ? static_cast<int>(semantic[i].label)
-                        : -1;
-    points[i].opacity = 1.f / (1.f + std::exp(-cloud[i].opacity));
-  }
+  // The cloud as PCL users take it (model_semantic): each Gaussian's class from the views; for
+  // comparison also the class of its own decoded feature.
+  const auto cloud = labelledCloud(*run.trainer, run.scene);
+  const std::vector<eval::CloudPoint> points = cloudPoints(cloud, C);
+  const std::vector<eval::CloudPoint> feature_points = cloudPoints(run.trainer->toCloud(), C);
   const eval::NearestTruthSurface truth = [&](const std::array<float, 3>& p) {
     const synth::NearestSurface s = world->nearestSurface(p.data());
     return eval::TruthSurface{s.distance, s.cls};
@@ -91,6 +99,12 @@ std::string evalCloudRun(const std::string& run_dir) {
   j["weighted_miou"] = s.weighted_miou;
   j["weighted_oacc"] = s.weighted_oacc;
   j["weighted_iou"] = perClass(run.scene.classes, s.weighted_iou);
+  j["labels"] = "the class the training views render where the Gaussian draws (labelled_cloud.h)";
+  const eval::CloudScores f = eval::scoreCloud(feature_points, truth, surface, options);
+  j["feature_labels"] = {{"point_miou", f.miou},
+                         {"point_oacc", f.oacc},
+                         {"weighted_miou", f.weighted_miou},
+                         {"point_iou", perClass(run.scene.classes, f.iou)}};
   j["opaque_at"] = options.opaque;
   j["opaque"] = s.opaque;
   j["distance_median_m"] = s.median_metres;

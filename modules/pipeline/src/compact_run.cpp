@@ -12,6 +12,7 @@
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/run_directory.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/train_run.h"
 
@@ -43,7 +44,7 @@ std::string compactRun(const std::string& run_dir, const std::string& out_dir,
   OpenedRun run = openRun(run_dir, "", 0.5, ScenePixels::kLeftOnDisk,
                           o.refine > 0 ? gaussians::TrainerViews::kLoaded
                                        : gaussians::TrainerViews::kCamerasOnly);
-  pcl::PointCloud<GaussianPoint> model = run.trainer->toCloud();
+  pcl::PointCloud<GaussianPoint> model = labelledCloud(*run.trainer, run.scene);
   const at::Tensor opacity = run.trainer->effectiveOpacity().to(at::kFloat).contiguous();
   const float* a = opacity.data_ptr<float>();
   for (std::size_t i = 0; i < model.size(); ++i) {

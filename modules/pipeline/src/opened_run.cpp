@@ -1,5 +1,7 @@
 #include "sadsplat/pipeline/opened_run.h"
 
+#include <ATen/Context.h>
+
 #include <filesystem>
 
 #include "sadsplat/common/error.h"
@@ -43,6 +45,11 @@ OpenedRun openRun(const std::string& run_dir, const std::string& scene_override,
   o.scale = scene_override.empty() ? record.scale : scale;
   o.train_seconds = record.train_seconds;
   o.config = gaussians::TrainConfig::fromJson(io::readWholeFile(dir.config()), dir.config());
+  // A run trained on a GPU opens on a machine without one (eval, maps, the viewer on a laptop):
+  // the model then renders with the CPU rasterizer, the reference the CUDA one is tested against.
+  if (o.config.device == gaussians::TrainDevice::kCuda && !at::hasCUDA()) {
+    o.config.device = gaussians::TrainDevice::kCpu;
+  }
   o.scene = loadScene(o.scene_path, o.scale, nullptr, pixels);
   o.trainer = std::make_unique<gaussians::Trainer>(o.scene, o.config, views);
   o.trainer->setDropStrategy(semantic_drop::makeDropStrategy(o.config));

@@ -12,6 +12,7 @@
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/run_directory.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/gaussians/device.h"
 
@@ -52,7 +53,7 @@ SplatFrames::SplatFrames(const std::string& path, const std::string& device) : s
   s.device = gaussians::deviceNamed(device, path);
   if (io::RunDirectory::hasCheckpoint(path)) {
     s.run = std::make_unique<OpenedRun>(openRun(path));
-    s.cloud = s.run->trainer->toCloud();
+    s.cloud = labelledCloud(*s.run->trainer, s.run->scene);
     s.params = s.run->trainer->parameters();
     return;
   }

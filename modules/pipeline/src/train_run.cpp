@@ -17,6 +17,7 @@
 #include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/semantic_ply.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
 #include "sadsplat/gaussians/device.h"
@@ -53,8 +54,9 @@ gaussians::TrainConfig runConfiguration(const TrainRunOptions& o,
 }
 
 void writeModel(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
-                const std::vector<ClassInfo>& classes) {
-  const auto cloud = trainer.toCloud();
+                const io::Scene& scene) {
+  const std::vector<ClassInfo>& classes = scene.classes;
+  const auto cloud = labelledCloud(trainer, scene);
   io::PlyWriteOptions ply;
   // A scene without classes trains plain 3DGS: a standard PLY without semantic properties.
   ply.semantic = !classes.empty();
@@ -190,7 +192,7 @@ void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trai
                      const io::Scene& scene, const io::RunRecord& record) {
   trainer.saveCheckpoint(dir.checkpoint());
   dir.writeRecord(record);
-  writeModel(dir, trainer, scene.classes);
+  writeModel(dir, trainer, scene);
   if (!scene.classes.empty()) io::writeClassesJson(dir.classes(), scene.classes);
   if (scene.georeference) {
     // The model's frame: east-north-up metres around the origin (for GIS outputs and viewers).

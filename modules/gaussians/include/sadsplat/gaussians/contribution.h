@@ -9,6 +9,7 @@
 
 #include <ATen/ATen.h>
 
+#include <functional>
 #include <vector>
 
 #include "sadsplat/gaussians/rasterizer.h"
@@ -23,6 +24,31 @@ namespace gaussians {
 /// \return float [N] on the device of the Gaussians, >= 0 (in pixels)
 at::Tensor blendingWeightSums(const GaussianParams& gaussians,
                               const std::vector<RasterCamera>& cameras);
+
+/// \brief Per Gaussian, the sum over the pixels of one camera of its blending weight times each
+/// of K per-pixel values: sum_p alpha_i T_i (p) values(p, k). With values 1 it is the Gaussian's
+/// part of blendingWeightSums for this camera; divided by that, the mean value over what the
+/// Gaussian draws (e.g. the rendered depth there).
+/// \param[in] gaussians the Gaussians (any device; no gradient is taken into them)
+/// \param[in] camera the view
+/// \param[in] values [H, W, K] float, K >= 1 (any device)
+/// \return float [N, K] on the device of the Gaussians
+at::Tensor weightedPixelSums(const GaussianParams& gaussians, const RasterCamera& camera,
+                             const at::Tensor& values);
+
+/// \brief Per Gaussian and class, the sum of its blending weights over the pixels that a class
+/// map of each camera gives that class: how much of what the views show as class c the
+/// Gaussian makes. Summed over the classes it is blendingWeightSums over the labelled pixels.
+/// \param[in] gaussians the Gaussians (any device; no gradient is taken into them)
+/// \param[in] cameras the views to sum over
+/// \param[in] class_map the class of every pixel of camera k ([H, W] int64, any device; a value
+/// outside [0, num_classes) counts for no class), asked for once per camera in order
+/// \param[in] num_classes > 0
+/// \return float [N, num_classes] on the device of the Gaussians, >= 0 (in pixels)
+at::Tensor classWeightSums(const GaussianParams& gaussians,
+                           const std::vector<RasterCamera>& cameras,
+                           const std::function<at::Tensor(std::size_t)>& class_map,
+                           int num_classes);
 
 /// \brief Weights that fall with the contribution: w = (1 + c / median(c))^-gamma, scaled to mean
 /// 1. A Gaussian that contributes nothing gets the largest weight, one at the median 2^-gamma of

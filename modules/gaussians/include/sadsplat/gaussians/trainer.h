@@ -124,6 +124,12 @@ class Trainer {
   /// compositing skips them).
   SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5,
                              bool features = true) const;
+  /// \brief Per Gaussian and class [N, classes] (float, on the CPU): its blending weight summed
+  /// over the pixels that this model's render of each camera shows as that class
+  /// (contribution.h's classWeightSums with predictClasses' maps): what the views say each
+  /// Gaussian is. Each camera is rendered twice.
+  /// \throws sadsplat::Error when the model has no classes
+  at::Tensor renderedClassWeights(const std::vector<RasterCamera>& cameras) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 

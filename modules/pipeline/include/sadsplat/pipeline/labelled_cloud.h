@@ -1,0 +1,36 @@
+#pragma once
+/// \file labelled_cloud.h
+/// \brief The Gaussians as a run hands them out (model.ply's label, model_semantic, `extract`,
+/// the viewer's class selection, `eval --3d`), with each Gaussian's class taken from what the
+/// training views show where it draws.
+///
+/// A Gaussian's own decoded feature is a poor class for the Gaussian: the semantic loss trains
+/// the *composited* feature of each pixel, so a Gaussian's feature only has to be right in the
+/// blend with its neighbours. Instead every Gaussian gets the class that the model's own renders
+/// of the training views show over the pixels it draws, weighted by how much it draws them (its
+/// blending weight alpha T): a vote over the views in the spirit of the 2D-to-3D label lifting
+/// of Gaussian Grouping and SAGA, with the model's rendered classes as the 2D labels. Measured
+/// against the world of `synth` scenes (docs/measurements/cloud_3d): the per-class cloud's point
+/// mIoU rises from 20 points below the views' to about theirs.
+
+#include <pcl/point_cloud.h>
+
+#include "sadsplat/common/gaussian_point.h"
+#include "sadsplat/gaussians/trainer.h"
+#include "sadsplat/io/scene.h"
+
+namespace sadsplat {
+namespace pipeline {
+
+/// \brief trainer.toCloud() with each Gaussian's label replaced by the class with the largest
+/// blending weight summed over the training views of `scene` rendered as `trainer` renders them
+/// (Trainer::renderedClassWeights). Gaussians that no training view draws keep the class of their
+/// decoded feature. A model without classes is returned as toCloud gives it.
+/// \param[in] trainer a trained model
+/// \param[in] scene its scene: the cameras of the views marked `train` are rendered (no pixels
+/// are read)
+pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
+                                             const io::Scene& scene);
+
+}  // namespace pipeline
+}  // namespace sadsplat
