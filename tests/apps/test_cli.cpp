@@ -153,6 +153,20 @@ TEST(Cli, TrainEvalAndResumeOnTheFixture) {
   std::size_t roads = 0;
   for (const auto& p : io::readGaussianPly(run + "/model.ply")) roads += p.label == 0;
   EXPECT_EQ(io::readGaussianPly(dir.file("road.ply")).size(), roads);
+  // --on-surface keeps the roads near the surface the views render: no more than all of them;
+  // on a file (no views to render) it is an error.
+  ASSERT_EQ(test::runCommand(kCli + " extract " + run + " --class road --on-surface 0.5 --out " +
+                                 dir.file("road_on.ply"),
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("on the surface (within 0.5): "), std::string::npos) << out;
+  EXPECT_LE(io::readGaussianPly(dir.file("road_on.ply")).size(), roads);
+  EXPECT_EQ(test::runCommand(kCli + " extract " + run +
+                                 "/model.ply --class 0 --on-surface 1 --out " + dir.file("x.ply"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("--on-surface: expected a run directory"), std::string::npos) << out;
   // sadsplat reads every cloud it writes: info, convert and extract take each of them.
   const std::string n = std::to_string(io::readGaussianPly(run + "/model.ply").size());
   for (const char* f : {"model.ply", "model.pcd", "model_semantic.pcd", "model_semantic.ply"}) {
@@ -206,10 +220,10 @@ TEST(Cli, CompactTilesAndGlbOfATrainedRun) {
   const std::size_t n = io::readGaussianPly(run + "/model.ply").size();
   ASSERT_GT(n, 20u);
   // compact: a run directory with half the Gaussians that eval scores.
-  ASSERT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --refine 3 --out " +
-                                 dir.file("half"),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " compact " + run + " --ratio 0.5 --refine 3 --out " + dir.file("half"), &out),
+      0)
       << out;
   EXPECT_NE(out.find("refined 3 iterations"), std::string::npos) << out;
   EXPECT_EQ(io::readGaussianPly(dir.file("half") + "/model.ply").size(), (n + 1) / 2);
@@ -218,9 +232,8 @@ TEST(Cli, CompactTilesAndGlbOfATrainedRun) {
       << out;
   EXPECT_NE(out.find("\"iterations\": 33"), std::string::npos) << out;  // 30 trained + 3 refined
   // Exactly one of --count / --ratio / --model.
-  EXPECT_EQ(test::runCommand(kCli + " compact " + run + " --ratio 0.5 --count 3 --out " +
-                                 dir.file("bad"),
-                             &out),
+  EXPECT_EQ(test::runCommand(
+                kCli + " compact " + run + " --ratio 0.5 --count 3 --out " + dir.file("bad"), &out),
             1);
   EXPECT_NE(out.find("exactly one"), std::string::npos) << out;
   // tiles: every Gaussian in one leaf; a local tileset (the fixture has no georeference).

@@ -2,6 +2,7 @@
 // run.json and the train log say the trainer ran, and gaussians::resolveSchedule agree.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -134,9 +135,10 @@ namespace {
 // train, both ways of streaming: views read from the scene cache by the loader threads ahead of
 // the steps (trainRun on a cache path), and 8-bit host copies of a scene in memory (trainRun on
 // a loaded scene); and views held on the device train the same whether they were read from the
-// cache one at a time (trainRun on a cache path) or with the whole cache. Bit for bit on the CPU; on a GPU to the rounding of its backward's atomics
-// (two held runs differ as much). The cache is the fixture with the built-in pseudo-labels, so
-// the confidence maps and pseudo-label supervision come from the cache too.
+// cache one at a time (trainRun on a cache path) or with the whole cache. Bit for bit on the CPU;
+// on a GPU to the rounding of its backward's atomics (two held runs differ as much). The cache is
+// the fixture with the built-in pseudo-labels, so the confidence maps and pseudo-label supervision
+// come from the cache too.
 void expectStreamedViewsTrainLikeHeldViews(const std::string& device) {
   test::TempDir dir;
   pipeline::PseudoLabelRunOptions labelling;
@@ -196,12 +198,10 @@ TEST(OpenedRun, ATrainerForRenderingHoldsOnlyCamerasRendersAlikeAndRefusesToTrai
   test::TempDir dir;
   trainTinyRun(dir.file("run"));
   const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
-  const pipeline::OpenedRun loaded =
-      pipeline::openRun(dir.file("run"), "", 0.5, pipeline::ScenePixels::kRead,
-                        gaussians::TrainerViews::kLoaded);
+  const pipeline::OpenedRun loaded = pipeline::openRun(
+      dir.file("run"), "", 0.5, pipeline::ScenePixels::kRead, gaussians::TrainerViews::kLoaded);
   for (const io::View& v : run.scene.views) {
-    EXPECT_TRUE(run.trainer->renderView(v).rgb.equal(loaded.trainer->renderView(v).rgb))
-        << v.name;
+    EXPECT_TRUE(run.trainer->renderView(v).rgb.equal(loaded.trainer->renderView(v).rgb)) << v.name;
   }
   EXPECT_THROW(run.trainer->step(), sadsplat::Error);
   EXPECT_NO_THROW(loaded.trainer->step());
@@ -259,6 +259,41 @@ TEST(LabelledCloud, EachGaussianTakesTheClassTheViewsRenderWhereItDraws) {
     EXPECT_EQ(written[i].label, labelled[i].label) << i;
   }
   EXPECT_GT(seen, static_cast<int>(labelled.size()) / 2);
+}
+
+// `extract RUN --on-surface M` starts from gaussiansOnSurface: the labelled cloud without the
+// Gaussians farther than M from the surface their views render (surfaceGaps, one per Gaussian);
+// a large M keeps every Gaussian some view draws, a smaller one fewer.
+TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
+  test::TempDir dir;
+  trainTinyRun(dir.file("run"));
+  const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
+  const auto labelled = pipeline::labelledCloud(*run.trainer, run.scene);
+  const std::vector<float> gaps = pipeline::surfaceGaps(*run.trainer, run.scene);
+  ASSERT_EQ(gaps.size(), labelled.size());
+  std::vector<float> finite;
+  for (float g : gaps) {
+    EXPECT_GE(g, 0.f);
+    if (std::isfinite(g)) finite.push_back(g);
+  }
+  ASSERT_GT(finite.size(), labelled.size() / 2);
+  std::sort(finite.begin(), finite.end());
+  const auto all = pipeline::gaussiansOnSurface(dir.file("run"), 1e30f);
+  EXPECT_EQ(all.size(), finite.size());
+  const float median = finite[finite.size() / 2];
+  const auto near = pipeline::gaussiansOnSurface(dir.file("run"), median);
+  std::size_t expected = 0, j = 0;
+  for (std::size_t i = 0; i < labelled.size(); ++i) {
+    if (!(gaps[i] <= median)) continue;
+    ++expected;
+    ASSERT_LT(j, near.size());
+    EXPECT_EQ(near[j].x, labelled[i].x);
+    EXPECT_EQ(near[j].label, labelled[i].label);
+    ++j;
+  }
+  EXPECT_EQ(near.size(), expected);
+  EXPECT_LT(near.size(), all.size());
+  EXPECT_THROW(pipeline::gaussiansOnSurface(dir.file("run"), 0.f), sadsplat::Error);
 }
 
 // eval reads the test views from the scene cache one at a time: the same scores as with the

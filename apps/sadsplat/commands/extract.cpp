@@ -11,6 +11,7 @@
 #include "sadsplat/io/run_directory.h"
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 
 namespace sadsplat {
 namespace cli {
@@ -43,11 +44,20 @@ class ExtractCommand : public Command {
     c->add_option("--classification-map", classification_map_,
                   ".las: JSON {\"class name\": ASPRS code} replacing the default codes");
     c->add_flag("--negative", negative_, "keep every class except this one");
+    c->add_option("--on-surface", on_surface_,
+                  "a run directory only: keep only the Gaussians at most this far (scene units, "
+                  "metres for georeferenced or synth scenes) from the surface the training views "
+                  "render where they draw: floaters and Gaussians inside volumes go");
     return c;
   }
 
   int run(const Invocation&) override {
     std::string in = in_, classes = classes_;
+    if (on_surface_ != 0 && !io::isDirectory(in)) {
+      throw Error(in, "--on-surface",
+                  "a run directory (the check renders its model through its training views)",
+                  "a file");
+    }
     if (io::isDirectory(in)) {  // a run directory: its model and its class list
       const io::RunDirectory run(in);
       if (classes.empty()) {
@@ -80,8 +90,15 @@ class ExtractCommand : public Command {
             }
           });
     } else {
+      const auto read = [&](const std::string& p) {
+        if (on_surface_ == 0) return io::readGaussians(p);
+        const auto kept = pipeline::gaussiansOnSurface(in_, static_cast<float>(on_surface_));
+        std::cout << "on the surface (within " << on_surface_ << "): " << kept.size()
+                  << " Gaussians\n";
+        return kept;
+      };
       extractClass<GaussianPoint>(
-          in, out_, id, negative_, [](const std::string& p) { return io::readGaussians(p); },
+          in, out_, id, negative_, read,
           [&](const std::string& p, const pcl::PointCloud<GaussianPoint>& c) {
             if (las) {
               std::cout << geo::writeGaussiansLas(p, c, las_options) << "\n";
@@ -118,6 +135,7 @@ class ExtractCommand : public Command {
 
   std::string in_, out_, class_, classes_, classification_map_;
   bool negative_ = false;
+  double on_surface_ = 0;
 };
 
 }  // namespace

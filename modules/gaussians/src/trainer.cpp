@@ -521,6 +521,12 @@ at::Tensor Trainer::renderedClassWeights(const std::vector<RasterCamera>& camera
       .to(at::kCPU);
 }
 
+at::Tensor Trainer::renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const {
+  const auto depth_map = [&](std::size_t k) { return renderDepth(cameras[k]).depth; };
+  c10::AutoGradMode no_grad(false);
+  return depthResiduals(state_->evaluationGaussians(), cameras, depth_map).to(at::kCPU);
+}
+
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }
 
 pcl::PointCloud<GaussianPoint> Trainer::toCloud() const {

@@ -122,6 +122,26 @@ std::string evalCloudRun(const std::string& run_dir) {
     confusion.push_back(row);
   }
   j["confusion"] = confusion;  // rows: the nearest true surface's class; columns: the Gaussian's
+  // The cloud `extract --on-surface M` hands out: the Gaussians at most M from the surface the
+  // views render where they draw.
+  const std::vector<float> gaps = surfaceGaps(*run.trainer, run.scene);
+  nlohmann::json on_surface = nlohmann::json::array();
+  for (const float limit : {0.5f, 1.0f, 2.0f}) {
+    std::vector<eval::CloudPoint> kept;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (gaps[i] <= limit) kept.push_back(points[i]);
+    }
+    const eval::CloudScores k = eval::scoreCloud(kept, truth, surface, options);
+    on_surface.push_back({{"max_gap_m", limit},
+                          {"gaussians", kept.size()},
+                          {"point_miou", k.miou},
+                          {"opaque", k.opaque},
+                          {"share_within_0.5_m", k.share_near},
+                          {"share_beyond_1.0_m", k.share_far},
+                          {"distance_p90_m", k.p90_metres},
+                          {"completeness_all", k.completeness_all}});
+  }
+  j["on_surface"] = on_surface;
   j["completeness_within_m"] = options.complete_metres;
   j["completeness"] = perClass(run.scene.classes, s.completeness);
   j["completeness_all"] = s.completeness_all;

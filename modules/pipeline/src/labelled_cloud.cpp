@@ -1,8 +1,13 @@
 #include "sadsplat/pipeline/labelled_cloud.h"
 
+#include <cmath>
+#include <string>
 #include <vector>
 
+#include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/rasterizer.h"
+#include "sadsplat/pipeline/opened_run.h"
+#include "sadsplat/pipeline/ortho_render.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -11,10 +16,7 @@ pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
                                              const io::Scene& scene) {
   pcl::PointCloud<GaussianPoint> cloud = trainer.toCloud();
   if (trainer.numClasses() == 0) return cloud;
-  std::vector<gaussians::RasterCamera> cameras;
-  for (const io::View& view : scene.views) {
-    if (view.train) cameras.push_back(gaussians::RasterCamera::fromPinhole(view.camera));
-  }
+  const std::vector<gaussians::RasterCamera> cameras = trainingCameras(scene);
   if (cameras.empty()) return cloud;
   const at::Tensor weights = trainer.renderedClassWeights(cameras).to(at::kFloat).contiguous();
   const at::Tensor seen = (weights.sum(1) > 0).contiguous();
@@ -25,6 +27,28 @@ pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
     if (s[i]) cloud[i].label = static_cast<std::uint32_t>(b[i]);
   }
   return cloud;
+}
+
+std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene) {
+  const at::Tensor gaps =
+      trainer.renderedDepthResiduals(trainingCameras(scene)).to(at::kFloat).contiguous();
+  return std::vector<float>(gaps.data_ptr<float>(), gaps.data_ptr<float>() + gaps.numel());
+}
+
+pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir, float max_gap) {
+  if (!(max_gap > 0) || !std::isfinite(max_gap)) {
+    throw Error(run_dir, "--on-surface", "a positive distance in scene units",
+                std::to_string(max_gap));
+  }
+  const OpenedRun run = openRun(run_dir);
+  const pcl::PointCloud<GaussianPoint> all = labelledCloud(*run.trainer, run.scene);
+  const std::vector<float> gaps = surfaceGaps(*run.trainer, run.scene);
+  pcl::PointCloud<GaussianPoint> kept;
+  kept.header = all.header;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (gaps[i] <= max_gap) kept.push_back(all[i]);
+  }
+  return kept;
 }
 
 }  // namespace pipeline

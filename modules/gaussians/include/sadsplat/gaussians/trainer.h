@@ -130,6 +130,10 @@ class Trainer {
   /// Gaussian is. Each camera is rendered twice.
   /// \throws sadsplat::Error when the model has no classes
   at::Tensor renderedClassWeights(const std::vector<RasterCamera>& cameras) const;
+  /// \brief Per Gaussian [N] (float, on the CPU): the gap between its centre and the surface this
+  /// model renders through each camera where the Gaussian draws (contribution.h's
+  /// depthResiduals with renderDepth's maps), in scene units; +inf where no camera draws it.
+  at::Tensor renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 

@@ -15,6 +15,9 @@
 
 #include <pcl/point_cloud.h>
 
+#include <string>
+#include <vector>
+
 #include "sadsplat/common/gaussian_point.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/io/scene.h"
@@ -31,6 +34,21 @@ namespace pipeline {
 /// are read)
 pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
                                              const io::Scene& scene);
+
+/// \brief Per Gaussian of trainer.toCloud(), in its order: how far it lies from the surface the
+/// model renders through the training views of `scene` where it draws
+/// (Trainer::renderedDepthResiduals), in scene units; +inf where no training view draws it.
+/// `extract --on-surface M` keeps the Gaussians at most M from it: floaters and Gaussians sunk
+/// inside volumes go, the surfaces stay.
+std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene);
+
+/// \brief The run's labelled cloud (as its model.ply holds it) without the Gaussians more than
+/// `max_gap` scene units from the surface its training views render where they draw
+/// (surfaceGaps): what `extract RUN --on-surface M` starts from.
+/// \param[in] run_dir a trained run (its checkpoint and scene cache are read)
+/// \param[in] max_gap > 0
+/// \throws sadsplat::Error for a bad max_gap or a run that cannot be opened
+pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir, float max_gap);
 
 }  // namespace pipeline
 }  // namespace sadsplat
