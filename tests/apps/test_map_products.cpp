@@ -233,6 +233,32 @@ TEST_F(MapProducts, OrthoMinViewsMakesCellsFewPhotosSeeNodata) {
   EXPECT_GT(covered("--height blend --class-from first --min-views 0", &few_blend), 0.1);
 }
 
+// --on-surface M makes the maps of the Gaussians at most M from the surface the photos render:
+// the kept sets grow with M and a cell's accumulated alpha only grows with more Gaussians, so the
+// covered share grows with M up to the map of every Gaussian (M = 0, the default); ortho.json
+// says which M made it.
+TEST_F(MapProducts, OrthoOnSurfaceMapsOnlyTheGaussiansNearTheRenderedSurface) {
+  const auto covered = [&](const std::string& m) {
+    std::string out;
+    const std::string dir = dir_->file("ortho_surface");
+    EXPECT_EQ(
+        test::runCommand(
+            kCli + " ortho " + run() + " --gsd 1.5 --on-surface " + m + " --out " + dir, &out),
+        0)
+        << out;
+    const nlohmann::json j = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
+    EXPECT_EQ(j["on_surface_m"].get<double>(), std::stod(m));
+    return j["covered_share"].get<double>();
+  };
+  const double all = covered("0"), wide = covered("5"), narrow = covered("0.3"),
+               none = covered("0.000001");
+  EXPECT_GT(all, 0.1);
+  EXPECT_LE(wide, all);
+  EXPECT_LE(narrow, wide);
+  EXPECT_LE(none, narrow);
+  EXPECT_LT(none, all);
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");
@@ -439,6 +465,7 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
   expectError("ortho " + run() + " --min-spread 400 --out " + dir_->file("x"), "--min-spread");
   expectError("ortho " + run() + " --vectors roof --out " + dir_->file("x"), "roof");
+  expectError("ortho " + run() + " --on-surface -1 --out " + dir_->file("x"), "--on-surface");
   expectError("eval " + run() + " --ortho --height top", "--height");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");

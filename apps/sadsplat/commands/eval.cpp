@@ -32,6 +32,8 @@ class EvalCommand : public Command {
         ->default_val(0);
     c->add_option("--min-views", ortho_options_.min_views, "--ortho: as `ortho --min-views`")
         ->default_val(0);
+    c->add_option("--on-surface", ortho_options_.on_surface, "--ortho: as `ortho --on-surface`")
+        ->default_val(0);
     c->add_flag("--3d", cloud_,
                 "score the per-class cloud in 3D instead: every Gaussian's class against the "
                 "nearest true surface of a `sadsplat synth` scene's world, distances to it, "

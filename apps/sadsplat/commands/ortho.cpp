@@ -36,7 +36,8 @@ class OrthoCommand : public Command {
                   "first = of the Gaussians in front of the first surface")
         ->default_val("blend");
     c->add_option("--min-views", o_.min_views,
-                  "cells whose surface fewer training photos see unoccluded are nodata (default 0: keep all)")
+                  "cells whose surface fewer training photos see unoccluded are nodata (default 0: "
+                  "keep all)")
         ->default_val(0);
     c->add_option("--depth-tolerance", o_.depth_tolerance,
                   "--min-views: a photo sees a cell when the depth it renders there agrees within "
@@ -45,6 +46,11 @@ class OrthoCommand : public Command {
     c->add_option("--min-spread", o_.min_spread,
                   "cells whose photos all look from one side (horizontal directions spread less "
                   "than this many degrees) are nodata too (default 0: off)")
+        ->default_val(0);
+    c->add_option("--on-surface", o_.on_surface,
+                  "make the maps of the Gaussians at most this far (scene units) from the surface "
+                  "the training photos render where they draw, as `extract --on-surface` "
+                  "(default 0: all)")
         ->default_val(0);
     c->add_option("--vectors", o_.vectors,
                   "classes (names, comma-separated) whose regions are also written as polygons "

@@ -68,8 +68,7 @@ struct StepPass {
 // -> render -> losses -> backward -> statistics -> optimiser -> drop -> densification.
 struct Trainer::State {
   // The drop state sees the schedule as the trainer runs it (its guard needs the opacity resets).
-  explicit State(const TrainConfig& c)
-      : config(resolveDerivedKeys(c)), drop(config, config) {}
+  explicit State(const TrainConfig& c) : config(resolveDerivedKeys(c)), drop(config, config) {}
 
   TrainConfig config;
   at::Device device{at::kCPU};
@@ -106,6 +105,20 @@ struct Trainer::State {
   GaussianParams evaluationGaussians() const {
     GaussianParams g = params.gaussians();
     g.opacity_gate = drop.evaluationGate(params, iteration);
+    return g;
+  }
+  // The same, drawing only the Gaussians where `keep` ([N] bool, any device) is true (undefined:
+  // all of them).
+  GaussianParams evaluationGaussians(const at::Tensor& keep) const {
+    GaussianParams g = evaluationGaussians();
+    if (!keep.defined()) return g;
+    if (keep.dim() != 1 || keep.size(0) != g.means.size(0)) {
+      throw Error("<render>", "keep mask",
+                  "one flag per Gaussian (" + std::to_string(g.means.size(0)) + ")",
+                  std::to_string(keep.numel()));
+    }
+    const at::Tensor k = keep.to(g.means.device(), g.means.scalar_type());
+    g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
     return g;
   }
   RenderSettings evaluationSettings() const {
@@ -466,25 +479,15 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera) const {
 RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;
-  GaussianParams g = s.evaluationGaussians();
-  if (keep.defined()) {
-    if (keep.dim() != 1 || keep.size(0) != g.means.size(0)) {
-      throw Error("<render>", "keep mask",
-                  "one flag per Gaussian (" + std::to_string(g.means.size(0)) + ")",
-                  std::to_string(keep.numel()));
-    }
-    const at::Tensor k = keep.to(g.means.device(), g.means.scalar_type());
-    g.opacity_gate = g.opacity_gate.defined() ? g.opacity_gate * k : k;
-  }
-  return render(g, camera, s.evaluationSettings());
+  return render(s.evaluationGaussians(keep), camera, s.evaluationSettings());
 }
 
-RenderResult Trainer::renderDepth(const RasterCamera& camera) const {
+RenderResult Trainer::renderDepth(const RasterCamera& camera, const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;
   RenderSettings settings = s.evaluationSettings();
   settings.features = false;
-  return render(s.evaluationGaussians(), camera, settings);
+  return render(s.evaluationGaussians(keep), camera, settings);
 }
 
 at::Tensor Trainer::predictClasses(const RenderResult& r) const {
@@ -504,9 +507,10 @@ at::Tensor Trainer::classCosines(const at::Tensor& features) const {
   return d / d.norm(2, 2, true).clamp_min(1e-12);
 }
 
-SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level, bool features) const {
+SurfaceLayer Trainer::renderSurface(const RasterCamera& camera, double level, bool features,
+                                    const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
-  GaussianParams g = state_->evaluationGaussians();
+  GaussianParams g = state_->evaluationGaussians(keep);
   if (!features) g.features = at::Tensor();
   return renderSurfaceLayer(g, camera, level);
 }
@@ -559,8 +563,8 @@ void Trainer::setGaussians(const pcl::PointCloud<GaussianPoint>& cloud) {
   const std::int64_t d = state_->params["features"].value.size(1);
   const GaussianTensors t = fromCloud(cloud, at::kCPU, static_cast<int>(d));
   const std::map<std::string, at::Tensor> values = {
-      {"means", t.means},           {"sh_dc", t.sh_dc},   {"sh_rest", t.sh_rest},
-      {"opacity", t.opacity_logit}, {"scales", t.log_scales}, {"quats", t.rotations},
+      {"means", t.means},           {"sh_dc", t.sh_dc},        {"sh_rest", t.sh_rest},
+      {"opacity", t.opacity_logit}, {"scales", t.log_scales},  {"quats", t.rotations},
       {"features", t.features},     {"log_alpha", t.log_alpha}};
   for (const std::string& name : checkpointRowTensors()) {
     auto entry = a.tensors.find(name);
@@ -602,7 +606,9 @@ void Trainer::saveCheckpoint(const std::string& path) const {
   writeTensorArchive(path, checkpointSnapshot());
 }
 
-void Trainer::loadCheckpoint(const std::string& path) { loadCheckpoint(readTensorArchive(path), path); }
+void Trainer::loadCheckpoint(const std::string& path) {
+  loadCheckpoint(readTensorArchive(path), path);
+}
 
 std::vector<std::string> Trainer::checkpointRowTensors() const {
   const State& s = *state_;

@@ -76,8 +76,13 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--depth-tolerance", "a share of the depth in (0, 1]",
                 std::to_string(o.depth_tolerance));
   }
+  if (!(o.on_surface >= 0 && std::isfinite(o.on_surface))) {
+    throw Error(what, "--on-surface", "a distance >= 0 in scene units (0: off)",
+                std::to_string(o.on_surface));
+  }
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
+  r.max_surface_gap = o.on_surface;
   r.depth_tolerance = o.depth_tolerance;
   return r;
 }
@@ -232,6 +237,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["min_views"] = o.min_views;
   j["min_spread_degrees"] = o.min_spread;
   j["depth_tolerance"] = o.depth_tolerance;
+  j["on_surface_m"] = o.on_surface;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
@@ -374,6 +380,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["min_views"] = render.min_views;
   j["min_spread_degrees"] = render.min_spread;
   j["depth_tolerance"] = render.depth_tolerance;
+  j["on_surface_m"] = render.on_surface;
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();

@@ -174,9 +174,21 @@ at::Tensor backProject(const gaussians::RasterCamera& cam, const at::Tensor& dep
 
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
                         const OrthoRenderOptions& options, std::ostream* progress, int tile) {
-  if ((options.min_views > 0 || options.min_spread_degrees > 0) && options.cameras.empty()) {
-    throw Error("<ortho>", "cameras", "the training cameras (to count the views of each cell)",
+  if ((options.min_views > 0 || options.min_spread_degrees > 0 || options.max_surface_gap > 0) &&
+      options.cameras.empty()) {
+    throw Error("<ortho>", "cameras",
+                "the training cameras (to count the views of each cell, or check the surface)",
                 "none");
+  }
+  // The Gaussians the map is made of (undefined: all).
+  at::Tensor keep;
+  if (options.max_surface_gap > 0) {
+    keep = trainer.renderedDepthResiduals(options.cameras) <= options.max_surface_gap;
+    if (progress) {
+      *progress << "  on the surface (within " << options.max_surface_gap
+                << "): " << keep.sum().item<std::int64_t>() << " of " << keep.numel()
+                << " Gaussians\n";
+    }
   }
   OrthoImages out;
   out.width = grid.width;
@@ -197,13 +209,13 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       const int x_off = tx * tile, y_off = ty * tile;
       const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
       const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
-      const gaussians::RenderResult r = trainer.renderCamera(camera);
+      const gaussians::RenderResult r = trainer.renderCamera(camera, keep);
       const at::Tensor rgb =
           r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
       at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
       at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
       if (first_height || first_class) {
-        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5, first_class);
+        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5, first_class, keep);
         // The same cells: the transmittance falls below 0.5 where the alpha reaches 0.5.
         covered = layer.reached;
         if (first_height) depth = layer.depth;
@@ -260,7 +272,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     at::Tensor directions = at::zeros({points.size(0), 2}, points.options());
     int seen_by = 0;
     for (const gaussians::RasterCamera& c : options.cameras) {
-      const gaussians::RenderResult r = trainer.renderDepth(c);
+      const gaussians::RenderResult r = trainer.renderDepth(c, keep);
       const at::Tensor seen =
           gaussians::seenUnoccluded(points, c, r.depth, r.alpha, options.depth_tolerance);
       counts += seen.to(at::kInt);

@@ -104,8 +104,9 @@ class Trainer {
   /// \brief As renderCamera, drawing only the Gaussians where `keep` ([N] bool, on any device) is
   /// true (a viewer's class selection); an undefined `keep` draws them all.
   RenderResult renderCamera(const RasterCamera& camera, const at::Tensor& keep) const;
-  /// \brief As renderCamera, without the features: colour, alpha and expected depth.
-  RenderResult renderDepth(const RasterCamera& camera) const;
+  /// \brief As renderCamera, without the features: colour, alpha and expected depth; `keep` as
+  /// there.
+  RenderResult renderDepth(const RasterCamera& camera, const at::Tensor& keep = at::Tensor()) const;
   /// \brief Per-pixel class ids [H, W] int64 from a render's feature image (argmax of the cosine
   /// similarity of the decoded feature to each class embedding).
   at::Tensor predictClasses(const RenderResult& render) const;
@@ -121,9 +122,9 @@ class Trainer {
   /// \brief The first surface of the current Gaussians through an orthographic camera: where
   /// the transmittance falls below `level` (surface_layer.h), the Gaussians as renderCamera
   /// draws them. On the CPU. `features` false: SurfaceLayer::features has 0 channels (the
-  /// compositing skips them).
-  SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5,
-                             bool features = true) const;
+  /// compositing skips them). `keep` as renderCamera's.
+  SurfaceLayer renderSurface(const RasterCamera& camera, double level = 0.5, bool features = true,
+                             const at::Tensor& keep = at::Tensor()) const;
   /// \brief Per Gaussian and class [N, classes] (float, on the CPU): its blending weight summed
   /// over the pixels that this model's render of each camera shows as that class
   /// (contribution.h's classWeightSums with predictClasses' maps): what the views say each

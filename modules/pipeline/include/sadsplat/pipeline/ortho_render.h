@@ -77,6 +77,11 @@ struct OrthoRenderOptions {
   /// A photo sees a cell's surface point when the depth it renders there agrees within this
   /// share of the point's depth (gaussians::seenUnoccluded).
   double depth_tolerance = 0.02;
+  /// Not on by default: the map is made of the Gaussians at most this far (scene units) from the
+  /// surface the training cameras render where they draw (Trainer::renderedDepthResiduals, as
+  /// `extract --on-surface`); floaters and Gaussians off the surfaces drop out of the orthophoto,
+  /// the class map and the DSM. 0: every Gaussian.
+  double max_surface_gap = 0;
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
 };
 
@@ -95,7 +100,8 @@ struct OrthoImages {
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.
-/// \throws sadsplat::Error for min_views > 0 without cameras
+/// \throws sadsplat::Error for min_views > 0, min_spread_degrees > 0 or max_surface_gap > 0
+/// without cameras
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
                         const OrthoRenderOptions& options, std::ostream* progress = nullptr,
                         int tile = 1024);
