@@ -445,6 +445,21 @@ TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["predicted"].get<int>());
   // A scene that names no generated world has no 3D truth: one line.
   EXPECT_EQ(test::runCommand(kCli + " eval " + run() + " --3d --ortho", &out), 1) << out;
+  // --scene: the scene the run is scored on (a run copied away from its scene; a scene directory
+  // is imported at eval's scale, 0.5, so the classes voted from its views may differ): the same
+  // Gaussians are scored; a missing scene is named.
+  ASSERT_EQ(
+      test::runCommand(kCli + " eval " + run() + " --3d --scene " + dir_->file("scene"), &out), 0)
+      << out;
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(run() + "/metrics_3d.json"))["gaussians"],
+            j["gaussians"]);
+  EXPECT_EQ(test::runCommand(kCli + " eval " + run() + " --3d --scene " + dir_->file("gone"), &out),
+            1);
+  EXPECT_NE(out.find(dir_->file("gone")), std::string::npos) << out;
+  EXPECT_EQ(
+      test::runCommand(kCli + " eval " + run() + " --ortho --scene " + dir_->file("gone"), &out),
+      1);
+  EXPECT_NE(out.find(dir_->file("gone")), std::string::npos) << out;
 }
 
 TEST_F(MapProducts, BadOptionsAreOneLineErrors) {

@@ -45,11 +45,11 @@ class EvalCommand : public Command {
       throw Error("<eval>", "--3d / --ortho", "one of them per call", "both");
     }
     if (cloud_) {
-      std::cout << pipeline::evalCloudRun(run_);
+      std::cout << pipeline::evalCloudRun(run_, scene_);
       return 0;
     }
     if (ortho_) {
-      std::cout << pipeline::evalOrthoRun(run_, truth_, ortho_options_);
+      std::cout << pipeline::evalOrthoRun(run_, truth_, ortho_options_, scene_);
       return 0;
     }
     std::cout << pipeline::evalRun(run_, scene_);

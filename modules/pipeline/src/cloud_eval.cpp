@@ -44,8 +44,8 @@ std::vector<eval::CloudPoint> cloudPoints(const pcl::PointCloud<GaussianPoint>& 
 
 }  // namespace
 
-std::string evalCloudRun(const std::string& run_dir) {
-  OpenedRun run = openRun(run_dir);
+std::string evalCloudRun(const std::string& run_dir, const std::string& scene_override) {
+  OpenedRun run = openRun(run_dir, scene_override);
   const int C = run.trainer->numClasses();
   if (C == 0) {
     throw Error(run_dir, "model", "a semantic model (classes) to score in 3D", "no classes");

@@ -281,9 +281,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
 }
 
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json_in,
-                         const OrthoRunOptions& render) {
+                         const OrthoRunOptions& render, const std::string& scene_override) {
   OrthoRenderOptions render_options = checkedRenderOptions(render, "<eval>");
-  OpenedRun run = openRun(run_dir);
+  OpenedRun run = openRun(run_dir, scene_override);
   if (run.trainer->numClasses() == 0) {
     throw Error(run_dir, "model", "a semantic model (classes) to score on the map", "no classes");
   }

@@ -62,9 +62,11 @@ std::string orthoRun(const OrthoRunOptions& options);
 /// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's
 /// ortho_truth.json (written by `sadsplat synth`) and scores it: mIoU, per-class IoU, and the
 /// area error per class. The map is rendered as `ortho` renders it with `render`'s height,
-/// class_from and min_views. Writes RUN/ortho_metrics.json and returns its text.
+/// class_from and min_views; on `scene_override` when given (a copied run whose scene moved).
+/// Writes RUN/ortho_metrics.json and returns its text.
 std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_json = "",
-                         const OrthoRunOptions& render = {});
+                         const OrthoRunOptions& render = {},
+                         const std::string& scene_override = "");
 
 }  // namespace pipeline
 }  // namespace sadsplat
