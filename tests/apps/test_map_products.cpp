@@ -443,6 +443,16 @@ TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   EXPECT_GT(j["objects"]["true"].get<int>(), 10) << j.dump();
   EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["true"].get<int>());
   EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["predicted"].get<int>());
+  // The cloud `extract --on-surface M` hands out, for three M: more kept as M grows.
+  ASSERT_EQ(j["on_surface"].size(), 3u) << j.dump();
+  std::int64_t previous = 0;
+  for (const auto& entry : j["on_surface"]) {
+    EXPECT_GE(entry["gaussians"].get<std::int64_t>(), previous) << entry.dump();
+    EXPECT_LE(entry["gaussians"].get<std::int64_t>(), j["gaussians"].get<std::int64_t>());
+    previous = entry["gaussians"].get<std::int64_t>();
+    EXPECT_GE(entry["objects_f1"].get<double>(), 0.0);
+    EXPECT_LE(entry["objects_f1"].get<double>(), 1.0);
+  }
   // A scene that names no generated world has no 3D truth: one line.
   EXPECT_EQ(test::runCommand(kCli + " eval " + run() + " --3d --ortho", &out), 1) << out;
   // --scene: the scene the run is scored on (a run copied away from its scene; a scene directory

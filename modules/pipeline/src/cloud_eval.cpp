@@ -122,6 +122,27 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
     confusion.push_back(row);
   }
   j["confusion"] = confusion;  // rows: the nearest true surface's class; columns: the Gaussian's
+  // Objects: the buildings as examples/building_footprints extracts them (opaque Gaussians of
+  // the class, Euclidean clusters), against the world's standing buildings.
+  int building = -1;
+  for (int c = 0; c < C; ++c) {
+    if (run.scene.classes[c].name == "building") building = c;
+  }
+  std::vector<eval::Footprint> truth_footprints;
+  if (building >= 0) {
+    for (const synth::ObjectFootprint& f :
+         synth::groundFootprints(*world, static_cast<std::uint8_t>(building))) {
+      truth_footprints.push_back({{f.x0, f.y0}, {f.x1, f.y0}, {f.x1, f.y1}, {f.x0, f.y1}});
+    }
+  }
+  const eval::ObjectScoreOptions object_options;
+  const auto buildingObjects = [&](const std::vector<eval::CloudPoint>& cloud_points) {
+    std::vector<std::array<float, 3>> centres;
+    for (const eval::CloudPoint& p : cloud_points) {
+      if (p.cls == building && p.opacity >= options.opaque) centres.push_back(p.xyz);
+    }
+    return eval::scoreObjects(centres, truth_footprints, object_options);
+  };
   // The cloud `extract --on-surface M` hands out: the Gaussians at most M from the surface the
   // views render where they draw.
   const std::vector<float> gaps = surfaceGaps(*run.trainer, run.scene);
@@ -140,26 +161,14 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
                           {"share_beyond_1.0_m", k.share_far},
                           {"distance_p90_m", k.p90_metres},
                           {"completeness_all", k.completeness_all}});
+    if (building >= 0) on_surface.back()["objects_f1"] = buildingObjects(kept).f1;
   }
   j["on_surface"] = on_surface;
   j["completeness_within_m"] = options.complete_metres;
   j["completeness"] = perClass(run.scene.classes, s.completeness);
   j["completeness_all"] = s.completeness_all;
-  // Objects: the buildings as examples/building_footprints extracts them (opaque Gaussians of
-  // the class, Euclidean clusters), against the world's buildings.
-  for (int c = 0; c < C; ++c) {
-    if (run.scene.classes[c].name != "building") continue;
-    std::vector<std::array<float, 3>> centres;
-    for (const eval::CloudPoint& p : points) {
-      if (p.cls == c && p.opacity >= options.opaque) centres.push_back(p.xyz);
-    }
-    std::vector<eval::Footprint> truth_footprints;
-    for (const synth::ObjectFootprint& f :
-         synth::groundFootprints(*world, static_cast<std::uint8_t>(c))) {
-      truth_footprints.push_back({{f.x0, f.y0}, {f.x1, f.y0}, {f.x1, f.y1}, {f.x0, f.y1}});
-    }
-    const eval::ObjectScoreOptions object_options;
-    const eval::ObjectScores o = eval::scoreObjects(centres, truth_footprints, object_options);
+  if (building >= 0) {
+    const eval::ObjectScores o = buildingObjects(points);
     j["objects"] = buildingObjectsJson(o, {{"cluster_tolerance_m", object_options.tolerance},
                                            {"min_points", object_options.min_points},
                                            {"match_iou", object_options.match_iou}});
