@@ -261,7 +261,7 @@ TEST(LabelledCloud, EachGaussianTakesTheClassTheViewsRenderWhereItDraws) {
   EXPECT_GT(seen, static_cast<int>(labelled.size()) / 2);
 }
 
-// `extract RUN --on-surface M` starts from gaussiansOnSurface: the labelled cloud without the
+// `extract RUN --on-surface M` starts from gaussiansOnSurface: the run's model.ply without the
 // Gaussians farther than M from the surface their views render (surfaceGaps, one per Gaussian);
 // a large M keeps every Gaussian some view draws, a smaller one fewer.
 TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
@@ -269,6 +269,7 @@ TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
   trainTinyRun(dir.file("run"));
   const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
   const auto labelled = pipeline::labelledCloud(*run.trainer, run.scene);
+  const auto model = io::readGaussianPly(dir.file("run/model.ply"));  // labelled's labels
   const std::vector<float> gaps = pipeline::surfaceGaps(*run.trainer, run.scene);
   ASSERT_EQ(gaps.size(), labelled.size());
   std::vector<float> finite;
@@ -278,10 +279,10 @@ TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
   }
   ASSERT_GT(finite.size(), labelled.size() / 2);
   std::sort(finite.begin(), finite.end());
-  const auto all = pipeline::gaussiansOnSurface(dir.file("run"), 1e30f);
+  const auto all = pipeline::gaussiansOnSurface(dir.file("run"), model, 1e30f);
   EXPECT_EQ(all.size(), finite.size());
   const float median = finite[finite.size() / 2];
-  const auto near = pipeline::gaussiansOnSurface(dir.file("run"), median);
+  const auto near = pipeline::gaussiansOnSurface(dir.file("run"), model, median);
   std::size_t expected = 0, j = 0;
   for (std::size_t i = 0; i < labelled.size(); ++i) {
     if (!(gaps[i] <= median)) continue;
@@ -293,7 +294,10 @@ TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
   }
   EXPECT_EQ(near.size(), expected);
   EXPECT_LT(near.size(), all.size());
-  EXPECT_THROW(pipeline::gaussiansOnSurface(dir.file("run"), 0.f), sadsplat::Error);
+  EXPECT_THROW(pipeline::gaussiansOnSurface(dir.file("run"), model, 0.f), sadsplat::Error);
+  pcl::PointCloud<GaussianPoint> shorter = model;
+  shorter.resize(model.size() - 1);
+  EXPECT_THROW(pipeline::gaussiansOnSurface(dir.file("run"), shorter, 1.f), sadsplat::Error);
 }
 
 // eval reads the test views from the scene cache one at a time: the same scores as with the

@@ -92,7 +92,8 @@ class ExtractCommand : public Command {
     } else {
       const auto read = [&](const std::string& p) {
         if (on_surface_ == 0) return io::readGaussians(p);
-        const auto kept = pipeline::gaussiansOnSurface(in_, static_cast<float>(on_surface_));
+        const auto kept = pipeline::gaussiansOnSurface(in_, io::readGaussians(p),
+                                                       static_cast<float>(on_surface_));
         std::cout << "on the surface (within " << on_surface_ << "): " << kept.size()
                   << " Gaussians\n";
         return kept;

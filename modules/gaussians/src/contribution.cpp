@@ -6,7 +6,7 @@
 #include <string>
 
 #include "sadsplat/common/error.h"
-#include "sadsplat/gaussians/raster_math.h"
+#include "sadsplat/gaussians/view_coverage.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -119,12 +119,7 @@ at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<Ras
     const at::Tensor sums =
         weightedPixelSums(gaussians, camera, at::stack({at::ones_like(depth), depth}, 2))
             .to(at::kDouble);
-    // The Gaussian's depth in the camera: the third row of the world-to-camera rotation.
-    double R[9];
-    const double q[4] = {camera.qvec[0], camera.qvec[1], camera.qvec[2], camera.qvec[3]};
-    raster::quatToRotation(q, R);
-    const at::Tensor z = means.select(1, 0) * R[6] + means.select(1, 1) * R[7] +
-                         means.select(1, 2) * R[8] + camera.tvec[2];
+    const at::Tensor z = cameraDepths(means, camera);
     const at::Tensor w = sums.select(1, 0);
     weight += w;
     gap += (sums.select(1, 1) - w * z).abs();

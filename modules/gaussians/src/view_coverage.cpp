@@ -45,6 +45,10 @@ Projection project(const at::Tensor& m, const RasterCamera& c) {
 
 }  // namespace
 
+at::Tensor cameraDepths(const at::Tensor& points, const RasterCamera& camera) {
+  return project(points.detach().to(at::kDouble), camera).z;
+}
+
 double sceneExtent(const std::vector<RasterCamera>& cameras) {
   if (cameras.empty()) return 1e-3;
   std::array<double, 3> mean{0, 0, 0};

@@ -35,18 +35,23 @@ std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scen
   return std::vector<float>(gaps.data_ptr<float>(), gaps.data_ptr<float>() + gaps.numel());
 }
 
-pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir, float max_gap) {
+pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir,
+                                                  const pcl::PointCloud<GaussianPoint>& model,
+                                                  float max_gap) {
   if (!(max_gap > 0) || !std::isfinite(max_gap)) {
     throw Error(run_dir, "--on-surface", "a positive distance in scene units",
                 std::to_string(max_gap));
   }
   const OpenedRun run = openRun(run_dir);
-  const pcl::PointCloud<GaussianPoint> all = labelledCloud(*run.trainer, run.scene);
   const std::vector<float> gaps = surfaceGaps(*run.trainer, run.scene);
+  if (model.size() != gaps.size()) {
+    throw Error(run_dir, "model", "the checkpoint's " + std::to_string(gaps.size()) + " Gaussians",
+                std::to_string(model.size()));
+  }
   pcl::PointCloud<GaussianPoint> kept;
-  kept.header = all.header;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    if (gaps[i] <= max_gap) kept.push_back(all[i]);
+  kept.header = model.header;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    if (gaps[i] <= max_gap) kept.push_back(model[i]);
   }
   return kept;
 }

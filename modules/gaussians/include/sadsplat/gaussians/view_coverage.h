@@ -23,6 +23,10 @@ double sceneExtent(const std::vector<RasterCamera>& cameras);
 /// the device of `means`.
 at::Tensor viewCounts(const at::Tensor& means, const std::vector<RasterCamera>& cameras);
 
+/// \brief The camera z of world points (`points`, [N, 3], any device) in `camera`: the depth a
+/// render's depth image gives them. double [N] on the device of `points`.
+at::Tensor cameraDepths(const at::Tensor& points, const RasterCamera& camera);
+
 /// \brief Which of `points` ([N, 3], world) a camera sees unoccluded, as a view's depth image
 /// says: in front of the camera, inside its image, and with their camera z within
 /// `relative_tolerance` x z of the depth at their pixel (`depth` [H, W], camera z, e.g. a

@@ -42,13 +42,17 @@ pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
 /// inside volumes go, the surfaces stay.
 std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene);
 
-/// \brief The run's labelled cloud (as its model.ply holds it) without the Gaussians more than
-/// `max_gap` scene units from the surface its training views render where they draw
-/// (surfaceGaps): what `extract RUN --on-surface M` starts from.
+/// \brief The run's model as written (`model`: its model.ply, labels as stored) without the
+/// Gaussians more than `max_gap` scene units from the surface its training views render where
+/// they draw (surfaceGaps): what `extract RUN --on-surface M` starts from.
 /// \param[in] run_dir a trained run (its checkpoint and scene cache are read)
+/// \param[in] model the run's Gaussians in the checkpoint's order (its model.ply)
 /// \param[in] max_gap > 0
-/// \throws sadsplat::Error for a bad max_gap or a run that cannot be opened
-pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir, float max_gap);
+/// \throws sadsplat::Error for a bad max_gap, a run that cannot be opened, or a model that is not
+/// the checkpoint's (another count)
+pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir,
+                                                  const pcl::PointCloud<GaussianPoint>& model,
+                                                  float max_gap);
 
 }  // namespace pipeline
 }  // namespace sadsplat
