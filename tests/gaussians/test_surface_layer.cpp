@@ -135,11 +135,121 @@ TEST(SurfaceLayer, ATiltedRoofKeepsItsSlope) {
   }
 }
 
+// Through a photo's (pinhole) camera: composited to the end it is the rasterizer's blend too,
+// and a tilted disc's surface is where each pixel's ray crosses the disc's plane (not the plane
+// of constant depth through its centre, nor the orthographic camera's vertical line).
+TEST(SurfaceLayer, ThroughAPinholeCameraItFollowsEachRayToTheSurface) {
+  RasterCamera pinhole;
+  pinhole.width = pinhole.height = 64;
+  pinhole.fx = pinhole.fy = 40;
+  pinhole.cx = pinhole.cy = 32;
+  at::manual_seed(11);
+  const std::int64_t n = 40;
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  GaussianParams r;
+  r.means = at::cat({at::rand({n, 2}, opts) * 4 - 2, at::rand({n, 1}, opts) * 4 + 3}, 1);
+  r.quats = at::randn({n, 4}, opts);
+  r.log_scales = at::log(at::rand({n, 3}, opts) * 0.5 + 0.1);
+  r.opacity_logits = at::randn({n}, opts) * 2;
+  r.features = at::randn({n, 2}, opts);
+  r.sh = at::zeros({n, 1, 3}, opts);
+  const gaussians::RenderResult blend = gaussians::render(r, pinhole, flat());
+  const gaussians::SurfaceLayer all = gaussians::renderSurfaceLayer(r, pinhole, 1.0001e-4);
+  EXPECT_LT((all.weight - blend.alpha.to(at::kFloat)).abs().max().item<double>(), 1e-6);
+
+  // The disc of ATiltedRoofKeepsItsSlope, 5 in front of the camera: its plane is
+  // z = 5 - tan(30) x; the ray through pixel u is x = z (u + 0.5 - 32) / 40, so it meets the
+  // plane at z = 5 / (1 + tan(30) (u + 0.5 - 32) / 40).
+  GaussianParams g = stack({5}, {0.99}, {{{1, 0}}});
+  const double half = 15.0 * M_PI / 180;
+  g.quats[0][0] = std::cos(half);
+  g.quats[0][2] = std::sin(half);
+  g.log_scales[0][0] = std::log(2.0);
+  g.log_scales[0][1] = std::log(2.0);
+  const gaussians::SurfaceLayer layer = gaussians::renderSurfaceLayer(g, pinhole);
+  for (int px : {22, 32, 42}) {
+    ASSERT_TRUE(layer.reached[32][px].item<bool>()) << px;
+    const double ray = (px + 0.5 - 32) / 40;
+    EXPECT_NEAR(layer.depth[32][px].item<double>(), 5 / (1 + std::tan(M_PI / 6) * ray), 0.01) << px;
+  }
+}
+
+// A photo's camera at the origin looking along +z: 64 x 48 pixels, focal length 60.
+RasterCamera photoCamera(double centre_x = 0) {
+  RasterCamera c;
+  c.width = 64;
+  c.height = 48;
+  c.fx = c.fy = 60;
+  c.cx = 32;
+  c.cy = 24;
+  c.tvec = {-centre_x, 0, 0};
+  return c;
+}
+
+// Flat Gaussians facing the camera at (x, y, z) triples: scale 0.3 (0.01 in z), opacity 0.8.
+GaussianParams flatAt(const std::vector<double>& centres) {
+  const auto n = static_cast<std::int64_t>(centres.size() / 3);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  GaussianParams g;
+  g.means = at::tensor(centres, opts).view({n, 3});
+  g.quats = at::zeros({n, 4}, opts);
+  g.quats.select(1, 0).fill_(1);
+  g.log_scales = at::full({n, 3}, std::log(0.3), opts);
+  g.log_scales.select(1, 2).fill_(std::log(0.01));
+  g.opacity_logits = at::full({n}, logit(0.8), opts);
+  g.sh = at::zeros({n, 1, 3}, opts);
+  return g;
+}
+
+double gapOf(const at::Tensor& sums, int i) {
+  return sums[i][1].item<double>() / sums[i][0].item<double>();
+}
+
+// Alone, a Gaussian makes the surface it is compared with (gap 0), and its weight is summed over
+// the pixels where it takes the transmittance below 0.5 only.
+TEST(SurfaceGapSums, ASurfaceAloneHasNoGap) {
+  const GaussianParams one = flatAt({0.1, 0, 6});
+  const at::Tensor sums = gaussians::surfaceGapSums(one, photoCamera());
+  const gaussians::SurfaceLayer layer = gaussians::renderSurfaceLayer(one, photoCamera());
+  ASSERT_GT(sums[0][0].item<double>(), 1);
+  EXPECT_NEAR(sums[0][0].item<double>(),
+              (layer.weight * layer.reached.to(at::kFloat)).sum().item<double>(), 1e-4);
+  EXPECT_NEAR(gapOf(sums, 0), 0.0, 1e-4);
+}
+
+// A faint floater in front of a roof keeps its gap (the roof lies 3 behind it where it is seen);
+// the middle of a roof made of 5 x 5 semi-transparent Gaussians has none (the median depth is
+// the roof's, where the expected depth would blend in the wall behind it); the wall far behind,
+// seen only around the roof, is judged there and not where the roof hides it; a Gaussian
+// behind the wall and one drawn only where no surface is reached (the wall's faint corner) sum
+// to nothing.
+TEST(SurfaceGapSums, FloatersKeepTheirGapAndHiddenGaussiansCountNowhere) {
+  std::vector<double> centres = {0, 0, 20, 0, 0, 2, 0, 0, 30, -1.55, -1.15, 3};
+  for (int i = -2; i <= 2; ++i) {
+    for (int j = -2; j <= 2; ++j) centres.insert(centres.end(), {0.3 * i, 0.3 * j, 5});
+  }
+  GaussianParams g = flatAt(centres);
+  g.log_scales[0][0] = g.log_scales[0][1] = std::log(8.0);  // the wall
+  g.opacity_logits[0] = logit(0.99);
+  g.opacity_logits[1] = logit(0.2);   // the floater
+  g.opacity_logits[3] = logit(0.05);  // faint, small, in the image's corner (pixel 1, 1)
+  g.log_scales[3][0] = g.log_scales[3][1] = std::log(0.1);
+  g.opacity_logits.narrow(0, 4, 25).fill_(logit(0.3));  // the roof
+  const at::Tensor sums = gaussians::surfaceGapSums(g, photoCamera());
+  // The floater: at least the roof 3 behind it (where it overhangs the roof, the wall 18).
+  EXPECT_GT(gapOf(sums, 1), 2.5);
+  EXPECT_LT(std::abs(gapOf(sums, 4 + 12)), 0.05);  // the roof's middle
+  EXPECT_LT(std::abs(gapOf(sums, 0)), 0.5);        // the wall
+  EXPECT_EQ(sums[2][0].item<double>(), 0.0);       // behind the wall
+  EXPECT_EQ(sums[3][0].item<double>(), 0.0);       // where the wall is too faint to be reached
+  // Two cameras: sums add up per camera (Trainer::renderedDepthResiduals takes |gap| per
+  // camera); a camera that does not see a Gaussian adds nothing for it.
+  const at::Tensor side = gaussians::surfaceGapSums(g, photoCamera(40));
+  EXPECT_EQ(side[1][0].item<double>(), 0.0);
+}
+
 TEST(SurfaceLayer, RefusesWhatItCannotRender) {
   const GaussianParams g = stack({2}, {0.9}, {{{1, 0}}});
-  RasterCamera pinhole = mapCamera();
-  pinhole.orthographic = false;
-  EXPECT_THROW(gaussians::renderSurfaceLayer(g, pinhole), Error);
   EXPECT_THROW(gaussians::renderSurfaceLayer(g, mapCamera(), 0.0), Error);
   EXPECT_THROW(gaussians::renderSurfaceLayer(g, mapCamera(), 1.0), Error);
   GaussianParams bad = g;

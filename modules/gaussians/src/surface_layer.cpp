@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -26,6 +27,10 @@ struct Splat {
   double depth;       // camera z of the centre
   double slope[2];    // d(depth on the ray) / d(pixel x, y)
   double max_offset;  // 3 standard deviations in camera z
+  // Pinhole: the centre in camera coordinates and the inverse camera-frame covariance (rows of
+  // the symmetric 3 x 3: xx, xy, xz, yy, yz, zz), for the density's maximum along a ray.
+  double centre[3];
+  double precision[6];
   raster::AlphaEllipse<double> ellipse;
   int tx0, tx1, ty0, ty1;  // the rasterizer's tile rectangle [tx0, tx1) x [ty0, ty1)
   std::int64_t index;
@@ -45,12 +50,24 @@ void expectRows(const at::Tensor& t, const char* name, std::int64_t n, std::int6
   }
 }
 
-}  // namespace
+// Pinhole: camera z of the density's maximum along the ray through pixel (fx, fy), minus the
+// centre's; 0 where the ray runs parallel to a flat Gaussian (d^T P d vanishes).
+double rayOffset(const Splat& s, const raster::Camera<double>& cam, double fx, double fy) {
+  const double d[3] = {(fx - cam.cx) / cam.fx, (fy - cam.cy) / cam.fy, 1.0};
+  const double* P = s.precision;
+  const double Pd[3] = {P[0] * d[0] + P[1] * d[1] + P[2] * d[2],
+                        P[1] * d[0] + P[3] * d[1] + P[4] * d[2],
+                        P[2] * d[0] + P[4] * d[1] + P[5] * d[2]};
+  const double dPd = Pd[0] * d[0] + Pd[1] * d[1] + Pd[2] * d[2];
+  const double dPp = Pd[0] * s.centre[0] + Pd[1] * s.centre[1] + Pd[2] * s.centre[2];
+  if (!(dPd > 0) || !std::isfinite(dPp / dPd)) return 0.0;
+  return dPp / dPd - s.depth;
+}
 
-SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& camera, double level) {
-  if (!camera.orthographic) {
-    throw Error("<surface layer>", "camera", "an orthographic (map) camera", "a pinhole camera");
-  }
+// The Gaussians' splats through `camera` in the rasterizer's compositing order, after checking
+// the shapes; `level` is checked here too.
+std::vector<Splat> sortedSplats(const GaussianParams& g, const RasterCamera& camera, double level,
+                                const raster::Camera<double>& cam) {
   if (!(level > raster::kMinTransmittance && level < 1)) {
     throw Error("<surface layer>", "level", "a transmittance in (1e-4, 1)", std::to_string(level));
   }
@@ -65,22 +82,19 @@ SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& cam
   expectRows(g.log_scales, "log_scales", n, 3);
   expectRows(g.opacity_logits, "opacity_logits", n, 0);
   if (g.opacity_gate.defined()) expectRows(g.opacity_gate, "opacity_gate", n, 0);
-  const std::int64_t C = g.features.defined() ? g.features.size(1) : 0;
-  if (C > 0) expectRows(g.features, "features", n, C);
+  if (g.features.defined() && g.features.size(1) > 0) {
+    expectRows(g.features, "features", n, g.features.size(1));
+  }
 
   const at::Tensor means = cpuDouble(g.means), quats = cpuDouble(g.quats),
                    log_scales = cpuDouble(g.log_scales);
   at::Tensor opacity = at::sigmoid(cpuDouble(g.opacity_logits));
   if (g.opacity_gate.defined()) opacity = opacity * cpuDouble(g.opacity_gate);
   opacity = opacity.contiguous();
-  const at::Tensor features = C > 0 ? cpuDouble(g.features) : at::Tensor();
   const double* pm = means.data_ptr<double>();
   const double* pq = quats.data_ptr<double>();
   const double* ps = log_scales.data_ptr<double>();
   const double* po = opacity.data_ptr<double>();
-  const double* pf = C > 0 ? features.data_ptr<double>() : nullptr;
-
-  const raster::Camera<double> cam = raster::toCamera<double>(raster::cameraParams(camera));
   const int W = camera.width, H = camera.height;
   const auto [tiles_x, tiles_y] = raster::tileGrid(W, H);
   std::vector<Splat> splats;
@@ -126,12 +140,98 @@ SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& cam
     s.slope[0] = kx / cam.fx;  // per pixel: world x = (pixel - cx) / fx
     s.slope[1] = ky / cam.fy;
     s.max_offset = 3 * std::sqrt(std::max(0.0, V[8]));
+    if (!cam.orthographic) {
+      // The ray t (x', y', 1) of a pinhole pixel meets the density's maximum at
+      // t = d^T P p / d^T P d, P = (R Rq) diag(1/s^2) (R Rq)^T the inverse covariance (exact from
+      // the scales: a flat Gaussian's P is its plane, and t the ray's crossing of it).
+      double Rc[9];  // camera-frame rotation of the Gaussian's axes
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          Rc[3 * r + c] = cam.R[3 * r] * e.Rq[c] + cam.R[3 * r + 1] * e.Rq[3 + c] +
+                          cam.R[3 * r + 2] * e.Rq[6 + c];
+        }
+      }
+      const int rows[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+      for (int k = 0; k < 6; ++k) {
+        double v = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double inv = 1 / std::max(e.s[a] * e.s[a], 1e-300);
+          v += Rc[3 * rows[k][0] + a] * Rc[3 * rows[k][1] + a] * inv;
+        }
+        s.precision[k] = v;
+      }
+      for (int k = 0; k < 3; ++k) s.centre[k] = e.p[k];
+    }
     splats.push_back(s);
   }
   std::stable_sort(splats.begin(), splats.end(), [](const Splat& l, const Splat& r) {
     const float dl = static_cast<float>(l.depth), dr = static_cast<float>(r.depth);
     return dl < dr;  // stable: equal float depths keep index order, as the rasterizer's sort
   });
+  return splats;
+}
+
+// Composites the sorted splats over the pixels of tile row `ty` in the rasterizer's order, each
+// pixel until its transmittance falls below `level`: blend(k, s, w) for every blend (k: the
+// pixel's index in the row, w: the blend weight), then reach(k, s, fx, fy) where the fall below
+// `level` happens (s: the splat that takes it there, fx, fy: the pixel's centre).
+template <typename Blend, typename Reach>
+void compositeTileRow(const std::vector<Splat>& splats, int ty, int W, int H, double level,
+                      Blend&& blend, Reach&& reach) {
+  const int r0 = ty * raster::kTileSize, r1 = std::min(H, r0 + raster::kTileSize);
+  const std::size_t pixels = static_cast<std::size_t>(r1 - r0) * W;
+  std::vector<double> trans(pixels, 1.0);
+  std::vector<char> done(pixels, 0);
+  for (const Splat& s : splats) {
+    if (ty < s.ty0 || ty >= s.ty1) continue;
+    for (int tx = s.tx0; tx < s.tx1; ++tx) {
+      if (!raster::alphaEllipseMeetsTile(s.ellipse, tx, ty)) continue;
+      const int c0 = tx * raster::kTileSize, c1 = std::min(W, c0 + raster::kTileSize);
+      for (int py = r0; py < r1; ++py) {
+        for (int px = c0; px < c1; ++px) {
+          const std::size_t k = static_cast<std::size_t>(py - r0) * W + px;
+          if (done[k]) continue;
+          const double fx = px + 0.5, fy = py + 0.5;
+          double G = 0;
+          bool clamped = false;
+          const double alpha =
+              raster::pixelAlpha(s.mean2d, s.conic, s.opacity, fx, fy, &G, &clamped);
+          if (alpha == 0) continue;
+          const double next = trans[k] * (1 - alpha);
+          if (next < raster::kMinTransmittance) {  // the rasterizer stops before it
+            done[k] = 1;
+            continue;
+          }
+          blend(k, s, alpha * trans[k]);
+          trans[k] = next;
+          if (next < level) {
+            done[k] = 1;
+            reach(k, s, fx, fy);
+          }
+        }
+      }
+    }
+  }
+}
+
+// Camera z of the surface at pixel (fx, fy) of the splat that takes the transmittance there.
+double surfaceDepth(const Splat& s, const raster::Camera<double>& cam, double fx, double fy) {
+  const double off = cam.orthographic
+                         ? s.slope[0] * (fx - s.mean2d[0]) + s.slope[1] * (fy - s.mean2d[1])
+                         : rayOffset(s, cam, fx, fy);
+  return s.depth + std::max(-s.max_offset, std::min(s.max_offset, off));
+}
+
+}  // namespace
+
+SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& camera, double level) {
+  const raster::Camera<double> cam = raster::toCamera<double>(raster::cameraParams(camera));
+  const std::vector<Splat> splats = sortedSplats(g, camera, level, cam);
+  const std::int64_t C = g.features.defined() ? g.features.size(1) : 0;
+  const at::Tensor features = C > 0 ? cpuDouble(g.features) : at::Tensor();
+  const double* pf = C > 0 ? features.data_ptr<double>() : nullptr;
+  const int W = camera.width, H = camera.height;
+  const int tiles_y = raster::tileGrid(W, H).second;
 
   SurfaceLayer out;
   const auto f32 = at::TensorOptions().dtype(at::kFloat);
@@ -151,50 +251,21 @@ SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& cam
       const int ty = static_cast<int>(b);
       const int r0 = ty * raster::kTileSize, r1 = std::min(H, r0 + raster::kTileSize);
       const std::size_t pixels = static_cast<std::size_t>(r1 - r0) * W;
-      std::vector<double> trans(pixels, 1.0), wsum(pixels, 0.0),
-          acc(pixels * static_cast<std::size_t>(C), 0.0);
-      std::vector<char> done(pixels, 0);
-      for (const Splat& s : splats) {
-        if (ty < s.ty0 || ty >= s.ty1) continue;
-        for (int tx = s.tx0; tx < s.tx1; ++tx) {
-          if (!raster::alphaEllipseMeetsTile(s.ellipse, tx, ty)) continue;
-          const int c0 = tx * raster::kTileSize, c1 = std::min(W, c0 + raster::kTileSize);
-          for (int py = r0; py < r1; ++py) {
-            for (int px = c0; px < c1; ++px) {
-              const std::size_t k = static_cast<std::size_t>(py - r0) * W + px;
-              if (done[k]) continue;
-              const double fx = px + 0.5, fy = py + 0.5;
-              double G = 0;
-              bool clamped = false;
-              const double alpha =
-                  raster::pixelAlpha(s.mean2d, s.conic, s.opacity, fx, fy, &G, &clamped);
-              if (alpha == 0) continue;
-              const double next = trans[k] * (1 - alpha);
-              if (next < raster::kMinTransmittance) {  // the rasterizer stops before it
-                done[k] = 1;
-                continue;
-              }
-              const double w = alpha * trans[k];
-              wsum[k] += w;
-              if (C > 0) {
-                const double* f = pf + s.index * C;
-                double* a = acc.data() + k * C;
-                for (std::int64_t ch = 0; ch < C; ++ch) a[ch] += w * f[ch];
-              }
-              trans[k] = next;
-              if (next < level) {
-                done[k] = 1;
-                const std::size_t o = static_cast<std::size_t>(py) * W + px;
-                reached[o] = true;
-                const double off =
-                    s.slope[0] * (fx - s.mean2d[0]) + s.slope[1] * (fy - s.mean2d[1]);
-                depth[o] = static_cast<float>(s.depth +
-                                              std::max(-s.max_offset, std::min(s.max_offset, off)));
-              }
-            }
-          }
+      std::vector<double> wsum(pixels, 0.0), acc(pixels * static_cast<std::size_t>(C), 0.0);
+      const auto blend = [&](std::size_t k, const Splat& s, double w) {
+        wsum[k] += w;
+        if (C > 0) {
+          const double* f = pf + s.index * C;
+          double* a = acc.data() + k * C;
+          for (std::int64_t ch = 0; ch < C; ++ch) a[ch] += w * f[ch];
         }
-      }
+      };
+      const auto reach = [&](std::size_t k, const Splat& s, double fx, double fy) {
+        const std::size_t o = static_cast<std::size_t>(r0) * W + k;
+        reached[o] = true;
+        depth[o] = static_cast<float>(surfaceDepth(s, cam, fx, fy));
+      };
+      compositeTileRow(splats, ty, W, H, level, blend, reach);
       for (std::size_t k = 0; k < pixels; ++k) {
         const std::size_t o = static_cast<std::size_t>(r0) * W + k;
         weight[o] = static_cast<float>(wsum[k]);
@@ -207,6 +278,72 @@ SurfaceLayer renderSurfaceLayer(const GaussianParams& g, const RasterCamera& cam
     }
   });
   return out;
+}
+
+at::Tensor surfaceGapSums(const GaussianParams& g, const RasterCamera& camera, double level) {
+  const raster::Camera<double> cam = raster::toCamera<double>(raster::cameraParams(camera));
+  const std::vector<Splat> splats = sortedSplats(g, camera, level, cam);
+  const int W = camera.width, H = camera.height;
+  const int tiles_y = raster::tileGrid(W, H).second;
+  // Per row of tiles, per splat it blends into a pixel that reaches the surface: the sums of w
+  // and w (D - z). Rows are summed in order afterwards, so the result does not depend on the
+  // threads.
+  struct RowSums {
+    std::vector<std::int64_t> index;
+    std::vector<double> weight, weighted_gap;
+  };
+  std::vector<RowSums> rows(static_cast<std::size_t>(tiles_y));
+  at::parallel_for(0, tiles_y, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b) {
+      const int ty = static_cast<int>(b);
+      const int r0 = ty * raster::kTileSize, r1 = std::min(H, r0 + raster::kTileSize);
+      const std::size_t pixels = static_cast<std::size_t>(r1 - r0) * W;
+      // Every blend of the row, resolved once its pixel's surface depth is known.
+      struct Blend {
+        std::uint32_t pixel;
+        std::uint32_t splat;  // position in `splats`
+        double w;
+      };
+      std::vector<Blend> blends;
+      std::vector<double> surface(pixels, std::numeric_limits<double>::quiet_NaN());
+      const Splat* first = splats.data();
+      compositeTileRow(
+          splats, ty, W, H, level,
+          [&](std::size_t k, const Splat& s, double w) {
+            blends.push_back(
+                {static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(&s - first), w});
+          },
+          [&](std::size_t k, const Splat& s, double fx, double fy) {
+            surface[k] = surfaceDepth(s, cam, fx, fy);
+          });
+      // The blends come splat by splat in order: one row entry per splat.
+      RowSums& out = rows[static_cast<std::size_t>(b)];
+      std::int64_t last = -1;
+      for (const Blend& e : blends) {
+        const double d = surface[e.pixel];
+        if (std::isnan(d)) continue;  // the pixel shows no surface
+        if (static_cast<std::int64_t>(e.splat) != last) {
+          last = e.splat;
+          out.index.push_back(splats[e.splat].index);
+          out.weight.push_back(0);
+          out.weighted_gap.push_back(0);
+        }
+        out.weight.back() += e.w;
+        out.weighted_gap.back() += e.w * (d - splats[e.splat].depth);
+      }
+    }
+  });
+  const std::int64_t n = g.means.size(0);
+  at::Tensor sums = at::zeros({n, 2}, at::TensorOptions().dtype(at::kDouble));
+  double* ps = sums.data_ptr<double>();
+  for (const RowSums& row : rows) {
+    for (std::size_t k = 0; k < row.index.size(); ++k) {
+      const std::int64_t i = row.index[k];
+      ps[2 * i] += row.weight[k];
+      ps[2 * i + 1] += row.weighted_gap[k];
+    }
+  }
+  return sums;
 }
 
 }  // namespace gaussians

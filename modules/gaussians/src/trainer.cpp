@@ -526,9 +526,21 @@ at::Tensor Trainer::renderedClassWeights(const std::vector<RasterCamera>& camera
 }
 
 at::Tensor Trainer::renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const {
-  const auto depth_map = [&](std::size_t k) { return renderDepth(cameras[k]).depth; };
+  // Against the median depth (where the transmittance falls below 0.5), over the pixels where
+  // the Gaussian is seen: the expected depth at a roof blends the roof with the street behind
+  // it, and a surface hidden in one view (behind a roof) is judged by the views that see it.
   c10::AutoGradMode no_grad(false);
-  return depthResiduals(state_->evaluationGaussians(), cameras, depth_map).to(at::kCPU);
+  const GaussianParams g = state_->evaluationGaussians();
+  at::Tensor weight = at::zeros({g.means.size(0)}, at::TensorOptions().dtype(at::kDouble));
+  at::Tensor gap = at::zeros_like(weight);
+  for (const RasterCamera& camera : cameras) {
+    const at::Tensor sums = surfaceGapSums(g, camera, 0.5);
+    weight += sums.select(1, 0);
+    gap += sums.select(1, 1).abs();
+  }
+  return at::where(weight > 0, gap / weight.clamp_min(1e-30),
+                   at::full_like(weight, std::numeric_limits<double>::infinity()))
+      .to(at::kFloat);
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }

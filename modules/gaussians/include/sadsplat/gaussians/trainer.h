@@ -17,8 +17,8 @@
 #include "sadsplat/gaussians/collective.h"
 #include "sadsplat/gaussians/drop_strategy.h"
 #include "sadsplat/gaussians/rasterizer.h"
-#include "sadsplat/gaussians/surface_layer.h"
 #include "sadsplat/gaussians/step_profile.h"
+#include "sadsplat/gaussians/surface_layer.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/train_config.h"
 #include "sadsplat/io/scene.h"
@@ -119,7 +119,7 @@ class Trainer {
   /// \brief The same for any feature image [H, W, C] (e.g. SurfaceLayer::features), on the
   /// device of the model.
   at::Tensor classCosines(const at::Tensor& features) const;
-  /// \brief The first surface of the current Gaussians through an orthographic camera: where
+  /// \brief The first surface of the current Gaussians through a camera: where
   /// the transmittance falls below `level` (surface_layer.h), the Gaussians as renderCamera
   /// draws them. On the CPU. `features` false: SurfaceLayer::features has 0 channels (the
   /// compositing skips them). `keep` as renderCamera's.
@@ -132,8 +132,10 @@ class Trainer {
   /// \throws sadsplat::Error when the model has no classes
   at::Tensor renderedClassWeights(const std::vector<RasterCamera>& cameras) const;
   /// \brief Per Gaussian [N] (float, on the CPU): the gap between its centre and the surface this
-  /// model renders through each camera where the Gaussian draws (contribution.h's
-  /// depthResiduals with renderDepth's maps), in scene units; +inf where no camera draws it.
+  /// model renders through each camera where the Gaussian is seen: sum over the cameras of
+  /// |Σ w (D - z)| over sum of Σ w, surface_layer.h's surfaceGapSums at level 0.5 (D the median
+  /// depth), in scene units; +inf where no camera sees it in front of a surface. Computed on the
+  /// CPU, one compositing pass per camera.
   at::Tensor renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
