@@ -15,7 +15,10 @@
 #       trainings + eval of any scene (a cache or directory, e.g. a real survey imported with
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
-#       scenes; and as the blend through the Gaussians: orthoblend_*.json), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); $OUT gets
+#       scenes; and as the blend through the Gaussians: orthoblend_*.json), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); ORTHO_SURFACE="1 2" the orthophoto
+#       of the Gaussians on the surface (eval --ortho --on-surface M: ortho_sM_*.json); KEEP_RUNS=1
+#       packs the run directories (no .ply / .pcd) into $OUT/runs_<scene>.tar.* (15 MiB parts);
+#       $OUT gets
 #       scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
 #       stopped at the deadline is evaluated from its checkpoint (partial_<name>.json; the
 #       summary says at which iteration it stopped). The deadline counts from the call's start
@@ -280,7 +283,11 @@ mode_scene() {
         { [ "${ORTHO:-0}" = 0 ] || "$bin" eval "$work/run_$name" --ortho --height blend \
             --min-views 0 > "$work/results/orthoblend_$name.json" 2>> "$work/results/eval_$name.log"; } &&
         { [ "${THREED:-0}" = 0 ] || "$bin" eval "$work/run_$name" --3d \
-            > "$work/results/3d_$name.json" 2>> "$work/results/eval_$name.log"; } || {
+            > "$work/results/3d_$name.json" 2>> "$work/results/eval_$name.log"; } &&
+        for m in ${ORTHO_SURFACE:-}; do
+          "$bin" eval "$work/run_$name" --ortho --on-surface "$m" \
+            > "$work/results/ortho_s${m}_$name.json" 2>> "$work/results/eval_$name.log" || exit 1
+        done || {
         echo "$name: stopped (rc $?)"
         # A training stopped at the deadline leaves its checkpoint: evaluate the model as it was
         # (metrics.json says at which iteration), so that a run too long for the call still says
@@ -293,6 +300,10 @@ mode_scene() {
     ) &
   done
   wait
+  if [ "${KEEP_RUNS:-0}" = 1 ]; then
+    tar cf - -C "$work" --exclude='*.pcd' --exclude='*.ply' run_* |
+      split -b 15M - "$OUT/runs_$tag.tar."
+  fi
   local summary="$OUT/scene_$tag.txt" f
   echo "== $(date -u +%F) $scene, ${ITERATIONS:-7000} iterations, $jobs at once, $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1)" > "$summary"
   for spec in "$@"; do
@@ -307,6 +318,9 @@ mode_scene() {
     fi
     f="$work/results/ortho_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
+    for f in "$work/results"/ortho_s*_"$name".json; do
+      [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); d=m["dsm"]["per_class"]; print("    ortho on surface %s: mIoU %.2f  uncovered %.1f %%  building %+.0f %%  DSM %.2f m (roofs %.2f, road %.2f)  map objects F1 %.2f" % (m["on_surface_m"], 100*m["miou"], 100*m["uncovered_share"], 100*m["area"]["building"]["relative_error"], m["dsm"]["rmse_m"], d["building"]["rmse_m"], d["road"]["rmse_m"], m["objects"]["f1"]))' "$f" >> "$summary"
+    done
     f="$work/results/3d_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    3d: point mIoU %.2f (weighted %.2f)  OA %.2f  opaque %d of %d: median %.2f m, p90 %.2f m, within 0.5 m %.1f %%, beyond 1 m %.1f %%  completeness %.1f %% (%s)" % (100*m["point_miou"], 100*m["weighted_miou"], 100*m["point_oacc"], m["opaque"], m["gaussians"], m["distance_median_m"], m["distance_p90_m"], 100*m["share_within_0.5_m"], 100*m["share_beyond_1.0_m"], 100*m["completeness_all"], " ".join("%s %.0f" % (k, 100*v) for k, v in m["completeness"].items() if v is not None)))' "$f" >> "$summary"
     f="$work/results/train_$name.log"
