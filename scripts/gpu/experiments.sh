@@ -301,7 +301,8 @@ mode_scene() {
   done
   wait
   if [ "${KEEP_RUNS:-0}" = 1 ]; then
-    tar cf - -C "$work" --exclude='*.pcd' --exclude='*.ply' run_* |
+    # shellcheck disable=SC2046  # the run directories' names, relative to $work
+    tar cf - -C "$work" --exclude='*.pcd' --exclude='*.ply' $(cd "$work" && ls -d run_*) |
       split -b 15M - "$OUT/runs_$tag.tar."
   fi
   local summary="$OUT/scene_$tag.txt" f
