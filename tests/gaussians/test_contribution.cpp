@@ -138,6 +138,58 @@ TEST(ClassWeightSums, GiveEachGaussianTheClassesOfThePixelsItDraws) {
                Error);
 }
 
+// The rendered depth map of the Gaussians themselves (what Trainer::renderedDepthResiduals uses).
+at::Tensor depthOf(const GaussianParams& g, const RasterCamera& c) {
+  gaussians::RenderSettings s;
+  s.sh_degree = 0;
+  s.features = false;
+  return gaussians::render(g, c, s).depth;
+}
+
+// Alone, a Gaussian is the surface: every pixel it draws renders its own depth, gap 0. A faint
+// Gaussian floating in front of an opaque wall draws where the rendered depth is mostly the
+// wall's: its gap is most of the distance between them, the wall's small. A Gaussian no camera
+// draws has no gap (+inf). Over several cameras the gaps average by the Gaussian's weights.
+TEST(DepthResiduals, AreTheGapsToTheRenderedSurfaceWhereEachGaussianDraws) {
+  const RasterCamera c = camera();
+  const GaussianParams one = gaussiansAt({0.1f, 0, 6});
+  const at::Tensor alone =
+      gaussians::depthResiduals(one, {c}, [&](std::size_t) { return depthOf(one, c); });
+  EXPECT_LT(alone[0].item<double>(), 1e-3);
+
+  GaussianParams g = gaussiansAt({0, 0, 8, 0, 0, 3, 0, 0, -5});
+  g.log_scales[0].fill_(std::log(3.0f));               // a wide wall
+  g.opacity_logits[0].fill_(std::log(0.99f / 0.01f));  // opaque
+  g.opacity_logits[1].fill_(std::log(0.2f / 0.8f));    // a faint floater, 5 in front
+  const at::Tensor gap =
+      gaussians::depthResiduals(g, {c}, [&](std::size_t) { return depthOf(g, c); });
+  ASSERT_EQ(gap.size(0), 3);
+  EXPECT_GT(gap[1].item<double>(), 2.5);           // the floater: far from what is rendered there
+  EXPECT_LT(gap[1].item<double>(), 5.0);           // but not beyond the wall
+  EXPECT_LT(gap[0].item<double>(), 0.5);           // the wall
+  EXPECT_TRUE(std::isinf(gap[2].item<double>()));  // behind the camera
+
+  // Over two cameras the gaps average by how much each Gaussian draws in each (its
+  // blendingWeightSums there).
+  const RasterCamera side = camera(3);
+  const at::Tensor gap_side =
+      gaussians::depthResiduals(g, {side}, [&](std::size_t) { return depthOf(g, side); });
+  const at::Tensor both = gaussians::depthResiduals(
+      g, {c, side}, [&](std::size_t k) { return depthOf(g, k == 0 ? c : side); });
+  const at::Tensor w0 = gaussians::blendingWeightSums(g, {c});
+  const at::Tensor w1 = gaussians::blendingWeightSums(g, {side});
+  for (int i = 0; i < 2; ++i) {
+    // (A camera that does not draw the Gaussian adds nothing: its gap alone is +inf.)
+    const double a = w0[i].item<double>(), b = w1[i].item<double>();
+    const double expected = ((a > 0 ? gap[i].item<double>() * a : 0.0) +
+                             (b > 0 ? gap_side[i].item<double>() * b : 0.0)) /
+                            (a + b);
+    EXPECT_NEAR(both[i].item<double>(), expected, 1e-3 * expected + 1e-5) << i;
+  }
+  EXPECT_THROW(gaussians::depthResiduals(g, {c}, [&](std::size_t) { return depthOf(g, c).t(); }),
+               Error);
+}
+
 // The L0 term's weights, by hand: w = (1 + c / median c)^-gamma / mean.
 TEST(InverseContributionWeights, FallWithTheContributionAndAverageOne) {
   // Sorted [0, 1, 1, 3]: the median (lower middle value) is 1; gamma 1 gives 1, 1/2, 1/2, 1/4

@@ -242,7 +242,7 @@ TEST(SurfaceGapSums, FloatersKeepTheirGapAndHiddenGaussiansCountNowhere) {
   EXPECT_LT(std::abs(gapOf(sums, 0)), 0.5);        // the wall
   EXPECT_EQ(sums[2][0].item<double>(), 0.0);       // behind the wall
   EXPECT_EQ(sums[3][0].item<double>(), 0.0);       // where the wall is too faint to be reached
-  // Two cameras: sums add up per camera (Trainer::renderedDepthResiduals takes |gap| per
+  // Two cameras: sums add up per camera (SurfaceDepth::kMedianWhereSeen takes |gap| per
   // camera); a camera that does not see a Gaussian adds nothing for it.
   const at::Tensor side = gaussians::surfaceGapSums(g, photoCamera(40));
   EXPECT_EQ(side[1][0].item<double>(), 0.0);

@@ -2,9 +2,11 @@
 
 #include <c10/core/GradMode.h>
 
+#include <limits>
 #include <string>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/gaussians/view_coverage.h"
 
 namespace sadsplat {
 namespace gaussians {
@@ -99,6 +101,32 @@ at::Tensor classWeightSums(const GaussianParams& gaussians,
     total += weightedPixelSums(gaussians, camera, onehot);
   }
   return total;
+}
+
+at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<RasterCamera>& cameras,
+                          const std::function<at::Tensor(std::size_t)>& depth_map) {
+  const at::Tensor means = gaussians.means.detach().to(at::kDouble);
+  at::Tensor weight = at::zeros({means.size(0)}, means.options());
+  at::Tensor gap = at::zeros_like(weight);
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    const RasterCamera& camera = cameras[k];
+    const at::Tensor depth = depth_map(k).to(gaussians.means.device(), at::kFloat);
+    if (depth.dim() != 2 || depth.size(0) != camera.height || depth.size(1) != camera.width) {
+      throw Error("<depthResiduals>", "depth map of camera " + std::to_string(k),
+                  "[" + std::to_string(camera.height) + ", " + std::to_string(camera.width) + "]",
+                  "another shape");
+    }
+    const at::Tensor sums =
+        weightedPixelSums(gaussians, camera, at::stack({at::ones_like(depth), depth}, 2))
+            .to(at::kDouble);
+    const at::Tensor z = cameraDepths(means, camera);
+    const at::Tensor w = sums.select(1, 0);
+    weight += w;
+    gap += (sums.select(1, 1) - w * z).abs();
+  }
+  return at::where(weight > 0, gap / weight.clamp_min(1e-30),
+                   at::full_like(weight, std::numeric_limits<double>::infinity()))
+      .to(at::kFloat);
 }
 
 at::Tensor inverseContributionWeights(const at::Tensor& contribution, double gamma) {

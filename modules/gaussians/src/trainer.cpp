@@ -525,12 +525,14 @@ at::Tensor Trainer::renderedClassWeights(const std::vector<RasterCamera>& camera
       .to(at::kCPU);
 }
 
-at::Tensor Trainer::renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const {
-  // Against the median depth (where the transmittance falls below 0.5), over the pixels where
-  // the Gaussian is seen: the expected depth at a roof blends the roof with the street behind
-  // it, and a surface hidden in one view (behind a roof) is judged by the views that see it.
+at::Tensor Trainer::renderedDepthResiduals(const std::vector<RasterCamera>& cameras,
+                                           SurfaceDepth against) const {
   c10::AutoGradMode no_grad(false);
   const GaussianParams g = state_->evaluationGaussians();
+  if (against == SurfaceDepth::kExpected) {
+    const auto depth_map = [&](std::size_t k) { return renderDepth(cameras[k]).depth; };
+    return depthResiduals(g, cameras, depth_map).to(at::kCPU);
+  }
   at::Tensor weight = at::zeros({g.means.size(0)}, at::TensorOptions().dtype(at::kDouble));
   at::Tensor gap = at::zeros_like(weight);
   for (const RasterCamera& camera : cameras) {

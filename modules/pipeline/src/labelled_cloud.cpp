@@ -31,7 +31,10 @@ pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
 
 std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene) {
   const at::Tensor gaps =
-      trainer.renderedDepthResiduals(trainingCameras(scene)).to(at::kFloat).contiguous();
+      trainer
+          .renderedDepthResiduals(trainingCameras(scene), gaussians::SurfaceDepth::kMedianWhereSeen)
+          .to(at::kFloat)
+          .contiguous();
   return std::vector<float>(gaps.data_ptr<float>(), gaps.data_ptr<float>() + gaps.numel());
 }
 

@@ -183,7 +183,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   // The Gaussians the map is made of (undefined: all).
   at::Tensor keep;
   if (options.max_surface_gap > 0) {
-    keep = trainer.renderedDepthResiduals(options.cameras) <= options.max_surface_gap;
+    keep = trainer.renderedDepthResiduals(options.cameras, gaussians::SurfaceDepth::kExpected) <=
+           options.max_surface_gap;
     if (progress) {
       *progress << "  on the surface (within " << options.max_surface_gap
                 << "): " << keep.sum().item<std::int64_t>() << " of " << keep.numel()

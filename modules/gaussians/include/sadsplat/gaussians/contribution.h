@@ -50,6 +50,22 @@ at::Tensor classWeightSums(const GaussianParams& gaussians,
                            const std::function<at::Tensor(std::size_t)>& class_map,
                            int num_classes);
 
+/// \brief Per Gaussian, how far its centre lies from the surface the views render where it
+/// draws: sum_k |sum_p w(p) (D_k(p) - z_k)| / sum_k sum_p w(p), with w the Gaussian's blending
+/// weight in camera k, D_k camera k's rendered depth map and z_k the Gaussian's depth in camera
+/// k. Per camera that is the gap between the Gaussian's depth and the mean rendered depth over
+/// the pixels it draws, averaged over the cameras by how much it draws in each. A Gaussian on
+/// the surface the views agree on scores about its own thickness; one floating in front of that
+/// surface or sunk behind it scores the gap.
+/// \param[in] gaussians the Gaussians (any device; no gradient is taken into them)
+/// \param[in] cameras pinhole views to sum over
+/// \param[in] depth_map camera k's rendered depth ([H, W] float, any device), asked for once per
+/// camera in order
+/// \return float [N] on the device of the Gaussians, in scene units; +inf where no camera draws
+/// the Gaussian
+at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<RasterCamera>& cameras,
+                          const std::function<at::Tensor(std::size_t)>& depth_map);
+
 /// \brief Weights that fall with the contribution: w = (1 + c / median(c))^-gamma, scaled to mean
 /// 1. A Gaussian that contributes nothing gets the largest weight, one at the median 2^-gamma of
 /// it; gamma 0 gives all ones. Where the median is 0 (most Gaussians contribute nothing), the mean

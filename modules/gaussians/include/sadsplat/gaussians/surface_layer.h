@@ -5,7 +5,7 @@
 /// (0.5: the median depth of 2DGS / RaDe-GS). The class and the height a map should show are
 /// those of that surface, not the blend through it that RenderResult::depth and ::features give
 /// (a floater or a roof's edge above the ground pulls the expected depth half-way between); the
-/// surface check of a photo's Gaussians (Trainer::renderedDepthResiduals) compares with it too.
+/// surface check of the cloud's Gaussians (surfaceGapSums) compares with it too.
 
 #include <ATen/ATen.h>
 

@@ -60,6 +60,19 @@ enum class TrainerViews { kLoaded, kCamerasOnly };
 ///
 /// Randomness (view order, split samples, feature initialisation) is derived from the seed and
 /// the iteration, so a run resumed from a checkpoint continues exactly as it would have.
+/// \brief The surface a Gaussian's gap is measured against (Trainer::renderedDepthResiduals).
+enum class SurfaceDepth {
+  /// The expected depth (renderDepth's alpha-weighted mean) over every pixel the Gaussian
+  /// draws: contribution.h's depthResiduals. Keeps more of the roofs that oblique photos see at
+  /// their silhouettes; the map products (`ortho --on-surface`) use it.
+  kExpected,
+  /// The median depth (where the transmittance falls below 0.5) over the pixels where the
+  /// Gaussian is composited before it (seen, not hidden): surface_layer.h's surfaceGapSums, one
+  /// CPU compositing pass per camera. More of the kept cloud lies on a true surface; the cloud
+  /// (`extract --on-surface`, `eval --3d`) uses it.
+  kMedianWhereSeen,
+};
+
 class Trainer {
  public:
   /// \param[in] scene an imported scene with sparse points and at least one training view
@@ -132,11 +145,10 @@ class Trainer {
   /// \throws sadsplat::Error when the model has no classes
   at::Tensor renderedClassWeights(const std::vector<RasterCamera>& cameras) const;
   /// \brief Per Gaussian [N] (float, on the CPU): the gap between its centre and the surface this
-  /// model renders through each camera where the Gaussian is seen: sum over the cameras of
-  /// |Σ w (D - z)| over sum of Σ w, surface_layer.h's surfaceGapSums at level 0.5 (D the median
-  /// depth), in scene units; +inf where no camera sees it in front of a surface. Computed on the
-  /// CPU, one compositing pass per camera.
-  at::Tensor renderedDepthResiduals(const std::vector<RasterCamera>& cameras) const;
+  /// model renders through each camera, in scene units; +inf where no camera shows it on a
+  /// surface. `against` says which surface and over which pixels (SurfaceDepth).
+  at::Tensor renderedDepthResiduals(const std::vector<RasterCamera>& cameras,
+                                    SurfaceDepth against) const;
   /// \brief Classes the model decodes (0: a plain 3DGS model).
   int numClasses() const;
 

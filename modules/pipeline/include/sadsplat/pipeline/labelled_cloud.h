@@ -36,8 +36,9 @@ pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
                                              const io::Scene& scene);
 
 /// \brief Per Gaussian of trainer.toCloud(), in its order: how far it lies from the surface the
-/// model renders through the training views of `scene` where it draws
-/// (Trainer::renderedDepthResiduals), in scene units; +inf where no training view draws it.
+/// model renders through the training views of `scene` where it is seen (the median depth:
+/// Trainer::renderedDepthResiduals, SurfaceDepth::kMedianWhereSeen), in scene units; +inf where
+/// no training view shows it in front of a surface.
 /// `extract --on-surface M` keeps the Gaussians at most M from it: floaters and Gaussians sunk
 /// inside volumes go, the surfaces stay.
 std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene);

@@ -78,9 +78,10 @@ struct OrthoRenderOptions {
   /// share of the point's depth (gaussians::seenUnoccluded).
   double depth_tolerance = 0.02;
   /// Not on by default: the map is made of the Gaussians at most this far (scene units) from the
-  /// surface the training cameras render where they draw (Trainer::renderedDepthResiduals, as
-  /// `extract --on-surface`); floaters and Gaussians off the surfaces drop out of the orthophoto,
-  /// the class map and the DSM. 0: every Gaussian.
+  /// surface the training cameras render where they draw (Trainer::renderedDepthResiduals
+  /// against the expected depth, SurfaceDepth::kExpected: on the maps it kept more roofs than the
+  /// cloud's median-depth check); floaters and Gaussians off the surfaces drop out of the
+  /// orthophoto, the class map and the DSM. 0: every Gaussian.
   double max_surface_gap = 0;
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
 };
