@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""The benchmark's 3D and map table from `scripts/gpu/experiments.sh scene` results.
+
+usage: map_table.py DIR
+DIR holds one folder per scene run, as experiments.sh leaves them under /tmp/sadsplat-scene:
+<scene>[_pl][_<capture>]/results/{metrics,ortho,3d}_<name>.json (ORTHO=1 THREED=1). Prints a
+Markdown table: per scene, capture and run the view mIoU, the cloud's 3D point mIoU and
+geometry, the class map's mIoU and its gap to the views, the DSM's RMSE on roofs and roads,
+the building area error and object F1 (map regions; the cloud's Euclidean clusters).
+"""
+import glob
+import json
+import os
+import sys
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def pct(v):
+    return "—" if v is None else "%.1f" % (100 * v)
+
+
+def main():
+    root = sys.argv[1]
+    rows = []
+    for metrics in sorted(glob.glob(os.path.join(root, "*", "results", "metrics_*.json"))):
+        results = os.path.dirname(metrics)
+        folder = os.path.basename(os.path.dirname(results))
+        name = os.path.basename(metrics)[len("metrics_"):-len(".json")]
+        capture = "grid-oblique" if folder.endswith("_grid-oblique") else "orbit"
+        scene = folder.replace("_grid-oblique", "").replace("_pl", "")
+        method = {"none": "Net-1", "full": "full"}.get(name, name)
+        m = load(metrics)
+        o = load(os.path.join(results, "ortho_%s.json" % name))
+        t = load(os.path.join(results, "3d_%s.json" % name))
+        dsm = o["dsm"]["per_class"]
+        building = o["area"].get("building")
+        on1 = [s for s in t.get("on_surface", []) if s["max_gap_m"] == 1.0]
+        rows.append((scene, capture, method, [
+            "%d" % m["num_gaussians"],
+            pct(m["miou"]),
+            pct(t["point_miou"]),
+            "%s / %.1f" % (pct(t["share_within_0.5_m"]), t["distance_p90_m"]),
+            "%s (%+.1f)" % (pct(o["miou"]), 100 * (o["miou"] - m["miou"])),
+            "%.2f / %.2f / %.2f" % (o["dsm"]["rmse_m"],
+                                    dsm["building"]["rmse_m"] if "building" in dsm else float("nan"),
+                                    dsm["road"]["rmse_m"]),
+            "%+.0f %%" % (100 * building["relative_error"]) if building else "—",
+            "%.2f / %.2f" % (o["objects"]["f1"], t["objects"]["f1"]) if "objects" in t else "—",
+            "%s (%d %%)" % (pct(on1[0]["share_within_0.5_m"]),
+                            round(100 * on1[0]["gaussians"] / t["gaussians"])) if on1 else "—",
+        ]))
+    order = {"Net-1": 0, "full": 1}
+    rows.sort(key=lambda r: (r[0], r[1] != "orbit", order.get(r[2], 9)))
+    print("| scene | capture | run | Gaussians | view mIoU | 3D point mIoU | opaque within 0.5 m / p90 (m) "
+          "| class map mIoU (− views) | DSM RMSE all / roofs / road (m) | building area "
+          "| building F1 map / cloud | checked cloud (M = 1 m): within 0.5 m (kept) |")
+    print("|---|---|---|---:|---:|---:|---|---|---|---:|---|---|")
+    for scene, capture, method, cells in rows:
+        print("| %s | %s | %s | %s |" % (scene, capture, method, " | ".join(cells)))
+
+
+if __name__ == "__main__":
+    main()
