@@ -46,8 +46,9 @@ class ExtractCommand : public Command {
     c->add_flag("--negative", negative_, "keep every class except this one");
     c->add_option("--on-surface", on_surface_,
                   "a run directory only: keep only the Gaussians at most this far (scene units, "
-                  "metres for georeferenced or synth scenes) from the surface the training views "
-                  "render where they draw: floaters and Gaussians inside volumes go");
+                  "metres for georeferenced or synth scenes) from the surface (median depth) the "
+                  "training views render where they see it: floaters and Gaussians inside "
+                  "volumes go");
     return c;
   }
 
@@ -93,7 +94,7 @@ class ExtractCommand : public Command {
       const auto read = [&](const std::string& p) {
         if (on_surface_ == 0) return io::readGaussians(p);
         const auto kept = pipeline::gaussiansOnSurface(in_, io::readGaussians(p),
-                                                       static_cast<float>(on_surface_));
+                                                       static_cast<float>(on_surface_), &std::cerr);
         std::cout << "on the surface (within " << on_surface_ << "): " << kept.size()
                   << " Gaussians\n";
         return kept;

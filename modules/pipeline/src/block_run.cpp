@@ -190,8 +190,7 @@ double BlockRun::train(const gaussians::TrainConfig& config) {
     block_options.out = block_dir.path();
     block_options.collective = nullptr;
     block_options.resume = o.resume && io::RunDirectory::hasCheckpoint(block_dir.path());
-    sayBlock(o.progress, block, partition_, scene_,
-             block_options.resume ? "resuming" : "training");
+    sayBlock(o.progress, block, partition_, scene_, block_options.resume ? "resuming" : "training");
     seconds += trainRun(block_options, config, geo::blockScene(scene_, block));
   }
   if (b.rank == 0 && b.wait_for_ranks) waitForOtherRanks(o, partition_, iterations, b);
@@ -214,8 +213,8 @@ void BlockRun::merge() const {
     const io::RunDirectory block_dir = dir.block(block.index);
     if (!io::RunDirectory::hasCheckpoint(block_dir.path()))
       throw Error(block_dir.path(), "checkpoint.bin", "a trained block", "missing");
-    const auto block_config = gaussians::TrainConfig::fromJson(
-        io::readWholeFile(block_dir.config()), block_dir.config());
+    const auto block_config =
+        gaussians::TrainConfig::fromJson(io::readWholeFile(block_dir.config()), block_dir.config());
     const io::RunRecord record = block_dir.readRecord(false);
     if (record.iterations < block_config.iterations || !io::RunDirectory::isRun(block_dir.path()))
       throw Error(block_dir.runJson(), "iterations",
@@ -261,7 +260,8 @@ void BlockRun::merge() const {
   io::writeTextFileAtomically(dir.config(), trainer.config().toJson());
   writeTrainedRun(dir, trainer, scene_,
                   io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
-                                trainer.iteration(), seconds});
+                                trainer.iteration(), seconds},
+                  o.progress);
   if (o.progress) {
     *o.progress << "merged " << trained.size() << " blocks: " << trainer.numGaussians()
                 << " Gaussians (of " << total << " in the blocks, each keeping its cell's), the "

@@ -9,6 +9,7 @@
 
 #include "background_task.h"
 #include "sadsplat/common/semantic_cloud.h"
+#include "sadsplat/gaussians/device.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
@@ -20,7 +21,6 @@
 #include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/semantic_drop/drop_strategy.h"
-#include "sadsplat/gaussians/device.h"
 #include "training_report.h"
 
 namespace sadsplat {
@@ -54,9 +54,9 @@ gaussians::TrainConfig runConfiguration(const TrainRunOptions& o,
 }
 
 void writeModel(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
-                const io::Scene& scene) {
+                const io::Scene& scene, std::ostream* progress) {
   const std::vector<ClassInfo>& classes = scene.classes;
-  const auto cloud = labelledCloud(trainer, scene);
+  const auto cloud = labelledCloud(trainer, scene, progress);
   io::PlyWriteOptions ply;
   // A scene without classes trains plain 3DGS: a standard PLY without semantic properties.
   ply.semantic = !classes.empty();
@@ -189,10 +189,10 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config) 
 }
 
 void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
-                     const io::Scene& scene, const io::RunRecord& record) {
+                     const io::Scene& scene, const io::RunRecord& record, std::ostream* progress) {
   trainer.saveCheckpoint(dir.checkpoint());
   dir.writeRecord(record);
-  writeModel(dir, trainer, scene);
+  writeModel(dir, trainer, scene, progress);
   if (!scene.classes.empty()) io::writeClassesJson(dir.classes(), scene.classes);
   if (scene.georeference) {
     // The model's frame: east-north-up metres around the origin (for GIS outputs and viewers).
@@ -230,11 +230,9 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
     return previous_seconds +
            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  Checkpoints checkpoints(dir,
-                          io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
-                                        first, 0},
-                          writer,
-                          first);
+  Checkpoints checkpoints(
+      dir, io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device), first, 0}, writer,
+      first);
   const int kill_at = faultKillIteration(o);
   report.atCap(o.resume && trainer.numGaussians() >= config.max_gaussians);
   report.begin(first);
@@ -268,7 +266,8 @@ double trainRun(const TrainRunOptions& o, const gaussians::TrainConfig& config_i
   if (!writer) return total;
   writeTrainedRun(dir, trainer, scene,
                   io::RunRecord{o.scene, o.scale, gaussians::choiceName(config.device),
-                                trainer.iteration(), total});
+                                trainer.iteration(), total},
+                  o.progress);
   return total;
 }
 

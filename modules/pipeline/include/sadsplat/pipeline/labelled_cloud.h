@@ -15,6 +15,7 @@
 
 #include <pcl/point_cloud.h>
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -32,16 +33,20 @@ namespace pipeline {
 /// \param[in] trainer a trained model
 /// \param[in] scene its scene: the cameras of the views marked `train` are rendered (no pixels
 /// are read)
+/// \param[out] progress when given, a line before the pass (two renders per training view) and
+/// its time after
 pcl::PointCloud<GaussianPoint> labelledCloud(const gaussians::Trainer& trainer,
-                                             const io::Scene& scene);
+                                             const io::Scene& scene,
+                                             std::ostream* progress = nullptr);
 
 /// \brief Per Gaussian of trainer.toCloud(), in its order: how far it lies from the surface the
 /// model renders through the training views of `scene` where it is seen (the median depth:
 /// Trainer::renderedDepthResiduals, SurfaceDepth::kMedianWhereSeen), in scene units; +inf where
 /// no training view shows it in front of a surface.
 /// `extract --on-surface M` keeps the Gaussians at most M from it: floaters and Gaussians sunk
-/// inside volumes go, the surfaces stay.
-std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene);
+/// inside volumes go, the surfaces stay. `progress` as labelledCloud's.
+std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scene& scene,
+                               std::ostream* progress = nullptr);
 
 /// \brief The run's model as written (`model`: its model.ply, labels as stored) without the
 /// Gaussians more than `max_gap` scene units from the surface its training views render where
@@ -49,11 +54,12 @@ std::vector<float> surfaceGaps(const gaussians::Trainer& trainer, const io::Scen
 /// \param[in] run_dir a trained run (its checkpoint and scene cache are read)
 /// \param[in] model the run's Gaussians in the checkpoint's order (its model.ply)
 /// \param[in] max_gap > 0
+/// \param[out] progress as labelledCloud's
 /// \throws sadsplat::Error for a bad max_gap, a run that cannot be opened, or a model that is not
 /// the checkpoint's (another count)
 pcl::PointCloud<GaussianPoint> gaussiansOnSurface(const std::string& run_dir,
                                                   const pcl::PointCloud<GaussianPoint>& model,
-                                                  float max_gap);
+                                                  float max_gap, std::ostream* progress = nullptr);
 
 }  // namespace pipeline
 }  // namespace sadsplat

@@ -68,9 +68,11 @@ double trainRun(const TrainRunOptions& options, const gaussians::TrainConfig& co
 
 /// \brief Writes the files of a trained model into a run directory: checkpoint.bin, run.json
 /// (`record`), model.ply / model.pcd, with classes the semantic clouds and classes.json, and a
-/// georeferenced scene's georeference.json.
+/// georeferenced scene's georeference.json. `progress`: labelledCloud's line for the classes of
+/// the Gaussians.
 void writeTrainedRun(const io::RunDirectory& dir, const gaussians::Trainer& trainer,
-                     const io::Scene& scene, const io::RunRecord& record);
+                     const io::Scene& scene, const io::RunRecord& record,
+                     std::ostream* progress = nullptr);
 
 }  // namespace pipeline
 }  // namespace sadsplat
