@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,9 @@ class Stopwatch {
   ~Stopwatch() {
     if (!out_) return;
     const std::chrono::duration<double> s = std::chrono::steady_clock::now() - start_;
-    *out_ << " " << std::fixed << std::setprecision(1) << s.count() << " s\n" << std::defaultfloat;
+    std::ostringstream seconds;  // the caller's stream keeps its own format
+    seconds << std::fixed << std::setprecision(1) << s.count();
+    *out_ << " " << seconds.str() << " s\n";
   }
   Stopwatch(const Stopwatch&) = delete;
   Stopwatch& operator=(const Stopwatch&) = delete;
