@@ -56,10 +56,6 @@ struct StepStats {
 /// cameras (a trainer that renders a trained model).
 enum class TrainerViews { kLoaded, kCamerasOnly };
 
-/// \brief Trains Gaussians on a scene.
-///
-/// Randomness (view order, split samples, feature initialisation) is derived from the seed and
-/// the iteration, so a run resumed from a checkpoint continues exactly as it would have.
 /// \brief The surface a Gaussian's gap is measured against (Trainer::renderedDepthResiduals).
 enum class SurfaceDepth {
   /// The expected depth (renderDepth's alpha-weighted mean) over every pixel the Gaussian
@@ -73,6 +69,10 @@ enum class SurfaceDepth {
   kMedianWhereSeen,
 };
 
+/// \brief Trains Gaussians on a scene.
+///
+/// Randomness (view order, split samples, feature initialisation) is derived from the seed and
+/// the iteration, so a run resumed from a checkpoint continues exactly as it would have.
 class Trainer {
  public:
   /// \param[in] scene an imported scene with sparse points and at least one training view
