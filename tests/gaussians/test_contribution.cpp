@@ -5,24 +5,14 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/contribution.h"
+#include "test_support/photo_camera.h"
 
 namespace sadsplat {
 namespace {
 
 using gaussians::GaussianParams;
 using gaussians::RasterCamera;
-
-// 64x48 pixels, focal length 60, at the origin looking along +z.
-RasterCamera camera(double centre_x = 0) {
-  RasterCamera c;
-  c.width = 64;
-  c.height = 48;
-  c.fx = c.fy = 60;
-  c.cx = 32;
-  c.cy = 24;
-  c.tvec = {-centre_x, 0, 0};
-  return c;
-}
+using test::smallPhotoCamera;
 
 // Isotropic Gaussians at `centres` (x, y, z triples) with scale 0.3 and opacity 0.8.
 GaussianParams gaussiansAt(const std::vector<float>& centres) {
@@ -48,30 +38,32 @@ double alphaSum(const GaussianParams& g, const RasterCamera& c) {
 TEST(Contribution, ScoresSumToTheRenderedAlphaAndHiddenOrUnseenGaussiansScoreZero) {
   // In front; right behind it (partly hidden); behind the camera; far outside the image.
   const GaussianParams g = gaussiansAt({0, 0, 5, 0, 0, 8, 0, 0, -5, 40, 0, 5});
-  const at::Tensor score = gaussians::blendingWeightSums(g, {camera()});
+  const at::Tensor score = gaussians::blendingWeightSums(g, {smallPhotoCamera()});
   ASSERT_EQ(score.size(0), 4);
   EXPECT_GT(score[0].item<double>(), 10.0);  // covers many pixels at up to 0.8
   EXPECT_GT(score[1].item<double>(), 0.0);
   EXPECT_LT(score[1].item<double>(), score[0].item<double>());  // behind the first
   EXPECT_EQ(score[2].item<double>(), 0.0);
   EXPECT_EQ(score[3].item<double>(), 0.0);
-  EXPECT_NEAR(score.sum().item<double>(), alphaSum(g, camera()), 1e-3 * alphaSum(g, camera()));
+  EXPECT_NEAR(score.sum().item<double>(), alphaSum(g, smallPhotoCamera()),
+              1e-3 * alphaSum(g, smallPhotoCamera()));
 
   // Alone, a Gaussian's score is its alpha image's sum.
   const GaussianParams one = gaussiansAt({0, 0, 8});
-  EXPECT_NEAR(gaussians::blendingWeightSums(one, {camera()})[0].item<double>(),
-              alphaSum(one, camera()), 1e-3 * alphaSum(one, camera()));
+  EXPECT_NEAR(gaussians::blendingWeightSums(one, {smallPhotoCamera()})[0].item<double>(),
+              alphaSum(one, smallPhotoCamera()), 1e-3 * alphaSum(one, smallPhotoCamera()));
 }
 
 TEST(Contribution, SumsOverTheViewsAndAppliesTheGate) {
   GaussianParams g = gaussiansAt({0, 0, 5, 1, 0, 6});
-  const at::Tensor a = gaussians::blendingWeightSums(g, {camera(0)});
-  const at::Tensor b = gaussians::blendingWeightSums(g, {camera(1)});
-  const at::Tensor both = gaussians::blendingWeightSums(g, {camera(0), camera(1)});
+  const at::Tensor a = gaussians::blendingWeightSums(g, {smallPhotoCamera(0)});
+  const at::Tensor b = gaussians::blendingWeightSums(g, {smallPhotoCamera(1)});
+  const at::Tensor both =
+      gaussians::blendingWeightSums(g, {smallPhotoCamera(0), smallPhotoCamera(1)});
   EXPECT_TRUE(at::allclose(both, a + b, 1e-5, 1e-4));
   // A closed gate: the Gaussian renders nothing and scores 0; the other one is no longer hidden.
   g.opacity_gate = at::tensor({0.0f, 1.0f});
-  const at::Tensor gated = gaussians::blendingWeightSums(g, {camera(0)});
+  const at::Tensor gated = gaussians::blendingWeightSums(g, {smallPhotoCamera(0)});
   EXPECT_EQ(gated[0].item<double>(), 0.0);
   EXPECT_GT(gated[1].item<double>(), a[1].item<double>());
 }
@@ -80,7 +72,7 @@ TEST(Contribution, SumsOverTheViewsAndAppliesTheGate) {
 // any per-pixel values is sum_p alpha(p) values(p, k), computed here from the alpha image.
 TEST(WeightedPixelSums, AreTheAlphaWeightedSumsOfTheValuesForOneGaussian) {
   const GaussianParams one = gaussiansAt({0.2f, -0.1f, 6});
-  const RasterCamera c = camera();
+  const RasterCamera c = smallPhotoCamera();
   gaussians::RenderSettings s;
   s.sh_degree = 0;
   s.features = false;
@@ -108,7 +100,7 @@ TEST(WeightedPixelSums, AreTheAlphaWeightedSumsOfTheValuesForOneGaussian) {
 // labelled pixels; pixels without a class (-1 or >= the count) count for none.
 TEST(ClassWeightSums, GiveEachGaussianTheClassesOfThePixelsItDraws) {
   const GaussianParams g = gaussiansAt({-1.5f, 0, 5, 1.5f, 0, 5, -1.5f, 0, 30});
-  const RasterCamera c = camera();
+  const RasterCamera c = smallPhotoCamera();
   const at::Tensor column =
       at::arange(c.width, at::kLong).view({1, c.width}).expand({c.height, c.width});
   const at::Tensor halves = (column >= c.width / 2).to(at::kLong).contiguous();
@@ -151,7 +143,7 @@ at::Tensor depthOf(const GaussianParams& g, const RasterCamera& c) {
 // wall's: its gap is most of the distance between them, the wall's small. A Gaussian no camera
 // draws has no gap (+inf). Over several cameras the gaps average by the Gaussian's weights.
 TEST(DepthResiduals, AreTheGapsToTheRenderedSurfaceWhereEachGaussianDraws) {
-  const RasterCamera c = camera();
+  const RasterCamera c = smallPhotoCamera();
   const GaussianParams one = gaussiansAt({0.1f, 0, 6});
   const at::Tensor alone =
       gaussians::depthResiduals(one, {c}, [&](std::size_t) { return depthOf(one, c); });
@@ -171,7 +163,7 @@ TEST(DepthResiduals, AreTheGapsToTheRenderedSurfaceWhereEachGaussianDraws) {
 
   // Over two cameras the gaps average by how much each Gaussian draws in each (its
   // blendingWeightSums there).
-  const RasterCamera side = camera(3);
+  const RasterCamera side = smallPhotoCamera(3);
   const at::Tensor gap_side =
       gaussians::depthResiduals(g, {side}, [&](std::size_t) { return depthOf(g, side); });
   const at::Tensor both = gaussians::depthResiduals(

@@ -6,12 +6,14 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/surface_layer.h"
+#include "test_support/photo_camera.h"
 
 namespace sadsplat {
 namespace {
 
 using gaussians::GaussianParams;
 using gaussians::RasterCamera;
+using test::smallPhotoCamera;
 
 // Looking down the world's z axis from z = 0 (identity rotation): camera z = world z; 10
 // pixels per unit, the world origin at pixel (32, 32).
@@ -174,18 +176,6 @@ TEST(SurfaceLayer, ThroughAPinholeCameraItFollowsEachRayToTheSurface) {
   }
 }
 
-// A photo's camera at the origin looking along +z: 64 x 48 pixels, focal length 60.
-RasterCamera photoCamera(double centre_x = 0) {
-  RasterCamera c;
-  c.width = 64;
-  c.height = 48;
-  c.fx = c.fy = 60;
-  c.cx = 32;
-  c.cy = 24;
-  c.tvec = {-centre_x, 0, 0};
-  return c;
-}
-
 // Flat Gaussians facing the camera at (x, y, z) triples: scale 0.3 (0.01 in z), opacity 0.8.
 GaussianParams flatAt(const std::vector<double>& centres) {
   const auto n = static_cast<std::int64_t>(centres.size() / 3);
@@ -209,8 +199,8 @@ double gapOf(const at::Tensor& sums, int i) {
 // the pixels where it takes the transmittance below 0.5 only.
 TEST(SurfaceGapSums, ASurfaceAloneHasNoGap) {
   const GaussianParams one = flatAt({0.1, 0, 6});
-  const at::Tensor sums = gaussians::surfaceGapSums(one, photoCamera());
-  const gaussians::SurfaceLayer layer = gaussians::renderSurfaceLayer(one, photoCamera());
+  const at::Tensor sums = gaussians::surfaceGapSums(one, smallPhotoCamera());
+  const gaussians::SurfaceLayer layer = gaussians::renderSurfaceLayer(one, smallPhotoCamera());
   ASSERT_GT(sums[0][0].item<double>(), 1);
   EXPECT_NEAR(sums[0][0].item<double>(),
               (layer.weight * layer.reached.to(at::kFloat)).sum().item<double>(), 1e-4);
@@ -235,7 +225,7 @@ TEST(SurfaceGapSums, FloatersKeepTheirGapAndHiddenGaussiansCountNowhere) {
   g.opacity_logits[3] = logit(0.05);  // faint, small, in the image's corner (pixel 1, 1)
   g.log_scales[3][0] = g.log_scales[3][1] = std::log(0.1);
   g.opacity_logits.narrow(0, 4, 25).fill_(logit(0.3));  // the roof
-  const at::Tensor sums = gaussians::surfaceGapSums(g, photoCamera());
+  const at::Tensor sums = gaussians::surfaceGapSums(g, smallPhotoCamera());
   // The floater: at least the roof 3 behind it (where it overhangs the roof, the wall 18).
   EXPECT_GT(gapOf(sums, 1), 2.5);
   EXPECT_LT(std::abs(gapOf(sums, 4 + 12)), 0.05);  // the roof's middle
@@ -244,7 +234,7 @@ TEST(SurfaceGapSums, FloatersKeepTheirGapAndHiddenGaussiansCountNowhere) {
   EXPECT_EQ(sums[3][0].item<double>(), 0.0);       // where the wall is too faint to be reached
   // Two cameras: sums add up per camera (SurfaceDepth::kMedianWhereSeen takes |gap| per
   // camera); a camera that does not see a Gaussian adds nothing for it.
-  const at::Tensor side = gaussians::surfaceGapSums(g, photoCamera(40));
+  const at::Tensor side = gaussians::surfaceGapSums(g, smallPhotoCamera(40));
   EXPECT_EQ(side[1][0].item<double>(), 0.0);
 }
 
