@@ -106,9 +106,7 @@ at::Tensor classWeightSums(const GaussianParams& gaussians,
 at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<RasterCamera>& cameras,
                           const std::function<at::Tensor(std::size_t)>& depth_map) {
   const at::Tensor means = gaussians.means.detach().to(at::kDouble);
-  at::Tensor weight = at::zeros({means.size(0)}, means.options());
-  at::Tensor gap = at::zeros_like(weight);
-  for (std::size_t k = 0; k < cameras.size(); ++k) {
+  return gapsFromCameraSums(means.size(0), means.device(), cameras.size(), [&](std::size_t k) {
     const RasterCamera& camera = cameras[k];
     const at::Tensor depth = depth_map(k).to(gaussians.means.device(), at::kFloat);
     if (depth.dim() != 2 || depth.size(0) != camera.height || depth.size(1) != camera.width) {
@@ -119,10 +117,19 @@ at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<Ras
     const at::Tensor sums =
         weightedPixelSums(gaussians, camera, at::stack({at::ones_like(depth), depth}, 2))
             .to(at::kDouble);
-    const at::Tensor z = cameraDepths(means, camera);
     const at::Tensor w = sums.select(1, 0);
-    weight += w;
-    gap += (sums.select(1, 1) - w * z).abs();
+    return at::stack({w, sums.select(1, 1) - w * cameraDepths(means, camera)}, 1);
+  });
+}
+
+at::Tensor gapsFromCameraSums(std::int64_t n, at::Device device, std::size_t cameras,
+                              const std::function<at::Tensor(std::size_t)>& camera_sums) {
+  at::Tensor weight = at::zeros({n}, at::TensorOptions().dtype(at::kDouble).device(device));
+  at::Tensor gap = at::zeros_like(weight);
+  for (std::size_t k = 0; k < cameras; ++k) {
+    const at::Tensor sums = camera_sums(k).to(device, at::kDouble);
+    weight += sums.select(1, 0);
+    gap += sums.select(1, 1).abs();
   }
   return at::where(weight > 0, gap / weight.clamp_min(1e-30),
                    at::full_like(weight, std::numeric_limits<double>::infinity()))

@@ -533,16 +533,8 @@ at::Tensor Trainer::renderedDepthResiduals(const std::vector<RasterCamera>& came
     const auto depth_map = [&](std::size_t k) { return renderDepth(cameras[k]).depth; };
     return depthResiduals(g, cameras, depth_map).to(at::kCPU);
   }
-  at::Tensor weight = at::zeros({g.means.size(0)}, at::TensorOptions().dtype(at::kDouble));
-  at::Tensor gap = at::zeros_like(weight);
-  for (const RasterCamera& camera : cameras) {
-    const at::Tensor sums = surfaceGapSums(g, camera, 0.5);
-    weight += sums.select(1, 0);
-    gap += sums.select(1, 1).abs();
-  }
-  return at::where(weight > 0, gap / weight.clamp_min(1e-30),
-                   at::full_like(weight, std::numeric_limits<double>::infinity()))
-      .to(at::kFloat);
+  return gapsFromCameraSums(g.means.size(0), at::kCPU, cameras.size(),
+                            [&](std::size_t k) { return surfaceGapSums(g, cameras[k], 0.5); });
 }
 
 int Trainer::numClasses() const { return static_cast<int>(state_->num_classes); }

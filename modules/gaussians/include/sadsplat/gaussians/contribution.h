@@ -66,6 +66,17 @@ at::Tensor classWeightSums(const GaussianParams& gaussians,
 at::Tensor depthResiduals(const GaussianParams& gaussians, const std::vector<RasterCamera>& cameras,
                           const std::function<at::Tensor(std::size_t)>& depth_map);
 
+/// \brief The gaps of both surface checks from their per-camera sums: per Gaussian
+/// sum_k |G_k| / sum_k W_k, where (W_k, G_k) = camera_sums(k) are its blend weights and its
+/// weighted signed gaps (surface depth - its depth) summed over camera k's pixels.
+/// \param[in] n the number of Gaussians
+/// \param[in] device where the result lives
+/// \param[in] cameras how many cameras to ask camera_sums for, in order
+/// \param[in] camera_sums [n, 2] per camera (any floating dtype, any device)
+/// \return float [n] on `device`; +inf where no camera has weight for the Gaussian
+at::Tensor gapsFromCameraSums(std::int64_t n, at::Device device, std::size_t cameras,
+                              const std::function<at::Tensor(std::size_t)>& camera_sums);
+
 /// \brief Weights that fall with the contribution: w = (1 + c / median(c))^-gamma, scaled to mean
 /// 1. A Gaussian that contributes nothing gets the largest weight, one at the median 2^-gamma of
 /// it; gamma 0 gives all ones. Where the median is 0 (most Gaussians contribute nothing), the mean
