@@ -11,6 +11,7 @@
 #include "sadsplat/gaussians/contribution.h"
 #include "sadsplat/gaussians/densification.h"
 #include "sadsplat/gaussians/schedule.h"
+#include "sadsplat/gaussians/sparse_depth_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/trainer.h"
 #include "sadsplat/gaussians/view_coverage.h"
@@ -168,6 +169,45 @@ TEST_P(TrainerOnDevice, TheFlatnessLossMakesDiscs) {
   EXPECT_LT(smallestOverLargest(flat), 0.8 * smallestOverLargest(plain))
       << "start " << start << " plain " << smallestOverLargest(plain);
   EXPECT_TRUE(std::isfinite(flat.step().rgb_loss));
+}
+
+// The sparse-depth loss ties the rendered depth to the scene's points: Gaussians started at
+// random (not on the points) end nearer the points' depths with it than without it.
+TEST_P(TrainerOnDevice, TheSparseDepthLossPullsTheSurfacesToThePoints) {
+  std::vector<float> xyz;
+  for (const io::ScenePoint& p : scene_.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+  const at::Tensor points =
+      at::tensor(xyz, at::kFloat).view({static_cast<std::int64_t>(scene_.points.size()), 3});
+  const auto depthError = [&](const Trainer& t) {
+    double sum = 0;
+    int n = 0;
+    for (const io::View& v : scene_.views) {
+      if (!v.train) continue;
+      const auto camera = gaussians::RasterCamera::fromPinhole(v.camera);
+      gaussians::SparseDepthSamples s = gaussians::visibleSparseDepths(points, camera);
+      const at::Tensor depth = t.renderDepth(camera).depth.detach();
+      s.pixels = s.pixels.to(depth.device());
+      s.depths = s.depths.to(depth.device());
+      sum += gaussians::sparseDepthLoss(depth, s).item<double>();
+      ++n;
+    }
+    return sum / n;
+  };
+  TrainConfig config = small(150);
+  config.init = gaussians::InitMode::kRandom;
+  config.init_random_count = 2000;
+  Trainer plain(scene_, config);
+  config.lambda_sparse_depth = 1;
+  Trainer tied(scene_, config);
+  const double start = depthError(tied);
+  EXPECT_NEAR(start, depthError(plain), 1e-9);
+  for (int i = 0; i < 150; ++i) {
+    plain.step(false);
+    tied.step(false);
+  }
+  EXPECT_LT(depthError(tied), 0.5 * depthError(plain))
+      << "start " << start << " plain " << depthError(plain);
+  EXPECT_TRUE(std::isfinite(tied.step().loss));
 }
 
 // scale_limit_from: no bound before that iteration; at it, the Gaussians above the limit are
@@ -450,7 +490,7 @@ class ThirdsGates : public gaussians::DropStrategy {
 TEST_P(TrainerOnDevice, RecoveryFoldsTheGatesIntoTheOpacitiesAndTrainsWithoutThem) {
   TrainConfig c = small(20);
   c.recovery_iterations = 5;
-  c.lr_opacity = 0;       // the opacities change only by the folding
+  c.lr_opacity = 0;                           // the opacities change only by the folding
   c.drop_rule = gaussians::DropRule::kPaper;  // the L0 term is in the loss
   Trainer trainer(scene_, c);
   auto gates = std::make_shared<ThirdsGates>();

@@ -130,6 +130,37 @@ TEST(ViewCoverage, SparseDepthIsTheMedianPerBlockFilledFromTheNearestBlock) {
           .defined());
 }
 
+TEST(ViewCoverage, SparseSamplesAreThePointsNoNearerPointOfTheirBlockHides) {
+  // Camera at the origin looking along +z: (x, y, z) lands at u = 100 x / z + 50, v likewise;
+  // 16-pixel blocks. Points 0-3 fall in the block of columns and rows 48-63:
+  // 0: (0, 0, 5) -> (50, 50), the block's nearest. 1: (0.02, 0, 10) -> (50.2, 50).
+  // 2: (0.5, 0, 10.2) -> (54.9, 50). 3: (0.5, 0.5, 10.1) -> (54.95, 54.95).
+  // 4: (-4, 0, 10) -> (10, 50), alone in its block. 5: behind the camera. 6: outside the image.
+  const at::Tensor points = at::tensor({0.0,  0.0,  5.0, 0.02, 0.0, 10.0, 0.5,  0.0, 10.2, 0.5, 0.5,
+                                        10.1, -4.0, 0.0, 10.0, 0.0, 0.0,  -5.0, 9.0, 0.0,  5.0},
+                                       at::kFloat)
+                                .view({7, 3});
+  // Point 0 hides 1-3 (5 m behind it, far beyond 3 % of their depth).
+  const gaussians::SparseDepthSamples s =
+      gaussians::visibleSparseDepths(points, viewCamera(0), 16, 0.03);
+  ASSERT_EQ(s.size(), 2);
+  EXPECT_EQ(s.pixels[0].item<std::int64_t>(), 50 * 100 + 50);
+  EXPECT_FLOAT_EQ(s.depths[0].item<float>(), 5.0f);
+  EXPECT_EQ(s.pixels[1].item<std::int64_t>(), 50 * 100 + 10);
+  EXPECT_FLOAT_EQ(s.depths[1].item<float>(), 10.0f);
+  // Without point 0 the block's front is point 1 at 10: point 3 (0.1 behind) is within 1 % and
+  // 3 % of its depth, point 2 (0.2 behind) only within 3 %.
+  const at::Tensor rest = points.slice(0, 1);
+  EXPECT_EQ(gaussians::visibleSparseDepths(rest, viewCamera(0), 16, 0.03).size(), 4);
+  const gaussians::SparseDepthSamples tight =
+      gaussians::visibleSparseDepths(rest, viewCamera(0), 16, 0.01);
+  ASSERT_EQ(tight.size(), 3);
+  EXPECT_FLOAT_EQ(tight.depths[1].item<float>(), 10.1f);
+  // Blocks of one pixel: only point 1 shares a pixel (50, 50) with a nearer point.
+  EXPECT_EQ(gaussians::visibleSparseDepths(points, viewCamera(0), 1, 0.03).size(), 4);
+  EXPECT_THROW(gaussians::visibleSparseDepths(at::zeros({3}), viewCamera(0)), Error);
+}
+
 TEST(ViewCoverage, SceneExtentIsTheCamerasRadiusTimes1point1) {
   // Centres (0, 0, 0) and (2, 0, 0): mean (1, 0, 0), radius 1.
   EXPECT_NEAR(gaussians::sceneExtent({viewCamera(0), viewCamera(2)}), 1.1, 1e-12);

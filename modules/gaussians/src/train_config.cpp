@@ -93,6 +93,10 @@ const std::vector<TrainOption> kOptions = {
      nullptr, 0, kInf},
     {"lambda_flatten", &C::lambda_flatten,
      "weight of the flatness loss: mean smallest scale / scene extent (0: off)", nullptr, 0, kInf},
+    {"lambda_sparse_depth", &C::lambda_sparse_depth,
+     "weight of the sparse-depth loss: mean |rendered depth - sparse point depth| / depth over "
+     "the points each training view sees (0: off)",
+     nullptr, 0, kInf},
     {"semantic_interval", &C::semantic_interval,
      "every this many iterations a labelled view is rendered as well (0: never)", nullptr, 0, kInf},
     {"views_per_step", &C::views_per_step,

@@ -23,6 +23,7 @@
 #include "sadsplat/gaussians/parameter_store.h"
 #include "sadsplat/gaussians/schedule.h"
 #include "sadsplat/gaussians/semantic_loss.h"
+#include "sadsplat/gaussians/sparse_depth_loss.h"
 #include "sadsplat/gaussians/tensor_archive.h"
 #include "sadsplat/gaussians/tile_list_capacity.h"
 #include "sadsplat/gaussians/view_coverage.h"
@@ -210,9 +211,11 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
   };
   enterPhase(p, "render forward");
   const ViewRole role = views.role(v, c);
-  // Training uses no depth, and features only where a semantic loss reads them.
+  // Features only where a semantic loss reads them, depth only for the sparse-depth loss.
+  const bool sparse_depth = c.lambda_sparse_depth > 0 && !views.sparse_depths.empty() &&
+                            views.sparse_depths[v].size() > 0;
   pass.settings.features = role.semantic;
-  pass.settings.depth = false;
+  pass.settings.depth = sparse_depth;
   RenderResult r = render(pass.g, views.cameras[v], pass.settings);
   r.means2d.retain_grad();
   enterPhase(p, "losses forward");
@@ -246,6 +249,9 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
     const double weight = views.semantic_weight[v];
     loss = loss + (weight == 1 ? sem : weight * sem);
     accumulate(pass.sem_sum, sem);
+  }
+  if (sparse_depth) {
+    loss = loss + c.lambda_sparse_depth * sparseDepthLoss(r.depth, views.sparse_depths[v]);
   }
   pass.renders.push_back(r);
   pass.cameras.push_back(views.cameras[v]);
@@ -339,6 +345,9 @@ Trainer::Trainer(const io::Scene& scene, const TrainConfig& config, TrainerViews
   s.views = views == TrainerViews::kLoaded ? loadTrainingViews(scene, s.config, s.device)
                                            : cameraViews(scene, s.device);
   s.extent = sceneExtent(s.views.cameras);
+  if (views == TrainerViews::kLoaded && s.config.lambda_sparse_depth > 0) {
+    addSparseDepths(scene, s.views);
+  }
 
   // Initial Gaussians (3DGS initialisation, features N(0, 0.01)).
   InitOptions init;

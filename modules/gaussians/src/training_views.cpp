@@ -34,8 +34,7 @@ DeviceView TrainingViews::onDevice(int v) const {
   DeviceView d;
   d.image = host.image.to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
   d.mask = host.mask.to(device, /*non_blocking=*/true).to(at::kFloat).div(255.0);
-  if (host.labels.defined())
-    d.labels = host.labels.to(device, /*non_blocking=*/true).to(at::kLong);
+  if (host.labels.defined()) d.labels = host.labels.to(device, /*non_blocking=*/true).to(at::kLong);
   return d;
 }
 
@@ -120,8 +119,8 @@ HostView hostView(const io::View& v, const TrainConfig& config, bool pin, bool s
   // A host copy the device can read asynchronously: page-locked for a CUDA device.
   const auto host = [&](const at::Tensor& t) { return pin ? t.pin_memory() : t.clone(); };
   HostView h;
-  const at::Tensor rgb8 = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()),
-                                        {H, W, 3}, at::TensorOptions().dtype(at::kByte));
+  const at::Tensor rgb8 = at::from_blob(const_cast<std::uint8_t*>(v.rgb.pixels.data()), {H, W, 3},
+                                        at::TensorOptions().dtype(at::kByte));
   const at::Tensor mask8 = at::from_blob(const_cast<std::uint8_t*>(v.mask.pixels.data()), {H, W},
                                          at::TensorOptions().dtype(at::kByte));
   h.image = host(rgb8);
@@ -269,6 +268,25 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
   }
   if (s.streamed && from_cache) s.loader = loaderFor(false);
   return s;
+}
+
+std::int64_t addSparseDepths(const io::Scene& scene, TrainingViews& views) {
+  views.sparse_depths.assign(views.cameras.size(), SparseDepthSamples());
+  if (scene.points.empty()) return 0;
+  std::vector<float> xyz;
+  xyz.reserve(3 * scene.points.size());
+  for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+  const at::Tensor points =
+      at::tensor(xyz, at::kFloat).view({static_cast<std::int64_t>(scene.points.size()), 3});
+  std::int64_t total = 0;
+  for (int v : views.train_views) {
+    SparseDepthSamples s = visibleSparseDepths(points, views.cameras[v]);
+    total += s.size();
+    s.pixels = s.pixels.to(views.device);
+    s.depths = s.depths.to(views.device);
+    views.sparse_depths[v] = std::move(s);
+  }
+  return total;
 }
 
 }  // namespace gaussians

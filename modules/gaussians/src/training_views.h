@@ -9,6 +9,7 @@
 
 #include "sadsplat/gaussians/rasterizer.h"
 #include "sadsplat/gaussians/train_config.h"
+#include "sadsplat/gaussians/view_coverage.h"
 #include "sadsplat/io/scene.h"
 #include "view_loader.h"
 
@@ -46,14 +47,17 @@ struct TrainingViews {
   std::shared_ptr<ViewLoader> loader;
   int prefetched_until = -1;  // the last step whose views the loader was asked for
   at::Device device{at::kCPU};
-  std::vector<RasterCamera> cameras;        // every view of the scene
-  std::vector<at::Tensor> images;           // training views only (see above)
+  std::vector<RasterCamera> cameras;  // every view of the scene
+  std::vector<at::Tensor> images;     // training views only (see above)
   std::vector<at::Tensor> masks;
   std::vector<char> mask_is_full;           // every pixel valid: the mask multiplies nothing
   std::vector<at::Tensor> labels;           // undefined where a view supervises no class
   std::vector<char> supervised;             // some pixel of the view has a class to learn
   std::vector<double> semantic_weight;      // lambda_semantic (ground truth) or lambda_pseudo
   std::vector<at::Tensor> confidence_maps;  // [H, W] max class confidence (or undefined)
+  // The scene's sparse points each training view sees (on the device; empty for every view when
+  // the sparse-depth loss is off or the scene has no points).
+  std::vector<SparseDepthSamples> sparse_depths;
   int pseudo_labelled_views = 0;
   std::vector<int> train_views, labelled_views;
 
@@ -94,6 +98,10 @@ TrainingViews cameraViews(const io::Scene& scene, const at::Device& device);
 /// \throws sadsplat::Error when the scene has no training view
 TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& config,
                                 const at::Device& device);
+
+// The sparse points of `scene` that each training view of `views` sees (visibleSparseDepths),
+// on the views' device, into views.sparse_depths; returns how many samples all views hold.
+std::int64_t addSparseDepths(const io::Scene& scene, TrainingViews& views);
 
 }  // namespace gaussians
 }  // namespace sadsplat

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -198,6 +200,42 @@ at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera
     }
   }
   return image;
+}
+
+SparseDepthSamples visibleSparseDepths(const at::Tensor& points, const RasterCamera& camera,
+                                       int cell, double relative_tolerance) {
+  if (points.dim() != 2 || points.size(1) != 3) {
+    throw Error("<view coverage>", "sparse points", "a [P, 3] tensor",
+                std::to_string(points.dim()) + "-d");
+  }
+  cell = std::max(1, cell);
+  const int W = camera.width;
+  const int cols = (W + cell - 1) / cell, rows = (camera.height + cell - 1) / cell;
+  const Projection p = project(points.detach().to(at::kCPU, at::kDouble), camera);
+  const auto u = p.u.accessor<double, 1>(), v = p.v.accessor<double, 1>(),
+             z = p.z.accessor<double, 1>();
+  const auto seen = p.seen.accessor<bool, 1>();
+  const auto blockOf = [&](std::int64_t i) {
+    return static_cast<std::size_t>(static_cast<int>(v[i]) / cell) * cols +
+           static_cast<int>(u[i]) / cell;
+  };
+  std::vector<double> nearest(static_cast<std::size_t>(cols) * rows,
+                              std::numeric_limits<double>::infinity());
+  for (std::int64_t i = 0; i < p.z.size(0); ++i) {
+    if (seen[i]) nearest[blockOf(i)] = std::min(nearest[blockOf(i)], z[i]);
+  }
+  std::vector<std::int64_t> pixels;
+  std::vector<float> depths;
+  for (std::int64_t i = 0; i < p.z.size(0); ++i) {
+    if (!seen[i] || z[i] - nearest[blockOf(i)] > relative_tolerance * z[i]) continue;
+    pixels.push_back(static_cast<std::int64_t>(v[i]) * W + static_cast<std::int64_t>(u[i]));
+    depths.push_back(static_cast<float>(z[i]));
+  }
+  SparseDepthSamples s;
+  const auto n = static_cast<std::int64_t>(pixels.size());
+  s.pixels = at::tensor(pixels, at::kLong).view({n});
+  s.depths = at::tensor(depths, at::kFloat).view({n});
+  return s;
 }
 
 at::Tensor floaterMask(const at::Tensor& means, const at::Tensor& log_scales,

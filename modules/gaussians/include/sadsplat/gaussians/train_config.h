@@ -15,9 +15,9 @@ namespace gaussians {
 /// \brief The training options that choose among named values, as enums: their names (JSON,
 /// flags, logs) are choiceNames', read and written only by the option table (train_options.h).
 enum class DropMode { kNone, kSemantic, kStructure, kFull };  ///< none|semantic|structure|full
-enum class DropRule { kBalanced, kPaper };                     ///< balanced|paper
-enum class InitMode { kAuto, kPoints, kRandom };               ///< auto|points|random
-enum class TrainDevice { kCpu, kCuda };                        ///< cpu|cuda
+enum class DropRule { kBalanced, kPaper };                    ///< balanced|paper
+enum class InitMode { kAuto, kPoints, kRandom };              ///< auto|points|random
+enum class TrainDevice { kCpu, kCuda };                       ///< cpu|cuda
 
 /// \brief The names of a choice's values, in the enum's order (the argument picks the enum).
 const std::vector<std::string>& choiceNames(DropMode);
@@ -64,6 +64,12 @@ struct LossOptions {
   /// Gaussians become discs on the surfaces, so that a facade seen from above is a line, not a
   /// band over the street. 0: off.
   double lambda_flatten = 0.0;
+  /// Not the paper: weight of the sparse-depth loss (gaussians/sparse_depth_loss.h), the mean
+  /// relative difference between each training view's rendered depth and the depth of the
+  /// scene's sparse points it sees (structure-from-motion points; gsplat's `depth_loss`). Ties
+  /// the surfaces to what the photos triangulated where the photometric loss alone leaves the
+  /// depth free (a capture that sees the ground from one side). 0: off; nothing without points.
+  double lambda_sparse_depth = 0.0;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;
@@ -136,8 +142,8 @@ struct DensificationOptions {
 /// the strategy given to setDropStrategy (semantic_drop::makeDropStrategy) reads them.
 struct DropOptions {
   DropMode drop = DropMode::kNone;
-  double p_base = 1.0;        ///< paper: P_base = 1.0
-  int drop_interval = 500;    ///< paper: every N = 500 iterations
+  double p_base = 1.0;      ///< paper: P_base = 1.0
+  int drop_interval = 500;  ///< paper: every N = 500 iterations
   /// Weight of L_L0. 0.2 was chosen on city seed 1 (0.1 / 0.2 / 0.4) for >= 5x fewer Gaussians
   /// at equal mIoU; it costs ~3 dB PSNR against no drop (0.1: ~1.7 dB, ~4x fewer). See README.
   double lambda_l0 = 0.2;

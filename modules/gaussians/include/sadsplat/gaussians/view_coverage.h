@@ -7,6 +7,7 @@
 
 #include <ATen/ATen.h>
 
+#include <cstdint>
 #include <vector>
 
 #include "sadsplat/gaussians/rasterizer.h"
@@ -56,6 +57,20 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
 /// undefined tensor when no point lies in front of the camera and inside its image. Depth that
 /// belongs to the capture, not to a model: what pixelViewCounts() needs to score models alike.
 at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera, int cell = 32);
+
+/// \brief Where a camera sees a scene's sparse points, and at what depth: the pixel (row-major
+/// index y * W + x of the pixel holding the projection) and camera z of each point in front of the
+/// camera and inside its image that is not hidden behind another. A point is hidden when a point
+/// of its `cell` x `cell` pixel block lies nearer the camera by more than `relative_tolerance` x
+/// its depth (a z-buffer at the sparse points' density: no track of which photos saw a point is
+/// needed). `pixels` int64 [K] and `depths` float [K], on the CPU; K = 0 when none is seen.
+struct SparseDepthSamples {
+  at::Tensor pixels;
+  at::Tensor depths;
+  std::int64_t size() const { return pixels.defined() ? pixels.size(0) : 0; }
+};
+SparseDepthSamples visibleSparseDepths(const at::Tensor& points, const RasterCamera& camera,
+                                       int cell = 16, double relative_tolerance = 0.03);
 
 /// \brief The floaters of a model: Gaussians seen by fewer than `min_views` cameras, or whose
 /// largest scale (standard deviation, world units) exceeds `max_scale`. bool [N] (true = floater).
