@@ -386,7 +386,9 @@ void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthSc
     const std::size_t pix = static_cast<std::size_t>(w) * o.width + u;
     const std::uint8_t cls = v.labels.pixels[pix];
     const float z = v.depth[pix];
-    if (cls == io::kIgnoreLabel || z <= 0.f) continue;
+    // Any surface, the unlabelled terrain beyond the world included (as structure from motion
+    // triangulates whatever the photos show); not the sky (no depth).
+    if (z <= 0.f) continue;
     // Back-project the pixel centre; SfM-like noise moves it a little towards the camera, so no
     // point ends up inside a solid.
     const float zn = z * (1.f - 0.0002f * rnd.next());
