@@ -216,6 +216,26 @@ TEST(AerialBenchmark, SparsePointsProjectOntoTheirSurfaceInTheWrittenFiles) {
   EXPECT_GT(label_agree, 0.93 * checked) << label_agree << " of " << checked;
 }
 
+// Structure from motion triangulates whatever the photos show: the orbit's photos see terrain
+// beyond the labelled world, and the sparse points hold it (unlabelled, 255) as well as the
+// world's own surfaces; no point lies in the sky (every one is on a surface its views see).
+TEST(AerialBenchmark, SparsePointsIncludeTheTerrainBeyondTheWorld) {
+  synth::SynthOptions o = small(synth::SceneKind::kCity, 0);
+  o.max_points = 2000;
+  const auto scene = synth::generate(o);
+  const float extent = synth::World::extentOf(1);
+  int beyond = 0, beyond_unlabelled = 0;
+  for (const auto& p : scene.points) {
+    const bool outside = std::fabs(p.xyz[0]) > extent || std::fabs(p.xyz[1]) > extent;
+    beyond += outside;
+    beyond_unlabelled += outside && p.cls == io::kIgnoreLabel;
+    EXPECT_LT(std::fabs(p.xyz[2]), 100.f) << "a point far above or below the ground";
+  }
+  EXPECT_GT(beyond, 0.02 * scene.points.size()) << beyond << " of " << scene.points.size();
+  EXPECT_EQ(beyond_unlabelled, beyond);
+  EXPECT_LT(beyond, 0.8 * scene.points.size());
+}
+
 TEST(AerialBenchmark, WrittenScenesLoadThroughTheSceneImport) {
   const auto scene = synth::generate(small(synth::SceneKind::kPort, 5));
   test::TempDir dir;
