@@ -64,8 +64,17 @@ void TrainingReport::started(const io::Scene& scene, const gaussians::TrainConfi
         << "\n";
   }
   if (config.device == gaussians::TrainDevice::kCuda) {
-    out << "device memory: " << gaussians::estimateTrainingMemory(scene, config).describe()
-        << "\n";
+    out << "device memory: " << gaussians::estimateTrainingMemory(scene, config).describe() << "\n";
+  }
+  if (config.lambda_sparse_depth > 0) {
+    if (scene.points.empty()) {
+      out << "sparse-depth loss: the scene has no sparse points, so lambda_sparse_depth "
+          << config.lambda_sparse_depth << " does nothing\n";
+    } else {
+      out << "sparse-depth loss (weight " << config.lambda_sparse_depth << "): the rendered depth "
+          << "against the scene's " << scene.points.size()
+          << " sparse points where each training view sees them\n";
+    }
   }
   if (!resume && gaussians::initialisesRandomly(config.init, scene.points.size())) {
     out << "initialisation: up to " << config.init_random_count
