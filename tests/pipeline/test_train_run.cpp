@@ -21,6 +21,7 @@
 #include "sadsplat/io/train_log.h"
 #include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
+#include "sadsplat/pipeline/ortho_render.h"
 #include "sadsplat/pipeline/pseudo_label_run.h"
 #include "sadsplat/pipeline/train_run.h"
 #include "test_support/test_support.h"
@@ -298,6 +299,56 @@ TEST(LabelledCloud, OnTheSurfaceKeepsTheGaussiansWithinTheGap) {
   pcl::PointCloud<GaussianPoint> shorter = model;
   shorter.resize(model.size() - 1);
   EXPECT_THROW(pipeline::gaussiansOnSurface(dir.file("run"), shorter, 1.f), sadsplat::Error);
+}
+
+// The map's default footprint is what the training photos look at: Gaussians that a photo shows
+// only near its image's edge (an oblique photo's far terrain) do not stretch the grid.
+TEST(OrthoFootprint, IsWhatThePhotosShowInTheMiddleOfTheirImages) {
+  // One photo 10 above the origin looking down (world (x, y, 0) -> u = 6 x + 32, v = 24 - 6 y;
+  // 64 x 48 pixels): 100 Gaussians at |x|, |y| <= 1 (u 26-38, in the middle 80 % of the image,
+  // columns 6-57) and 40 at x = -5 (u = 2: in the image, not in its middle).
+  io::Scene scene;
+  io::View v;
+  v.name = "down.png";
+  v.train = true;
+  v.camera.width = 64;
+  v.camera.height = 48;
+  v.camera.fx = v.camera.fy = 60;
+  v.camera.cx = 32;
+  v.camera.cy = 24;
+  v.camera.qvec = {0, 1, 0, 0};  // 180 degrees about x: the camera's z is the world's -z
+  v.camera.tvec = {0, 0, 10};
+  scene.views.push_back(v);
+  pcl::PointCloud<GaussianPoint> cloud;
+  const auto add = [&](float x, float y) {
+    GaussianPoint p{};
+    p.x = x, p.y = y, p.z = 0;
+    p.opacity = 5;  // logit: 0.993
+    for (float& s : p.scale) s = -3;
+    p.rot[0] = 1;
+    cloud.push_back(p);
+  };
+  for (int i = 0; i < 100; ++i) add(-1.f + 0.02f * i, -1.f + 0.02f * ((i * 37) % 100));
+  for (int i = 0; i < 40; ++i) add(-5.f, -1.f + 0.05f * i);
+  gaussians::TrainConfig config;
+  gaussians::Trainer trainer(scene, config, gaussians::TrainerViews::kCamerasOnly);
+  trainer.setGaussians(cloud);
+  const pipeline::OrthoGrid grid = pipeline::footprintGrid(trainer, scene, 0.1);
+  // x from -1 to 0.98 with a 2 % margin, y alike: ~21 cells a side (the edge's Gaussians would
+  // make the grid ~63 cells wide).
+  EXPECT_LE(grid.width, 23);
+  EXPECT_GE(grid.width, 19);
+  EXPECT_LE(grid.height, 23);
+  EXPECT_GT(grid.x0, -1.2);
+  // No photo shows any Gaussian in its middle: the footprint of all of them.
+  pcl::PointCloud<GaussianPoint> edge_only;
+  for (std::size_t i = 100; i < cloud.size(); ++i) {
+    edge_only.push_back(cloud[i]);
+    edge_only.back().x += 0.01f * static_cast<float>(i - 100);  // -5 .. -4.61
+  }
+  trainer.setGaussians(edge_only);
+  const pipeline::OrthoGrid all = pipeline::footprintGrid(trainer, scene, 0.1);
+  EXPECT_LT(all.x0, -4.9);
 }
 
 // eval reads the test views from the scene cache one at a time: the same scores as with the

@@ -36,13 +36,29 @@ OrthoGrid footprintGrid(const gaussians::Trainer& trainer, const io::Scene& scen
   const double* m = means.data_ptr<double>();
   const double* o = opacity.data_ptr<double>();
 
+  // The training photos cropped to the middle of their images: a Gaussian one of them shows
+  // there is part of what the capture looks at.
+  std::vector<gaussians::RasterCamera> middles;
+  for (const io::View& v : scene.views) {
+    if (!v.train) continue;
+    gaussians::RasterCamera c = gaussians::RasterCamera::fromPinhole(v.camera);
+    const int w = std::max(1, static_cast<int>(kFootprintImageShare * c.width));
+    const int h = std::max(1, static_cast<int>(kFootprintImageShare * c.height));
+    c.cx -= 0.5 * (c.width - w), c.cy -= 0.5 * (c.height - h);
+    c.width = w, c.height = h;
+    middles.push_back(c);
+  }
+  at::Tensor looked_at = gaussians::viewCounts(means, middles) > 0;
+  if (looked_at.sum().item<std::int64_t>() < 2) looked_at = at::ones({n}, at::kBool);
+  const bool* in_middle = looked_at.contiguous().data_ptr<bool>();
+
   const geo::MapFrame local = geo::localMapFrame(geo::sceneUp(scene));
   std::vector<double> e, nn;
   double top = -1e300;
   for (std::int64_t i = 0; i < n; ++i) {
     const Vec3 l = local.toLocal({m[3 * i], m[3 * i + 1], m[3 * i + 2]});
     top = std::max(top, l[2]);
-    if (o[i] < 0.1) continue;
+    if (o[i] < 0.1 || !in_middle[i]) continue;
     e.push_back(l[0]);
     nn.push_back(l[1]);
   }

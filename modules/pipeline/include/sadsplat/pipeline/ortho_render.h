@@ -28,11 +28,14 @@ struct OrthoGrid {
 };
 
 /// \brief The grid over the model's ground footprint: the 1st to 99th percentile of its
-/// Gaussians' centres (those of opacity >= 0.1) in map x and y, 2 % margin, corners snapped to
+/// Gaussians' centres (those of opacity >= 0.1 that some training photo shows in the middle
+/// kFootprintImageShare of its width and height: what the capture looks at, not the far terrain
+/// an oblique photo shows near its edge) in map x and y, 2 % margin, corners snapped to
 /// whole multiples of `gsd`. A georeferenced scene gets its UTM frame (fitted over that
 /// footprint), any other its local-metres frame. `bounds` (x0, y0, x1, y1 in the frame's map
 /// units) replaces the footprint.
 /// \throws sadsplat::Error for gsd <= 0, a grid over 40,000 pixels a side or an empty model
+constexpr double kFootprintImageShare = 0.8;
 OrthoGrid footprintGrid(const gaussians::Trainer& trainer, const io::Scene& scene, double gsd,
                         const std::optional<std::array<double, 4>>& bounds = std::nullopt);
 
