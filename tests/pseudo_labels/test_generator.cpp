@@ -82,6 +82,40 @@ TEST(PseudoLabelGenerator, GroundTruthOverridesPseudoLabels) {
   for (std::int16_t l : io::supervisionLabels(other, false)) EXPECT_EQ(l, -1);
 }
 
+// What the annotated photos show, per class: a class no labelled training view shows gets 0
+// (pseudo-labels warns of it by name); unlabelled and test views do not count.
+TEST(AnnotatedPixels, CountTheClassesOfTheLabelledTrainingViewsOnly) {
+  io::Scene scene = sadsplat::test::toyPseudoLabelScene();
+  std::vector<std::int64_t> expected(scene.classes.size(), 0);
+  int labelled = 0;
+  for (const io::View& v : scene.views) {
+    if (!v.train || !v.labelled) continue;
+    ++labelled;
+    for (std::uint8_t c : v.labels.pixels) {
+      if (c < expected.size()) ++expected[c];
+    }
+  }
+  ASSERT_GT(labelled, 0);
+  int views = -1;
+  EXPECT_EQ(io::annotatedPixelsPerClass(scene, &views), expected);
+  EXPECT_EQ(views, labelled);
+  ASSERT_GT(expected[1], 0);
+  // Relabel class 1 as ignored on every labelled view: it is then shown by none.
+  for (io::View& v : scene.views) {
+    if (!v.labelled) continue;
+    for (std::uint8_t& c : v.labels.pixels) {
+      if (c == 1) c = io::kIgnoreLabel;
+    }
+  }
+  const std::vector<std::int64_t> after = io::annotatedPixelsPerClass(scene);
+  EXPECT_EQ(after[1], 0);
+  EXPECT_EQ(after[0], expected[0]);
+  // A view that is labelled but not a training view does not count.
+  for (io::View& v : scene.views) v.train = false;
+  for (std::int64_t n : io::annotatedPixelsPerClass(scene, &views)) EXPECT_EQ(n, 0);
+  EXPECT_EQ(views, 0);
+}
+
 TEST(PseudoLabelGenerator, BadOptionsAreErrorsNamingTheOption) {
   io::Scene scene = sadsplat::test::toyPseudoLabelScene();
   auto scorer = sp::makeBuiltinScorer(smallOptions());

@@ -104,5 +104,19 @@ std::vector<std::int16_t> supervisionLabels(const View& view, bool use_pseudo) {
   return out;
 }
 
+std::vector<std::int64_t> annotatedPixelsPerClass(const Scene& scene, int* views) {
+  std::vector<std::int64_t> pixels(scene.classes.size(), 0);
+  int counted = 0;
+  for (const View& v : scene.views) {
+    if (!v.train || !v.labelled || v.labels.empty()) continue;
+    ++counted;
+    for (std::uint8_t c : v.labels.pixels) {
+      if (c < pixels.size()) ++pixels[c];
+    }
+  }
+  if (views != nullptr) *views = counted;
+  return pixels;
+}
+
 }  // namespace io
 }  // namespace sadsplat

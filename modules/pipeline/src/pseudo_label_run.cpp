@@ -89,6 +89,22 @@ nlohmann::json generationJson(const pseudo_labels::PseudoLabelSummary& s,
   return g;
 }
 
+// A class no annotated photo shows cannot be learnt: say so before the long work, by name.
+void warnOfUnannotatedClasses(const io::Scene& scene, std::ostream* progress) {
+  int views = 0;
+  const std::vector<std::int64_t> pixels = io::annotatedPixelsPerClass(scene, &views);
+  if (progress == nullptr || views == 0) return;
+  std::string missing;
+  for (std::size_t c = 0; c < pixels.size(); ++c) {
+    if (pixels[c] == 0) missing += (missing.empty() ? "" : ", ") + scene.classes[c].name;
+  }
+  if (missing.empty()) return;
+  *progress << "warning: no annotated photo (" << views << " labelled training views) shows "
+            << missing << ": neither the annotations nor the pseudo-labels can teach "
+            << (missing.find(',') == std::string::npos ? "it" : "them")
+            << "; annotate a photo where each appears\n";
+}
+
 }  // namespace
 
 std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
@@ -99,6 +115,7 @@ std::string pseudoLabelRun(const PseudoLabelRunOptions& o) {
                 "no --out");
   }
   io::Scene scene = loadScene(o.scene, o.scale);
+  warnOfUnannotatedClasses(scene, o.progress);
   pseudo_labels::TargetScorer::Ptr scorer;
   if (o.backend == "builtin") {
     scorer = pseudo_labels::makeBuiltinScorer(o.builtin);

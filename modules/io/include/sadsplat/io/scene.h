@@ -141,6 +141,12 @@ struct Scene {
   std::optional<Georeference> georeference;
 };
 
+/// \brief Per class of `scene`, how many pixels of its labelled training views (their label maps
+/// held in memory) carry that class: a class at 0 is one no annotated photo shows, which neither
+/// the annotations nor the pseudo-labels (a classifier of the annotated classes) can teach.
+/// `*views` (optional) gets how many labelled training views were counted.
+std::vector<std::int64_t> annotatedPixelsPerClass(const Scene& scene, int* views = nullptr);
+
 /// \brief The class list and split of a scene directory, readable without OpenCV.
 struct SplitInfo {
   std::vector<std::string> train;     ///< image names
