@@ -174,10 +174,8 @@ TEST_P(TrainerOnDevice, TheFlatnessLossMakesDiscs) {
 // The sparse-depth loss ties the rendered depth to the scene's points: Gaussians started at
 // random (not on the points) end nearer the points' depths with it than without it.
 TEST_P(TrainerOnDevice, TheSparseDepthLossPullsTheSurfacesToThePoints) {
-  std::vector<float> xyz;
-  for (const io::ScenePoint& p : scene_.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
-  const at::Tensor points =
-      at::tensor(xyz, at::kFloat).view({static_cast<std::int64_t>(scene_.points.size()), 3});
+  const at::Tensor points = gaussians::sparsePointTensor(scene_);
+  ASSERT_TRUE(points.defined());
   const auto depthError = [&](const Trainer& t) {
     double sum = 0;
     int n = 0;

@@ -130,6 +130,19 @@ TEST(ViewCoverage, SparseDepthIsTheMedianPerBlockFilledFromTheNearestBlock) {
           .defined());
 }
 
+TEST(ViewCoverage, TheSceneSparsePointsAsATensor) {
+  io::Scene scene;
+  EXPECT_FALSE(gaussians::sparsePointTensor(scene).defined());
+  io::ScenePoint a, b;
+  a.xyz = {1, 2, 3};
+  b.xyz = {-4, 5.5f, 0};
+  scene.points = {a, b};
+  const at::Tensor t = gaussians::sparsePointTensor(scene);
+  ASSERT_EQ(t.sizes(), (std::vector<std::int64_t>{2, 3}));
+  EXPECT_EQ(t.scalar_type(), at::kFloat);
+  EXPECT_TRUE(at::equal(t, at::tensor({1.f, 2.f, 3.f, -4.f, 5.5f, 0.f}).view({2, 3})));
+}
+
 TEST(ViewCoverage, SparseSamplesAreThePointsNoNearerPointOfTheirBlockHides) {
   // Camera at the origin looking along +z: (x, y, z) lands at u = 100 x / z + 50, v likewise;
   // 16-pixel blocks. Points 0-3 fall in the block of columns and rows 48-63:

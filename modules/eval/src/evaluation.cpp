@@ -103,15 +103,6 @@ FloaterCensus countFloaters(const gaussians::Trainer& trainer, const io::Scene& 
 
 namespace {
 
-// The scene's sparse points as an [N, 3] tensor (undefined when it has none).
-at::Tensor sparsePoints(const io::Scene& scene) {
-  if (scene.points.empty()) return at::Tensor();
-  std::vector<float> xyz;
-  xyz.reserve(3 * scene.points.size());
-  for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
-  return at::tensor(xyz).view({-1, 3});
-}
-
 // The pixels of `view` whose surface at least kCoveredMinViews training views see. The surface
 // depth is the capture's (its sparse points) where a point falls into the view, so that every
 // model is scored on the same pixels; else the model's own (then *from_sparse is false).
@@ -143,7 +134,7 @@ EvalResult evaluate(const gaussians::Trainer& trainer, const io::Scene& scene,
   double covered_psnr_sum = 0, covered_pixels = 0, evaluated_pixels = 0;
   int covered_views = 0;
   const std::vector<gaussians::RasterCamera> training = camerasOf(scene, true);
-  const at::Tensor points = sparsePoints(scene);
+  const at::Tensor points = gaussians::sparsePointTensor(scene);
   result.covered_depth = "sparse points";
   const bool semantic = !scene.classes.empty();
   for (const io::View& listed : scene.views) {

@@ -272,12 +272,8 @@ TrainingViews loadTrainingViews(const io::Scene& scene, const TrainConfig& confi
 
 std::int64_t addSparseDepths(const io::Scene& scene, TrainingViews& views) {
   views.sparse_depths.assign(views.cameras.size(), SparseDepthSamples());
-  if (scene.points.empty()) return 0;
-  std::vector<float> xyz;
-  xyz.reserve(3 * scene.points.size());
-  for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
-  const at::Tensor points =
-      at::tensor(xyz, at::kFloat).view({static_cast<std::int64_t>(scene.points.size()), 3});
+  const at::Tensor points = sparsePointTensor(scene);
+  if (!points.defined()) return 0;
   std::int64_t total = 0;
   for (int v : views.train_views) {
     SparseDepthSamples s = visibleSparseDepths(points, views.cameras[v]);

@@ -151,6 +151,14 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
   return at::where(alpha.detach() >= min_alpha, counts, at::zeros_like(counts));
 }
 
+at::Tensor sparsePointTensor(const io::Scene& scene) {
+  if (scene.points.empty()) return at::Tensor();
+  std::vector<float> xyz;
+  xyz.reserve(3 * scene.points.size());
+  for (const io::ScenePoint& p : scene.points) xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+  return at::tensor(xyz, at::kFloat).view({-1, 3});
+}
+
 at::Tensor sparseDepthImage(const at::Tensor& points, const RasterCamera& camera, int cell) {
   if (points.dim() != 2 || points.size(1) != 3) {
     throw Error("<view coverage>", "sparse points", "a [P, 3] tensor",

@@ -51,6 +51,10 @@ at::Tensor pixelViewCounts(const at::Tensor& depth, const at::Tensor& alpha,
                            const RasterCamera& camera, const std::vector<RasterCamera>& cameras,
                            double min_alpha = 0.5, int stride = 1);
 
+/// \brief The scene's sparse points as a float [P, 3] tensor on the CPU, the form the functions
+/// below take; undefined when the scene has none.
+at::Tensor sparsePointTensor(const io::Scene& scene);
+
 /// \brief A coarse depth image of a view from a scene's sparse points ([P, 3], world): the
 /// median camera z of the points that project into each `cell` x `cell` pixel block; blocks
 /// without a point take the depth of the nearest block with one. float [H, W] on the CPU, or an
