@@ -13,6 +13,7 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/geo/geodesy.h"
+#include "sadsplat/geo/ground_model.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/io/cloud_files.h"
@@ -259,6 +260,57 @@ TEST_F(MapProducts, OrthoOnSurfaceMapsOnlyTheGaussiansNearTheRenderedSurface) {
   EXPECT_LT(none, all);
 }
 
+// --raised-check: ortho.json gives every class's median height above the ground and which
+// classes are raised; the cells it changes were of a raised class and are now of a ground class
+// (median below half the raised height), nothing else changes.
+TEST_F(MapProducts, OrthoRaisedCheckChangesOnlyRaisedCellsToGroundClasses) {
+  const auto ortho = [&](const std::string& args, const std::string& name) {
+    std::string out;
+    const std::string dir = dir_->file(name);
+    EXPECT_EQ(
+        test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 " + args + " --out " + dir, &out),
+        0)
+        << out;
+    return dir;
+  };
+  const std::string plain = ortho("", "ortho_plain"),
+                    checked = ortho("--raised-check 0.5 --ground-window 8", "ortho_raised");
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(checked + "/ortho.json"));
+  const std::vector<ClassInfo> classes = classesOf(run());
+  ASSERT_EQ(j["raised_check"].get<double>(), 0.5);
+  ASSERT_EQ(j["ground_window"].get<double>(), 8.0);
+  std::set<std::string> raised, ground;
+  for (const auto& c : classes) {
+    ASSERT_TRUE(j["class_height_above_ground"].contains(c.name)) << c.name;
+    const nlohmann::json& h = j["class_height_above_ground"][c.name];
+    if (h.is_null()) continue;
+    if (h.get<double>() >= 2.5) raised.insert(c.name);
+    if (h.get<double>() < 1.25) ground.insert(c.name);
+  }
+  std::set<std::string> listed;
+  for (const auto& r : j["raised_classes"]) listed.insert(r.get<std::string>());
+  EXPECT_EQ(listed, raised);
+  const geo::Raster a = geo::readByteRaster(plain + "/classes.tif");
+  const geo::Raster b = geo::readByteRaster(checked + "/classes.tif");
+  ASSERT_EQ(a.bytes.size(), b.bytes.size());
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < a.bytes.size(); ++i) {
+    if (a.bytes[i] == b.bytes[i]) continue;
+    ++changed;
+    ASSERT_LT(a.bytes[i], classes.size());
+    ASSERT_LT(b.bytes[i], classes.size());
+    EXPECT_TRUE(raised.count(classes[a.bytes[i]].name)) << classes[a.bytes[i]].name;
+    EXPECT_TRUE(ground.count(classes[b.bytes[i]].name)) << classes[b.bytes[i]].name;
+  }
+  const double share = j["raised_lowered_share"].get<double>();
+  EXPECT_NEAR(share, double(changed) / a.bytes.size(), 1e-12);
+  if (j["raised_check_applied"].get<bool>()) {
+    EXPECT_GE(j["near_ground_share"].get<double>(), geo::kMinNearGround);
+  } else {
+    EXPECT_EQ(changed, 0u);
+  }
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");
@@ -491,6 +543,9 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --min-spread 400 --out " + dir_->file("x"), "--min-spread");
   expectError("ortho " + run() + " --vectors roof --out " + dir_->file("x"), "roof");
   expectError("ortho " + run() + " --on-surface -1 --out " + dir_->file("x"), "--on-surface");
+  expectError("ortho " + run() + " --raised-check 1.5 --out " + dir_->file("x"), "--raised-check");
+  expectError("ortho " + run() + " --ground-window 0 --out " + dir_->file("x"), "--ground-window");
+  expectError("eval " + run() + " --ortho --raised-check -1", "--raised-check");
   expectError("eval " + run() + " --ortho --height top", "--height");
   expectError("render " + run() + " --views nope --out " + dir_->file("x"), "nope");
   expectError("render " + run() + " --outputs class,nope --out " + dir_->file("x"), "--outputs");

@@ -34,6 +34,12 @@ class EvalCommand : public Command {
         ->default_val(0);
     c->add_option("--on-surface", ortho_options_.on_surface, "--ortho: as `ortho --on-surface`")
         ->default_val(0);
+    c->add_option("--raised-check", ortho_options_.raised_check,
+                  "--ortho: as `ortho --raised-check`")
+        ->default_val(0);
+    c->add_option("--ground-window", ortho_options_.ground_window,
+                  "--ortho: as `ortho --ground-window`")
+        ->default_val(20);
     c->add_flag("--3d", cloud_,
                 "score the per-class cloud in 3D instead: every Gaussian's class against the "
                 "nearest true surface of a `sadsplat synth` scene's world, distances to it, "

@@ -52,6 +52,15 @@ class OrthoCommand : public Command {
                   "the training photos render where they draw, as `extract --on-surface` "
                   "(default 0: all)")
         ->default_val(0);
+    c->add_option("--raised-check", o_.raised_check,
+                  "a cell of a raised class (one whose cells stand at a median >= 2.5 m above "
+                  "the ground: buildings, trees) lower above the ground than this share of that "
+                  "median takes the most likely other class (default 0: off)")
+        ->default_val(0);
+    c->add_option("--ground-window", o_.ground_window,
+                  "--raised-check: the ground is a low percentile of the DSM in windows of this "
+                  "side (map units)")
+        ->default_val(20);
     c->add_option("--vectors", o_.vectors,
                   "classes (names, comma-separated) whose regions are also written as polygons "
                   "to OUT/vectors.gpkg (GeoPackage: class, area_m2; the map's CRS)")

@@ -14,6 +14,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/eval/object_scores.h"
+#include "sadsplat/geo/ground_model.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/geo/vector_files.h"
 #include "sadsplat/io/atomic_file.h"
@@ -80,11 +81,42 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--on-surface", "a distance >= 0 in scene units (0: off)",
                 std::to_string(o.on_surface));
   }
+  if (!(o.raised_check >= 0 && o.raised_check <= 1)) {
+    throw Error(what, "--raised-check", "a share of the raised class's height in [0, 1] (0: off)",
+                std::to_string(o.raised_check));
+  }
+  if (!(o.ground_window > 0 && std::isfinite(o.ground_window))) {
+    throw Error(what, "--ground-window", "a window side > 0 in map units",
+                std::to_string(o.ground_window));
+  }
+  r.raised_share = o.raised_check;
+  r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
   r.max_surface_gap = o.on_surface;
   r.depth_tolerance = o.depth_tolerance;
   return r;
+}
+
+// What the raised-class check did (OrthoRenderOptions::raised_share), for ortho.json and
+// ortho_metrics.json.
+void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
+                    const std::vector<ClassInfo>& classes) {
+  j["raised_check"] = o.raised_check;
+  if (o.raised_check <= 0) return;
+  j["ground_window"] = o.ground_window;
+  nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
+  for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
+    const double h = img.class_height_above_ground[c];
+    heights[classes[c].name] = std::isfinite(h) ? nlohmann::json(h) : nlohmann::json(nullptr);
+  }
+  for (int c : img.raised_classes) raised.push_back(classes.at(c).name);
+  j["class_height_above_ground"] = heights;
+  j["raised_classes"] = raised;
+  const std::size_t n = img.classes.size();
+  j["raised_lowered_share"] = n ? double(img.lowered_cells) / n : 0.0;
+  j["near_ground_share"] = img.near_ground;
+  j["raised_check_applied"] = img.near_ground >= geo::kMinNearGround;
 }
 
 }  // namespace
@@ -239,6 +271,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["depth_tolerance"] = o.depth_tolerance;
   j["on_surface_m"] = o.on_surface;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
+  addRaisedCheck(j, o, img, run.scene.classes);
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
   j["similarity_fit_residual_m"] = grid.frame.fit_residual;
@@ -381,6 +414,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["min_spread_degrees"] = render.min_spread;
   j["depth_tolerance"] = render.depth_tolerance;
   j["on_surface_m"] = render.on_surface;
+  addRaisedCheck(j, render, img, run.scene.classes);
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();

@@ -8,6 +8,7 @@
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/view_coverage.h"
+#include "sadsplat/geo/ground_model.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -186,6 +187,68 @@ at::Tensor backProject(const gaussians::RasterCamera& cam, const at::Tensor& dep
   return pc.matmul(rotation) + at::tensor(std::vector<double>(centre.begin(), centre.end()), opts);
 }
 
+// The features the class map is decoded from, for one tile (OrthoRenderOptions::classes).
+at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
+                         bool first_class, const at::Tensor& keep) {
+  if (first_class) return trainer.renderSurface(camera, 0.5, true, keep).features;
+  return trainer.renderCamera(camera, keep).features;
+}
+
+// OrthoRenderOptions::raised_share: the ground under the DSM, the raised classes, and the cells
+// of a raised class at ground height given the most likely class that is not raised (the tiles
+// that hold one are rendered again for their features).
+void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                      const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
+                      OrthoImages& out) {
+  geo::GroundModelOptions ground_options;
+  ground_options.window_cells =
+      std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
+  out.ground =
+      geo::groundHeights(out.elevation, out.covered, grid.width, grid.height, ground_options);
+  const int k = static_cast<int>(trainer.numClasses());
+  const geo::LowRaisedCells low = geo::findLowRaisedCells(
+      out.classes, out.elevation, out.ground, k, options.raised_height, options.raised_share);
+  out.class_height_above_ground = low.median_above_ground;
+  out.raised_classes = low.raised;
+  out.near_ground = low.near_ground;
+  out.lowered_cells = low.ground.empty() ? 0 : static_cast<std::int64_t>(low.cells.size());
+  if (low.cells.empty() || low.ground.empty()) return;
+  std::vector<std::uint8_t> lower(out.classes.size(), 0);
+  for (std::size_t c : low.cells) lower[c] = 1;
+  const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
+  for (int ty = 0; ty < tiles_y; ++ty) {
+    for (int tx = 0; tx < tiles_x; ++tx) {
+      const int x_off = tx * tile, y_off = ty * tile;
+      const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
+      bool any = false;
+      for (int y = 0; y < h && !any; ++y) {
+        for (int x = 0; x < w && !any; ++x) {
+          any = lower[static_cast<std::size_t>(y_off + y) * grid.width + x_off + x] != 0;
+        }
+      }
+      if (!any) continue;
+      const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
+      at::Tensor cosines = trainer.classCosines(
+          classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
+      at::Tensor others = at::ones({k}, at::kBool);
+      for (int c : low.ground) others[c] = false;
+      cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
+      const auto best = cosines.max(2);
+      const at::Tensor conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
+      const at::Tensor cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t d = static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
+          if (!lower[d]) continue;
+          const std::size_t s = static_cast<std::size_t>(y) * w + x;
+          out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
+          out.confidence[d] = conf.data_ptr<float>()[s];
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid,
@@ -327,6 +390,19 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       out.elevation[pf[i]] = 0.f;
     }
     out.few_views = few.numel();
+  }
+  if (options.raised_share > 0 && trainer.numClasses() > 0) {
+    lowerRaisedCells(trainer, grid, options, keep, tile, out);
+    if (progress && out.near_ground < geo::kMinNearGround) {
+      *progress << "  ortho: warning: --raised-check skipped: only " << std::fixed
+                << std::setprecision(0) << 100 * out.near_ground
+                << " % of the classified cells lie near the ground the DSM suggests (pits or "
+                   "no visible ground; try --min-views 2)\n"
+                << std::defaultfloat;
+    } else if (progress) {
+      *progress << "  ortho: " << out.lowered_cells << " cells of a raised class at ground height"
+                << " given the most likely ground class\n";
+    }
   }
   return out;
 }

@@ -45,7 +45,9 @@ struct OrthoRunOptions {
   int min_views = 0;      ///< --min-views: cells fewer training photos see are nodata (0: off)
   double min_spread = 0;  ///< --min-spread DEG (OrthoRenderOptions::min_spread_degrees)
   double depth_tolerance = 0.02;  ///< --depth-tolerance (OrthoRenderOptions::depth_tolerance)
-  double on_surface = 0;  ///< --on-surface M (OrthoRenderOptions::max_surface_gap; 0: off)
+  double on_surface = 0;          ///< --on-surface M (OrthoRenderOptions::max_surface_gap; 0: off)
+  double raised_check = 0;    ///< --raised-check SHARE (OrthoRenderOptions::raised_share; 0: off)
+  double ground_window = 20;  ///< --ground-window M (OrthoRenderOptions::ground_window)
   /// --vectors: classes (names) whose regions go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;
   std::ostream* progress = nullptr;

@@ -86,6 +86,16 @@ struct OrthoRenderOptions {
   /// cloud's median-depth check); floaters and Gaussians off the surfaces drop out of the
   /// orthophoto, the class map and the DSM. 0: every Gaussian.
   double max_surface_gap = 0;
+  /// Not on by default: the class map's raised classes (those whose cells stand at a median of
+  /// at least raised_height above the ground: buildings, trees) do not lie on the ground. A cell
+  /// of one lower than raised_share x its class's median height above the ground takes the most
+  /// likely ground class (median below half raised_height: roads, grass, not cars;
+  /// geo/ground_model.h; the ground from the DSM in windows of
+  /// ground_window). On synth orbits the cells the photos never see (passages between a
+  /// block's buildings) carry the building class at ground height. 0: off.
+  double raised_share = 0;
+  double raised_height = 2.5;                    ///< map units
+  double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
 };
 
@@ -101,6 +111,13 @@ struct OrthoImages {
   std::vector<float> elevation;   ///< map height of the rendered surface (OrthoSurface)
   std::vector<float> confidence;  ///< Trainer::classCosines of the class (0 without classes)
   std::int64_t few_views = 0;     ///< cells with a surface made nodata by min_views
+  /// With OrthoRenderOptions::raised_share: the ground height per cell (NaN: no surface at
+  /// all), each class's median height above it, the raised classes and how many cells they lost.
+  std::vector<float> ground;
+  std::vector<double> class_height_above_ground;
+  std::vector<int> raised_classes;
+  std::int64_t lowered_cells = 0;
+  double near_ground = 0;  ///< geo::LowRaisedCells::near_ground (the check's precondition)
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.

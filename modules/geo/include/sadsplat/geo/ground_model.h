@@ -1,0 +1,65 @@
+#pragma once
+/// \file ground_model.h
+/// \brief The bare ground under a surface model (a terrain model from a DSM), and the cells of a
+/// class map that cannot be what they say because they lie on that ground: a "building" or
+/// "tree" cell whose surface is at ground height.
+///
+/// The ground is a low percentile of the surface in square windows (the 25th: a window of a
+/// city holds streets and yards besides its roofs, and the lowest cells of a rendered DSM are
+/// pits under the true ground), the windows' values median-filtered over their 3 x 3
+/// neighbours (a window a building fills takes its neighbours' ground), a window without enough
+/// surface filled from the nearest ones, and interpolated bilinearly between the windows'
+/// centres. It assumes what a drone survey's area is: terrain smooth over a window, objects
+/// smaller than a window. No library call; plain arrays, row-major.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace sadsplat {
+namespace geo {
+
+/// \brief How the ground is estimated.
+struct GroundModelOptions {
+  int window_cells = 80;     ///< side of a window in cells (20 m at 0.25 m per cell)
+  double percentile = 0.25;  ///< share of a window's surface cells below its ground value
+  double min_covered = 0.1;  ///< share of a window's cells with a surface for it to count
+};
+
+/// \brief The ground height of every cell of a `width` x `height` grid whose surface heights are
+/// `surface` where `covered` is non-zero. Every cell gets a value (windows without surface take
+/// their nearest windows' ground); a grid without any surface gives NaN everywhere.
+/// \throws sadsplat::Error for sizes that do not match or a window below 1 cell
+std::vector<float> groundHeights(const std::vector<float>& surface,
+                                 const std::vector<std::uint8_t>& covered, int width, int height,
+                                 const GroundModelOptions& options = {});
+
+/// \brief The class map's cells that lie too low for their class.
+struct LowRaisedCells {
+  /// Per class (index = class id): the median height above the ground of its cells (NaN for a
+  /// class without cells).
+  std::vector<double> median_above_ground;
+  std::vector<int> raised;  ///< classes whose median is at least the raised height
+  /// Classes whose median is below half the raised height (roads, grass, water: not cars), the
+  /// ones a low cell of a raised class can take; all classes that are not raised when none is.
+  std::vector<int> ground;
+  std::vector<std::size_t> cells;  ///< cells of a raised class below share x its median
+  /// Share of the classified cells within half the raised height of the ground. Below
+  /// kMinNearGround the surface shows no ground to stand on (a DSM with pits of tens of metres, a
+  /// forest): nothing is listed in `cells`.
+  double near_ground = 0;
+};
+constexpr double kMinNearGround = 0.3;
+
+/// \brief Finds them: a class is raised when its cells stand at a median of at least
+/// `raised_height` above the ground (buildings, trees; not roads, grass, cars); a cell of a raised
+/// class lower than `share` x its class's median above the ground is listed. `classes` holds
+/// class ids (255: no class). A class without cells is neither raised nor ground.
+/// \throws sadsplat::Error for sizes that do not match, share outside (0, 1] or raised_height <= 0
+LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
+                                  const std::vector<float>& surface,
+                                  const std::vector<float>& ground, int num_classes,
+                                  double raised_height, double share);
+
+}  // namespace geo
+}  // namespace sadsplat
