@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """The benchmark's 3D and map table from `scripts/gpu/experiments.sh scene` results.
 
-usage: map_table.py DIR
+usage: map_table.py DIR [ORTHO]
 DIR holds one folder per scene run, as experiments.sh leaves them under /tmp/sadsplat-scene:
 <scene>[_pl][_<capture>]/results/{metrics,ortho,3d}_<name>.json (ORTHO=1 THREED=1). Prints a
 Markdown table: per scene, capture and run the view mIoU, the cloud's 3D point mIoU and
 geometry, the class map's mIoU and its gap to the views, the DSM's RMSE on roofs and roads,
 the building area error and object F1 (map regions; the cloud's Euclidean clusters).
+ORTHO names the class-map files to read (default "ortho": ortho_<name>.json; "ortho_r0.33":
+the raised-class check's, ORTHO_RAISED=0.33).
 """
 import glob
 import json
@@ -25,6 +27,7 @@ def pct(v):
 
 def main():
     root = sys.argv[1]
+    ortho = sys.argv[2] if len(sys.argv) > 2 else "ortho"
     rows = []
     for metrics in sorted(glob.glob(os.path.join(root, "*", "results", "metrics_*.json"))):
         results = os.path.dirname(metrics)
@@ -34,7 +37,7 @@ def main():
         scene = folder.replace("_grid-oblique", "").replace("_pl", "")
         method = {"none": "Net-1", "full": "full"}.get(name, name)
         m = load(metrics)
-        o = load(os.path.join(results, "ortho_%s.json" % name))
+        o = load(os.path.join(results, "%s_%s.json" % (ortho, name)))
         t = load(os.path.join(results, "3d_%s.json" % name))
         dsm = o["dsm"]["per_class"]
         building = o["area"].get("building")

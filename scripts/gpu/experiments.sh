@@ -16,7 +16,9 @@
 #       `sadsplat import`; or KIND_SEED for a synth scene, KIND_SEED_pl with pseudo-labels), JOBS
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
 #       scenes; and as the blend through the Gaussians: orthoblend_*.json), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); ORTHO_SURFACE="1 2" the orthophoto
-#       of the Gaussians on the surface (eval --ortho --on-surface M: ortho_sM_*.json); KEEP_RUNS=1
+#       of the Gaussians on the surface (eval --ortho --on-surface M: ortho_sM_*.json);
+#       ORTHO_RAISED="0.33" the class map with the raised-class check (eval --ortho --raised-check
+#       F: ortho_rF_*.json); KEEP_RUNS=1
 #       packs the run directories (no .ply / .pcd) into $OUT/runs_<scene>.tar.* (15 MiB parts);
 #       $OUT gets
 #       scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
@@ -287,6 +289,10 @@ mode_scene() {
         for m in ${ORTHO_SURFACE:-}; do
           "$bin" eval "$work/run_$name" --ortho --on-surface "$m" \
             > "$work/results/ortho_s${m}_$name.json" 2>> "$work/results/eval_$name.log" || exit 1
+        done &&
+        for r in ${ORTHO_RAISED:-}; do
+          "$bin" eval "$work/run_$name" --ortho --raised-check "$r" \
+            > "$work/results/ortho_r${r}_$name.json" 2>> "$work/results/eval_$name.log" || exit 1
         done || {
         echo "$name: stopped (rc $?)"
         # A training stopped at the deadline leaves its checkpoint: evaluate the model as it was
@@ -319,6 +325,9 @@ mode_scene() {
     fi
     f="$work/results/ortho_$name.json"
     [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print("    ortho (%s m): mIoU %.2f  OA %.2f  uncovered %.1f %%  area error %s" % (m["gsd"], 100*m["miou"], 100*m["oacc"], 100*m["uncovered_share"], " ".join("%s %+.0f%%" % (k, 100*v["relative_error"]) for k, v in m["area"].items() if v["relative_error"] is not None)))' "$f" >> "$summary"
+    for f in "$work/results"/ortho_r*_"$name".json; do
+      [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); b=m["area"].get("building"); print("    ortho raised check %s: mIoU %.2f  building %s  lowered %.1f %%  near ground %.0f %%  raised %s" % (m["raised_check"], 100*m["miou"], "%+.0f %%" % (100*b["relative_error"]) if b else "-", 100*m.get("raised_lowered_share", 0), 100*m.get("near_ground_share", 0), ",".join(m.get("raised_classes", []))))' "$f" >> "$summary"
+    done
     for f in "$work/results"/ortho_s*_"$name".json; do
       [ -s "$f" ] && python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); d=m["dsm"]["per_class"]; print("    ortho on surface %s: mIoU %.2f  uncovered %.1f %%  building %+.0f %%  DSM %.2f m (roofs %.2f, road %.2f)  map objects F1 %.2f" % (m["on_surface_m"], 100*m["miou"], 100*m["uncovered_share"], 100*m["area"]["building"]["relative_error"], m["dsm"]["rmse_m"], d["building"]["rmse_m"], d["road"]["rmse_m"], m["objects"]["f1"]))' "$f" >> "$summary"
     done
