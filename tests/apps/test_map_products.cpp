@@ -260,9 +260,9 @@ TEST_F(MapProducts, OrthoOnSurfaceMapsOnlyTheGaussiansNearTheRenderedSurface) {
   EXPECT_LT(none, all);
 }
 
-// --raised-check: ortho.json gives every class's median height above the ground and which
-// classes are raised; the cells it changes were of a raised class and are now of a ground class
-// (median below half the raised height), nothing else changes.
+// --raised-check (on by default): ortho.json gives every class's median height above the ground and
+// which classes are raised; the cells it changes were of a raised class and are now of a ground
+// class (median below half the raised height), nothing else changes.
 TEST_F(MapProducts, OrthoRaisedCheckChangesOnlyRaisedCellsToGroundClasses) {
   const auto ortho = [&](const std::string& args, const std::string& name) {
     std::string out;
@@ -273,10 +273,14 @@ TEST_F(MapProducts, OrthoRaisedCheckChangesOnlyRaisedCellsToGroundClasses) {
         << out;
     return dir;
   };
-  const std::string plain = ortho("", "ortho_plain"),
+  const std::string plain = ortho("--raised-check 0", "ortho_plain"),
                     checked = ortho("--raised-check 0.5 --ground-window 8", "ortho_raised");
   const nlohmann::json j = nlohmann::json::parse(test::readFile(checked + "/ortho.json"));
   const std::vector<ClassInfo> classes = classesOf(run());
+  EXPECT_EQ(nlohmann::json::parse(
+                test::readFile(ortho("", "ortho_default") + "/ortho.json"))["raised_check"]
+                .get<double>(),
+            0.33);
   ASSERT_EQ(j["raised_check"].get<double>(), 0.5);
   ASSERT_EQ(j["ground_window"].get<double>(), 8.0);
   std::set<std::string> raised, ground;

@@ -36,7 +36,7 @@ class EvalCommand : public Command {
         ->default_val(0);
     c->add_option("--raised-check", ortho_options_.raised_check,
                   "--ortho: as `ortho --raised-check`")
-        ->default_val(0);
+        ->default_val(0.33);
     c->add_option("--ground-window", ortho_options_.ground_window,
                   "--ortho: as `ortho --ground-window`")
         ->default_val(20);

@@ -55,8 +55,9 @@ class OrthoCommand : public Command {
     c->add_option("--raised-check", o_.raised_check,
                   "a cell of a raised class (one whose cells stand at a median >= 2.5 m above "
                   "the ground: buildings, trees) lower above the ground than this share of that "
-                  "median takes the most likely other class (default 0: off)")
-        ->default_val(0);
+                  "median takes the most likely ground class (0: off; skipped with a warning "
+                  "where the DSM shows no ground)")
+        ->default_val(0.33);
     c->add_option("--ground-window", o_.ground_window,
                   "--raised-check: the ground is a low percentile of the DSM in windows of this "
                   "side (map units)")

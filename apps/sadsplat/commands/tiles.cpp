@@ -16,8 +16,9 @@ class TilesCommand : public Command {
         "The model as a 3D Tiles 1.1 tileset for the globe (CesiumJS): glTF content with "
         "KHR_gaussian_splatting (SPZ), levels of detail by class-aware merges, classes as "
         "feature IDs, placed by the georeference");
-    c->add_option("MODEL", in_, "run directory, or a model file (.ply, .pcd, .spz, ...) with "
-                                "classes.json / georeference.json beside it")
+    c->add_option("MODEL", in_,
+                  "run directory, or a model file (.ply, .pcd, .spz, ...) with "
+                  "classes.json / georeference.json beside it")
         ->required();
     c->add_option("--out", out_, "tileset folder (tileset.json, tiles/*.glb)")->required();
     c->add_option("--max-splats", options_.max_splats,

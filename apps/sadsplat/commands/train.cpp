@@ -167,8 +167,7 @@ class TrainCommand : public Command {
                   "none");
     if (rank_env && !in_blocks) {
       // Every rank of a group, also a group of one (its all-reduce then costs what it costs).
-      options.collective =
-          distributed::joinGroup(*rank_env, gaussians::choiceName(config.device));
+      options.collective = distributed::joinGroup(*rank_env, gaussians::choiceName(config.device));
     }
     options.scene = scene_;
     options.out = out_;

@@ -86,13 +86,14 @@ struct OrthoRenderOptions {
   /// cloud's median-depth check); floaters and Gaussians off the surfaces drop out of the
   /// orthophoto, the class map and the DSM. 0: every Gaussian.
   double max_surface_gap = 0;
-  /// Not on by default: the class map's raised classes (those whose cells stand at a median of
+  /// The class map's raised classes (those whose cells stand at a median of
   /// at least raised_height above the ground: buildings, trees) do not lie on the ground. A cell
   /// of one lower than raised_share x its class's median height above the ground takes the most
   /// likely ground class (median below half raised_height: roads, grass, not cars;
   /// geo/ground_model.h; the ground from the DSM in windows of
   /// ground_window). On synth orbits the cells the photos never see (passages between a
-  /// block's buildings) carry the building class at ground height. 0: off.
+  /// block's buildings) carry the building class at ground height. 0: off (here; `ortho` and
+  /// `eval --ortho` ask for 0.33, map_products.h).
   double raised_share = 0;
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
