@@ -195,8 +195,8 @@ at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::Ras
 }
 
 // OrthoRenderOptions::raised_share: the ground under the DSM, the raised classes, and the cells
-// of a raised class at ground height given the most likely class that is not raised (the tiles
-// that hold one are rendered again for their features).
+// of a raised class at ground height given the most likely ground class (the tiles that hold one
+// are rendered again for their features).
 void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
                       const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
                       OrthoImages& out) {
@@ -394,11 +394,10 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   if (options.raised_share > 0 && trainer.numClasses() > 0) {
     lowerRaisedCells(trainer, grid, options, keep, tile, out);
     if (progress && out.near_ground < geo::kMinNearGround) {
-      *progress << "  ortho: warning: --raised-check skipped: only " << std::fixed
-                << std::setprecision(0) << 100 * out.near_ground
+      *progress << "  ortho: warning: --raised-check skipped: only "
+                << std::lround(100 * out.near_ground)
                 << " % of the classified cells lie near the ground the DSM suggests (pits or "
-                   "no visible ground; try --min-views 2)\n"
-                << std::defaultfloat;
+                   "no visible ground; try --min-views 2)\n";
     } else if (progress) {
       *progress << "  ortho: " << out.lowered_cells << " cells of a raised class at ground height"
                 << " given the most likely ground class\n";
