@@ -125,6 +125,21 @@ TEST(GroundModel, RaisedClassesAtGroundHeightAreListed) {
   const geo::LowRaisedCells half =
       geo::findLowRaisedCells(m.classes, m.surface, ground, 3, 2.5, 0.5);
   EXPECT_EQ(half.cells.size(), passages.size() + 10);
+  // Only the building class, also on the ground west of x = 50 (the rest unclassified): enough
+  // ground in view, but no class for the low cells to take: none listed.
+  std::vector<std::uint8_t> only_buildings = m.classes;
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      std::uint8_t& c = only_buildings[m.at(x, y)];
+      if (c != 255) c = c == 1 || x < 50 ? 1 : 255;
+    }
+  }
+  const geo::LowRaisedCells alone =
+      geo::findLowRaisedCells(only_buildings, m.surface, ground, 3, 2.5, 1.0 / 3);
+  ASSERT_GE(alone.near_ground, geo::kMinNearGround);
+  EXPECT_EQ(alone.raised, std::vector<int>({1}));
+  EXPECT_TRUE(alone.ground.empty());
+  EXPECT_TRUE(alone.cells.empty());
 }
 
 TEST(GroundModel, NoCheckWhereTheSurfaceShowsNoGround) {

@@ -201,6 +201,7 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
       if (!raised[k] && !above[k].empty()) out.ground.push_back(k);
     }
   }
+  if (out.ground.empty()) return out;  // no class for a low cell to take
   for (std::size_t c = 0; c < classes.size(); ++c) {
     const int k = classes[c];
     if (k >= num_classes || !raised[k]) continue;

@@ -187,6 +187,24 @@ at::Tensor backProject(const gaussians::RasterCamera& cam, const at::Tensor& dep
   return pc.matmul(rotation) + at::tensor(std::vector<double>(centre.begin(), centre.end()), opts);
 }
 
+// The grid cut into tiles of at most `tile` pixels a side, row by row.
+struct OrthoTile {
+  int x_off, y_off, w, h;
+  std::size_t cell(int x, int y, const OrthoGrid& grid) const {  // grid index of tile pixel
+    return static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
+  }
+};
+std::vector<OrthoTile> orthoTiles(const OrthoGrid& grid, int tile) {
+  std::vector<OrthoTile> tiles;
+  for (int y_off = 0; y_off < grid.height; y_off += tile) {
+    for (int x_off = 0; x_off < grid.width; x_off += tile) {
+      tiles.push_back(
+          {x_off, y_off, std::min(tile, grid.width - x_off), std::min(tile, grid.height - y_off)});
+    }
+  }
+  return tiles;
+}
+
 // The features the class map is decoded from, for one tile (OrthoRenderOptions::classes).
 at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
                          bool first_class, const at::Tensor& keep) {
@@ -211,39 +229,32 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
   out.class_height_above_ground = low.median_above_ground;
   out.raised_classes = low.raised;
   out.near_ground = low.near_ground;
-  out.lowered_cells = low.ground.empty() ? 0 : static_cast<std::int64_t>(low.cells.size());
-  if (low.cells.empty() || low.ground.empty()) return;
+  out.lowered_cells = static_cast<std::int64_t>(low.cells.size());
+  if (low.cells.empty()) return;
   std::vector<std::uint8_t> lower(out.classes.size(), 0);
   for (std::size_t c : low.cells) lower[c] = 1;
-  const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
-  for (int ty = 0; ty < tiles_y; ++ty) {
-    for (int tx = 0; tx < tiles_x; ++tx) {
-      const int x_off = tx * tile, y_off = ty * tile;
-      const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
-      bool any = false;
-      for (int y = 0; y < h && !any; ++y) {
-        for (int x = 0; x < w && !any; ++x) {
-          any = lower[static_cast<std::size_t>(y_off + y) * grid.width + x_off + x] != 0;
-        }
-      }
-      if (!any) continue;
-      const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
-      at::Tensor cosines = trainer.classCosines(
-          classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
-      at::Tensor others = at::ones({k}, at::kBool);
-      for (int c : low.ground) others[c] = false;
-      cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
-      const auto best = cosines.max(2);
-      const at::Tensor conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
-      const at::Tensor cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
-      for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t d = static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
-          if (!lower[d]) continue;
-          const std::size_t s = static_cast<std::size_t>(y) * w + x;
-          out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
-          out.confidence[d] = conf.data_ptr<float>()[s];
-        }
+  for (const OrthoTile& t : orthoTiles(grid, tile)) {
+    bool any = false;
+    for (int y = 0; y < t.h && !any; ++y) {
+      for (int x = 0; x < t.w && !any; ++x) any = lower[t.cell(x, y, grid)] != 0;
+    }
+    if (!any) continue;
+    const gaussians::RasterCamera camera = orthoCamera(grid, t.x_off, t.y_off, t.w, t.h);
+    at::Tensor cosines = trainer.classCosines(
+        classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
+    at::Tensor others = at::ones({k}, at::kBool);
+    for (int c : low.ground) others[c] = false;
+    cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
+    const auto best = cosines.max(2);
+    const at::Tensor conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
+    const at::Tensor cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
+    for (int y = 0; y < t.h; ++y) {
+      for (int x = 0; x < t.w; ++x) {
+        const std::size_t d = t.cell(x, y, grid);
+        if (!lower[d]) continue;
+        const std::size_t s = static_cast<std::size_t>(y) * t.w + x;
+        out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
+        out.confidence[d] = conf.data_ptr<float>()[s];
       }
     }
   }
@@ -281,64 +292,60 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   out.confidence.assign(pixels, 0.f);
   const bool first_height = options.height == OrthoSurface::kFirst;
   const bool first_class = options.classes == OrthoSurface::kFirst;
-  const int tiles_x = (grid.width + tile - 1) / tile, tiles_y = (grid.height + tile - 1) / tile;
+  const std::vector<OrthoTile> tiles = orthoTiles(grid, tile);
   int done = 0;
   std::vector<at::Tensor> surface_points, surface_cells;
-  for (int ty = 0; ty < tiles_y; ++ty) {
-    for (int tx = 0; tx < tiles_x; ++tx) {
-      const int x_off = tx * tile, y_off = ty * tile;
-      const int w = std::min(tile, grid.width - x_off), h = std::min(tile, grid.height - y_off);
-      const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
-      const gaussians::RenderResult r = trainer.renderCamera(camera, keep);
-      const at::Tensor rgb =
-          r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
-      at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
-      at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
-      if (first_height || first_class) {
-        const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5, first_class, keep);
-        // The same cells: the transmittance falls below 0.5 where the alpha reaches 0.5.
-        covered = layer.reached;
-        if (first_height) depth = layer.depth;
-        if (first_class) features = layer.features;
-      }
-      if (options.min_views > 0 || options.min_spread_degrees > 0) {
-        // The covered cells' surface points, counted against the photos after the last tile.
-        const at::Tensor cells = covered.reshape(-1).nonzero().reshape(-1);
-        surface_points.push_back(backProject(camera, depth).index_select(0, cells));
-        const at::Tensor ys = cells.div(w, "floor") + y_off, xs = cells.remainder(w) + x_off;
-        surface_cells.push_back(ys * grid.width + xs);
-      }
-      covered = covered.to(at::kByte).contiguous();
-      depth = depth.contiguous();
-      if (trainer.numClasses() > 0) {
-        const auto best = trainer.classCosines(features).max(2);
-        conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
-        cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
-      }
-      const auto* prgb = rgb.data_ptr<std::uint8_t>();
-      const auto* pc = covered.data_ptr<std::uint8_t>();
-      const float* pd = depth.data_ptr<float>();
-      for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t s = static_cast<std::size_t>(y) * w + x;
-          const std::size_t d = static_cast<std::size_t>(y_off + y) * grid.width + x_off + x;
-          for (int c = 0; c < 3; ++c) out.rgb[3 * d + c] = prgb[3 * s + c];
-          if (!pc[s]) continue;
-          out.covered[d] = 1;
-          out.elevation[d] = static_cast<float>(grid.top - pd[s] + grid.frame.height_offset);
-          if (cls.defined()) {
-            out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
-            out.confidence[d] = conf.data_ptr<float>()[s];
-          }
+  for (const OrthoTile& t : tiles) {
+    const int x_off = t.x_off, y_off = t.y_off, w = t.w, h = t.h;
+    const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
+    const gaussians::RenderResult r = trainer.renderCamera(camera, keep);
+    const at::Tensor rgb = r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
+    at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
+    at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
+    if (first_height || first_class) {
+      const gaussians::SurfaceLayer layer = trainer.renderSurface(camera, 0.5, first_class, keep);
+      // The same cells: the transmittance falls below 0.5 where the alpha reaches 0.5.
+      covered = layer.reached;
+      if (first_height) depth = layer.depth;
+      if (first_class) features = layer.features;
+    }
+    if (options.min_views > 0 || options.min_spread_degrees > 0) {
+      // The covered cells' surface points, counted against the photos after the last tile.
+      const at::Tensor cells = covered.reshape(-1).nonzero().reshape(-1);
+      surface_points.push_back(backProject(camera, depth).index_select(0, cells));
+      const at::Tensor ys = cells.div(w, "floor") + y_off, xs = cells.remainder(w) + x_off;
+      surface_cells.push_back(ys * grid.width + xs);
+    }
+    covered = covered.to(at::kByte).contiguous();
+    depth = depth.contiguous();
+    if (trainer.numClasses() > 0) {
+      const auto best = trainer.classCosines(features).max(2);
+      conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
+      cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
+    }
+    const auto* prgb = rgb.data_ptr<std::uint8_t>();
+    const auto* pc = covered.data_ptr<std::uint8_t>();
+    const float* pd = depth.data_ptr<float>();
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t s = static_cast<std::size_t>(y) * w + x;
+        const std::size_t d = t.cell(x, y, grid);
+        for (int c = 0; c < 3; ++c) out.rgb[3 * d + c] = prgb[3 * s + c];
+        if (!pc[s]) continue;
+        out.covered[d] = 1;
+        out.elevation[d] = static_cast<float>(grid.top - pd[s] + grid.frame.height_offset);
+        if (cls.defined()) {
+          out.classes[d] = static_cast<std::uint8_t>(cls.data_ptr<std::int64_t>()[s]);
+          out.confidence[d] = conf.data_ptr<float>()[s];
         }
       }
-      ++done;
-      if (progress && tiles_x * tiles_y > 1) {
-        *progress << "\r  ortho tile " << done << "/" << tiles_x * tiles_y << std::flush;
-      }
+    }
+    ++done;
+    if (progress && tiles.size() > 1) {
+      *progress << "\r  ortho tile " << done << "/" << tiles.size() << std::flush;
     }
   }
-  if (progress && tiles_x * tiles_y > 1) *progress << "\n";
+  if (progress && tiles.size() > 1) *progress << "\n";
   if ((options.min_views > 0 || options.min_spread_degrees > 0) && !surface_points.empty()) {
     const at::Tensor device_probe = trainer.parameters().means;
     const at::Tensor points = at::cat(surface_points).to(device_probe.device());

@@ -43,7 +43,8 @@ struct LowRaisedCells {
   /// Classes whose median is below half the raised height (roads, grass, water: not cars), the
   /// ones a low cell of a raised class can take; all classes that are not raised when none is.
   std::vector<int> ground;
-  std::vector<std::size_t> cells;  ///< cells of a raised class below share x its median
+  /// Cells of a raised class below share x its median (none when there is no ground class).
+  std::vector<std::size_t> cells;
   /// Share of the classified cells within half the raised height of the ground. Below
   /// kMinNearGround the surface shows no ground to stand on (a DSM with pits of tens of metres, a
   /// forest): nothing is listed in `cells`.
