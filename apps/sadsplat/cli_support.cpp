@@ -39,6 +39,27 @@ void parseSize(const std::string& text, const std::string& flag, int* width, int
   }
 }
 
+std::vector<int> parseIndexList(const std::string& text, const std::string& flag) {
+  std::vector<int> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma - start);
+    std::size_t used = 0;
+    int value = -1;
+    try {
+      value = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size() || value < 0)
+      throw Error("<command line>", flag, "comma-separated view indices (0,7,28) or auto", text);
+    out.push_back(value);
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
 void rerunUnderXvfbIfHeadless(const Invocation& invocation) {
 #if SADSPLAT_HAVE_VIZ
   if (viz::haveDisplay() || std::getenv("SADSPLAT_UNDER_XVFB") != nullptr) return;

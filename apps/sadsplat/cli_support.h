@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <string>
+#include <vector>
 
 #include "command.h"
 
@@ -18,6 +19,10 @@ void installStopHandlers();
 /// \brief "1280x720" -> width, height.
 /// \throws sadsplat::Error naming `flag` otherwise
 void parseSize(const std::string& text, const std::string& flag, int* width, int* height);
+
+/// \brief "0,7,28" -> {0, 7, 28} (non-negative integers).
+/// \throws sadsplat::Error naming `flag` otherwise
+std::vector<int> parseIndexList(const std::string& text, const std::string& flag);
 
 /// \brief VTK renders through X only on Debian: an offscreen job (a screenshot, a report, charts)
 /// on a machine with no display runs itself again under xvfb-run when that is installed. Returns

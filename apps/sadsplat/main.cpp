@@ -19,6 +19,7 @@ std::vector<std::unique_ptr<Command>> allCommands() {
   commands.push_back(makeInfoCommand());
   commands.push_back(makeSfmCommand());
   commands.push_back(makeImportCommand());
+  commands.push_back(makePickViewsCommand());
   commands.push_back(makeConvertCommand());
   commands.push_back(makeExtractCommand());
   commands.push_back(makeTrainCommand());

@@ -17,6 +17,7 @@
 #       at once; ITERATIONS (7000); ORTHO=1 also scores the class orthophoto (eval --ortho, synth
 #       scenes; and as the blend through the Gaussians: orthoblend_*.json), THREED=1 the per-class cloud in 3D (eval --3d, synth scenes); ORTHO_SURFACE="1 2" the orthophoto
 #       of the Gaussians on the surface (eval --ortho --on-surface M: ortho_sM_*.json);
+#       LABELLED=auto synth scenes with synth --labelled auto (the views pick-views advises);
 #       ORTHO_RAISED="0.33" the class map with the raised-class check (eval --ortho --raised-check
 #       F: ortho_rF_*.json); KEEP_RUNS=1
 #       packs the run directories (no .ply / .pcd) into $OUT/runs_<scene>.tar.* (15 MiB parts);
@@ -269,6 +270,7 @@ mode_scene() {
   fi
   local tag; tag=$(basename "${scene%.cache}")
   [ "${CAPTURE:-orbit}" = orbit ] || tag="${tag}_$CAPTURE"
+  [ -z "${LABELLED:-}" ] || tag="${tag}_l${LABELLED//,/-}"
   local work="/tmp/sadsplat-scene/$tag"; rm -rf "$work"; mkdir -p "$work/results"
   local spec
   for spec in "$@"; do

@@ -11,7 +11,8 @@
 #                                print the path of the synth scene cache (CAPTURE=grid-oblique
 #                                for synth's drone-mission capture; made once per kind,
 #                                seed and size under /tmp/sadsplat-scenes; KIND_SEED e.g. city_0,
-#                                or city-xl / city-xxl for the large presets)
+#                                or city-xl / city-xxl for the large presets; LABELLED=auto
+#                                for synth's --labelled)
 #   pl_cache CACHE [BIN] [ARGS]  print the path of CACHE with the built-in pseudo-labels (made once)
 #   make_cache PATH LOG CMD...   run CMD (writing PATH.part) once per PATH, one maker per machine
 #   deadline_start SECONDS       the deadline: SECONDS after the first script of this call sourced
@@ -123,6 +124,8 @@ scene_cache() {
   if [[ $scene == city-xl || $scene == city-xxl ]]; then args=(--kind city --preset "$scene")
   else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
   args+=(--capture "$capture")
+  # LABELLED (e.g. auto): synth's --labelled; its own cache name.
+  if [ -n "${LABELLED:-}" ]; then suffix="${suffix}_l${LABELLED//,/-}"; args+=(--labelled "$LABELLED"); fi
   make_cache "$cache" "$OUT/synth_${scene}_$size.log" "$bin" synth "${args[@]}" \
     --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" ||
     { echo "synth $scene failed" >&2; return 1; }

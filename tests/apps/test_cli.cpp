@@ -1,6 +1,7 @@
 // The CLI: subcommands listed, info summaries, clear errors with non-zero exits, demo.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -11,6 +12,7 @@
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gaussian_ply.h"
+#include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/io/train_log.h"
 #include "test_support/test_support.h"
@@ -87,6 +89,48 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
   EXPECT_EQ(test::runCommand(run + " --min-class-precision 1.5", &out), 2) << out;
   EXPECT_EQ(test::runCommand(run + " --min-view-agreement 1.5", &out), 2) << out;
   EXPECT_EQ(test::runCommand(run + " --targets foo", &out), 2) << out;
+}
+
+// `pick-views` names the photos to annotate; `synth --labelled auto` labels exactly those.
+TEST(Cli, PickViewsNamesTheViewsSynthLabelsWithAuto) {
+  test::TempDir dir;
+  std::string out;
+  const std::string synth = kCli + " synth --kind port --seed 2 --capture grid-oblique --views 70 " +
+                            "--width 96 --height 54 --points 3000 --cache " + dir.file("s.cache");
+  ASSERT_EQ(test::runCommand(synth + " --labelled auto", &out), 0) << out;
+  ASSERT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") + " --json " +
+                                 dir.file("pick.json"),
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("annotate these 3 photo(s)"), std::string::npos) << out;
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(dir.file("pick.json")));
+  const io::Scene scene = io::readSceneCacheWithoutPixels(dir.file("s.cache"));
+  std::vector<std::string> labelled;
+  for (const io::View& v : scene.views)
+    if (v.labelled) labelled.push_back(v.name);
+  std::vector<std::string> picked;
+  for (const auto& p : j.at("picked")) picked.push_back(p.at("name").get<std::string>());
+  std::sort(picked.begin(), picked.end());
+  EXPECT_EQ(picked, labelled);
+  EXPECT_GT(j.at("picked").back().at("cumulative_share").get<double>(), 0.5);
+  // Keeping those three, nothing is left to add much: the next view adds less than they saw.
+  ASSERT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") +
+                                 " --keep-labelled --count 1 --json " + dir.file("more.json"),
+                             &out),
+            0)
+      << out;
+  const nlohmann::json more = nlohmann::json::parse(test::readFile(dir.file("more.json")));
+  EXPECT_EQ(more.at("kept").size(), 3u);
+  EXPECT_NEAR(more.at("kept_share").get<double>(),
+              j.at("picked").back().at("cumulative_share").get<double>(), 1e-12);
+  EXPECT_EQ(test::runCommand(synth + " --labelled 0,x", &out), 1);
+  EXPECT_NE(out.find("--labelled"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + " pick-views " + dir.file("none.cache"), &out), 1);
+  EXPECT_NE(out.find("none.cache"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") + " --count 0", &out),
+            1);
+  EXPECT_NE(out.find("count"), std::string::npos) << out;
 }
 
 TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {

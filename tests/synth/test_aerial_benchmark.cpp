@@ -2,6 +2,8 @@
 // written files, and the scene import of what it writes.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -406,6 +408,45 @@ TEST(AerialBenchmark, TheGridCaptureFliesNadirLinesWithTheStatedOverlap) {
   EXPECT_EQ(synth::captureFromName(synth::captureName(synth::Capture::kGrid)),
             synth::Capture::kGrid);
   EXPECT_THROW(synth::captureFromName("spiral"), Error);
+}
+
+// --labelled auto: the views a user is advised to annotate. On the port's drone mission the
+// default indices (0, 7, 28: nadir photos of the first lines) show no ship and no crane; the
+// chosen views are training views that together show every class.
+TEST(AerialBenchmark, AutoLabelledViewsAreTrainingViewsShowingEveryClass) {
+  synth::SynthOptions o = synth::SynthOptions::demo(synth::SceneKind::kPort, 2);
+  o.capture = synth::Capture::kGridOblique;
+  o.views = 70;
+  o.width = 96;
+  o.height = 54;
+  o.max_points = 3000;
+  const auto classesShown = [](const synth::SynthScene& scene) {
+    std::set<int> shown;
+    for (const std::string& name : scene.split.labelled) {
+      for (const synth::SynthView& v : scene.views) {
+        if (v.name != name) continue;
+        for (std::uint8_t l : v.labels.pixels)
+          if (l != 255) shown.insert(l);
+      }
+    }
+    return shown;
+  };
+  const synth::SynthScene fixed = synth::generate(o);
+  o.labelled_auto = true;
+  const synth::SynthScene chosen = synth::generate(o);
+  ASSERT_EQ(chosen.split.labelled.size(), 3u);
+  EXPECT_NE(chosen.split.labelled, fixed.split.labelled);
+  for (const std::string& name : chosen.split.labelled) {
+    EXPECT_NE(std::find(chosen.split.train.begin(), chosen.split.train.end(), name),
+              chosen.split.train.end())
+        << name;
+  }
+  EXPECT_EQ(classesShown(chosen).size(), chosen.classes.size());
+  EXPECT_LT(classesShown(fixed).size(), chosen.classes.size());
+  // Only the split differs.
+  ASSERT_EQ(chosen.views.size(), fixed.views.size());
+  EXPECT_EQ(chosen.views[5].rgb.pixels, fixed.views[5].rgb.pixels);
+  EXPECT_EQ(chosen.split.test, fixed.split.test);
 }
 
 // Grid-oblique: the first half nadir on the grid, the second half on four passes at the same

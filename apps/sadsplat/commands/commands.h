@@ -11,6 +11,7 @@ namespace cli {
 std::unique_ptr<Command> makeInfoCommand();
 std::unique_ptr<Command> makeSfmCommand();
 std::unique_ptr<Command> makeImportCommand();
+std::unique_ptr<Command> makePickViewsCommand();
 std::unique_ptr<Command> makeConvertCommand();
 std::unique_ptr<Command> makeExtractCommand();
 std::unique_ptr<Command> makeTrainCommand();

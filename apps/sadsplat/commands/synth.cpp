@@ -1,6 +1,7 @@
 // `sadsplat synth`: a procedural aerial benchmark scene (directory, scene cache, survey photos).
 #include <iostream>
 
+#include "../cli_support.h"
 #include "commands.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/geo/map_frame.h"
@@ -35,7 +36,10 @@ class SynthCommand : public Command {
     c->add_option("--width", width_, "image width (1600)");
     c->add_option("--height", height_, "image height (900)");
     c->add_option("--points", points_, "sparse points to keep");
-    c->add_option("--labelled", labelled_, "labelled views (0,7,28)")->delimiter(',');
+    c->add_option("--labelled", labelled_,
+                  "labelled views: indices (0,7,28) or \"auto\": as many views as the preset "
+                  "labels, chosen as `pick-views` advises a user (those that see most of the "
+                  "ground)");
     c->add_option("--out", out_, "scene directory to write (PNG, needs OpenCV)");
     c->add_option("--cache", cache_, "scene cache file to write");
     c->add_flag("--preview", preview_, "also write OUT/preview.png");
@@ -141,7 +145,11 @@ class SynthCommand : public Command {
     if (width_ > 0) o.width = width_;
     if (height_ > 0) o.height = height_;
     if (points_ > 0) o.max_points = points_;
-    if (!labelled_.empty()) o.labelled = labelled_;
+    if (labelled_ == "auto") {
+      o.labelled_auto = true;
+    } else if (!labelled_.empty()) {
+      o.labelled = parseIndexList(labelled_, "--labelled");
+    }
     return o;
   }
 
@@ -150,7 +158,7 @@ class SynthCommand : public Command {
   int gcps_ = 0;
   std::uint64_t seed_ = 0;
   int views_ = -1, width_ = -1, height_ = -1, points_ = -1;
-  std::vector<int> labelled_;
+  std::string labelled_;
   bool preview_ = false, colmap_binary_ = false;
 };
 

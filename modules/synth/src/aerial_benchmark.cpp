@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/annotation_views.h"
 
 namespace sadsplat {
 namespace synth {
@@ -109,7 +110,8 @@ Pose obliquePose(const World& world, const SynthOptions& o, int i) {
   pass.capture = Capture::kGrid;
   pass.views = std::max(2, (oblique + 3) / 4);
   Pose p = gridPose(world, pass, std::min(j, pass.views - 1));
-  p.centre.z = static_cast<float>(gridLayout(o).altitude + (p.centre.z - gridLayout(pass).altitude));
+  p.centre.z =
+      static_cast<float>(gridLayout(o).altitude + (p.centre.z - gridLayout(pass).altitude));
   const double pitch = kObliquePitchDeg * kPi / 180.0;
   const double azimuth = kPi / 2 - direction * kPi / 2;  // north = +y, east = +x
   const Vec3 toward = {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)),
@@ -417,8 +419,9 @@ void samplePoints(const SynthOptions& o, const std::vector<Pose>& poses, SynthSc
 }  // namespace
 
 std::string captureName(Capture capture) {
-  return capture == Capture::kGrid ? "grid" : capture == Capture::kGridOblique ? "grid-oblique"
-                                                                               : "orbit";
+  return capture == Capture::kGrid          ? "grid"
+         : capture == Capture::kGridOblique ? "grid-oblique"
+                                            : "orbit";
 }
 
 Capture captureFromName(const std::string& name) {
@@ -500,6 +503,31 @@ std::optional<World> worldFromId(const std::string& id) {
   }
 }
 
+namespace {
+
+// SynthOptions::labelled_auto: the training views a user is advised to annotate.
+std::vector<int> chosenLabelledViews(const SynthScene& synth, const SynthOptions& o) {
+  io::Scene scene;
+  for (std::size_t i = 0; i < synth.views.size(); ++i) {
+    io::View view;
+    view.name = synth.views[i].name;
+    view.camera = synth.views[i].camera;
+    view.test = std::find(o.test.begin(), o.test.end(), static_cast<int>(i)) != o.test.end();
+    view.train = !view.test;
+    scene.views.push_back(std::move(view));
+  }
+  for (const SynthPoint& p : synth.points) {
+    io::ScenePoint sp;
+    std::copy(p.xyz, p.xyz + 3, sp.xyz.begin());
+    scene.points.push_back(sp);
+  }
+  geo::AnnotationViewOptions options;
+  options.count = std::max<int>(1, static_cast<int>(o.labelled.size()));
+  return geo::chooseAnnotationViews(scene, options, "<synth>").picked;
+}
+
+}  // namespace
+
 OrthoTruth orthoTruth(const World& world, double gsd) {
   OrthoTruth t;
   t.gsd = gsd;
@@ -568,13 +596,14 @@ SynthScene generate(const SynthOptions& o) {
   samplePoints(o, poses, &scene);
   scene.ortho = orthoTruth(world);
   scene.world = worldId(o.kind, o.seed, o.tiles);
+  const std::vector<int> labelled = o.labelled_auto ? chosenLabelledViews(scene, o) : o.labelled;
   for (int i = 0; i < o.views; ++i) {
     const bool test = std::find(o.test.begin(), o.test.end(), i) != o.test.end();
     if (test) {
       scene.split.test.push_back(scene.views[i].name);
     } else {
       scene.split.train.push_back(scene.views[i].name);
-      if (std::find(o.labelled.begin(), o.labelled.end(), i) != o.labelled.end()) {
+      if (std::find(labelled.begin(), labelled.end(), i) != labelled.end()) {
         scene.split.labelled.push_back(scene.views[i].name);
       }
     }

@@ -39,6 +39,10 @@ struct SynthOptions {
   int width = 1600;
   int height = 900;
   std::vector<int> labelled = {0, 7, 28};                ///< labelled training views
+  /// Instead of `labelled`: as many training views as it lists, chosen as a user is advised to
+  /// choose the photos to annotate (geo::chooseAnnotationViews: those that together see most of
+  /// the ground, by geometry alone).
+  bool labelled_auto = false;
   std::vector<int> test = {14, 21, 35, 42, 49, 56, 63};  ///< test views (those < views)
   double horizontal_fov_deg = 60.0;
   int max_points = 20000;    ///< sparse points kept (a few thousand to tens of thousands)
