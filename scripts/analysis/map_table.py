@@ -3,7 +3,7 @@
 
 usage: map_table.py DIR [ORTHO]
 DIR holds one folder per scene run, as experiments.sh leaves them under /tmp/sadsplat-scene:
-<scene>[_pl][_<capture>]/results/{metrics,ortho,3d}_<name>.json (ORTHO=1 THREED=1). Prints a
+<scene>[_pl][_<capture>][_l<labelled>]/results/{metrics,ortho,3d}_<name>.json (ORTHO=1 THREED=1). Prints a
 Markdown table: per scene, capture and run the view mIoU, the cloud's 3D point mIoU and
 geometry, the class map's mIoU and its gap to the views, the DSM's RMSE on roofs and roads,
 the building area error and object F1 (map regions; the cloud's Euclidean clusters).
@@ -33,8 +33,13 @@ def main():
         results = os.path.dirname(metrics)
         folder = os.path.basename(os.path.dirname(results))
         name = os.path.basename(metrics)[len("metrics_"):-len(".json")]
+        labelled = ""
+        if "_l" in folder.rsplit("_pl", 1)[-1]:  # LABELLED=...: <scene>..._l<labelled>
+            folder, labelled = folder.rsplit("_l", 1)
         capture = "grid-oblique" if folder.endswith("_grid-oblique") else "orbit"
         scene = folder.replace("_grid-oblique", "").replace("_pl", "")
+        if labelled:
+            scene += " (labelled %s)" % labelled
         method = {"none": "Net-1", "full": "full"}.get(name, name)
         m = load(metrics)
         o = load(os.path.join(results, "%s_%s.json" % (ortho, name)))
