@@ -120,13 +120,14 @@ scene_cache() {
   # CAPTURE (orbit, the default | grid | grid-oblique): synth's --capture; its own cache name.
   local capture="${CAPTURE:-orbit}" suffix=""
   [ "$capture" = orbit ] || suffix="_$capture"
-  local cache="$SCENES_DIR/${scene}_${size}$suffix.cache" args
+  local args
   if [[ $scene == city-xl || $scene == city-xxl ]]; then args=(--kind city --preset "$scene")
   else args=(--kind "${scene%_*}" --seed "${scene##*_}"); fi
   args+=(--capture "$capture")
   # LABELLED (e.g. auto): synth's --labelled; its own cache name.
   if [ -n "${LABELLED:-}" ]; then suffix="${suffix}_l${LABELLED//,/-}"; args+=(--labelled "$LABELLED"); fi
-  make_cache "$cache" "$OUT/synth_${scene}_$size.log" "$bin" synth "${args[@]}" \
+  local cache="$SCENES_DIR/${scene}_${size}$suffix.cache"
+  make_cache "$cache" "$OUT/synth_${scene}_$size$suffix.log" "$bin" synth "${args[@]}" \
     --width "${size%x*}" --height "${size#*x}" --cache "$cache.part" ||
     { echo "synth $scene failed" >&2; return 1; }
   echo "$cache"
