@@ -12,6 +12,7 @@
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/pipeline/labelled_cloud.h"
+#include "sadsplat/pipeline/raised_gaussians.h"
 
 namespace sadsplat {
 namespace cli {
@@ -49,11 +50,25 @@ class ExtractCommand : public Command {
                   "metres for georeferenced or synth scenes) from the surface (median depth) the "
                   "training views render where they see it: floaters and Gaussians inside "
                   "volumes go");
+    c->add_option("--raised-check", raised_check_,
+                  "a run directory only: leave out the Gaussians of a raised class (median at "
+                  "least 2.5 m above the ground: buildings, trees) lower than this share of "
+                  "their class's median height above the ground (0.33 as `ortho`'s; metres: "
+                  "georeferenced or synth scenes), e.g. building Gaussians on the street that "
+                  "join two buildings into one object; 0 = off (default)");
     return c;
   }
 
   int run(const Invocation&) override {
     std::string in = in_, classes = classes_;
+    if (raised_check_ != 0 && !io::isDirectory(in)) {
+      throw Error(in, "--raised-check", "a run directory (its scene gives the up direction)",
+                  "a file");
+    }
+    if (!(raised_check_ >= 0 && raised_check_ <= 1)) {
+      throw Error("<command line>", "--raised-check", "a share in [0, 1]",
+                  std::to_string(raised_check_));
+    }
     if (on_surface_ != 0 && !io::isDirectory(in)) {
       throw Error(in, "--on-surface",
                   "a run directory (the check renders its model through its training views)",
@@ -92,12 +107,19 @@ class ExtractCommand : public Command {
           });
     } else {
       const auto read = [&](const std::string& p) {
-        if (on_surface_ == 0) return io::readGaussians(p);
-        const auto kept = pipeline::gaussiansOnSurface(in_, io::readGaussians(p),
-                                                       static_cast<float>(on_surface_), &std::cerr);
-        std::cout << "on the surface (within " << on_surface_ << "): " << kept.size()
-                  << " Gaussians\n";
-        return kept;
+        pcl::PointCloud<GaussianPoint> model = io::readGaussians(p);
+        if (on_surface_ != 0) {
+          model =
+              pipeline::gaussiansOnSurface(in_, model, static_cast<float>(on_surface_), &std::cerr);
+          std::cout << "on the surface (within " << on_surface_ << "): " << model.size()
+                    << " Gaussians\n";
+        }
+        if (raised_check_ != 0) {
+          pipeline::RaisedGaussianOptions options;
+          options.share = raised_check_;
+          model = pipeline::withoutLowRaisedGaussians(in_, model, options, &std::cout);
+        }
+        return model;
       };
       extractClass<GaussianPoint>(
           in, out_, id, negative_, read,
@@ -138,6 +160,7 @@ class ExtractCommand : public Command {
   std::string in_, out_, class_, classes_, classification_map_;
   bool negative_ = false;
   double on_surface_ = 0;
+  double raised_check_ = 0;
 };
 
 }  // namespace

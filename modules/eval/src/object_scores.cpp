@@ -100,6 +100,61 @@ std::vector<std::vector<std::size_t>> euclideanClusters(
   return clusters;
 }
 
+double medianNeighbourDistance(const std::vector<std::array<float, 3>>& points) {
+  const std::size_t n = points.size();
+  if (n < 2) return 0;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (const auto& p : points) {
+    for (int c = 0; c < 3; ++c)
+      lo[c] = std::min<double>(lo[c], p[c]), hi[c] = std::max<double>(hi[c], p[c]);
+  }
+  // Start from the spacing of n points spread over the footprint; double it until more than half
+  // of the points have a neighbour within it (their nearest distances are then exact).
+  double h = std::max(1e-6, std::sqrt((hi[0] - lo[0]) * (hi[1] - lo[1]) / n));
+  using Key = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return std::hash<std::int64_t>()(std::get<0>(k) * 73856093LL ^ std::get<1>(k) * 19349663LL ^
+                                       std::get<2>(k) * 83492791LL);
+    }
+  };
+  for (int round = 0; round < 64; ++round, h *= 2) {
+    std::unordered_map<Key, std::vector<std::size_t>, KeyHash> cells;
+    const auto keyOf = [&](const std::array<float, 3>& p) {
+      return Key{static_cast<std::int64_t>(std::floor(p[0] / h)),
+                 static_cast<std::int64_t>(std::floor(p[1] / h)),
+                 static_cast<std::int64_t>(std::floor(p[2] / h))};
+    };
+    for (std::size_t i = 0; i < n; ++i) cells[keyOf(points[i])].push_back(i);
+    std::vector<double> nearest(n, INFINITY);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto [kx, ky, kz] = keyOf(points[i]);
+      double best = INFINITY;
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        for (std::int64_t dy = -1; dy <= 1; ++dy) {
+          for (std::int64_t dz = -1; dz <= 1; ++dz) {
+            const auto it = cells.find(Key{kx + dx, ky + dy, kz + dz});
+            if (it == cells.end()) continue;
+            for (std::size_t j : it->second) {
+              if (j == i) continue;
+              double d2 = 0;
+              for (int c = 0; c < 3; ++c) {
+                const double d = double(points[i][c]) - points[j][c];
+                d2 += d * d;
+              }
+              best = std::min(best, d2);
+            }
+          }
+        }
+      }
+      if (std::sqrt(best) <= h) nearest[i] = std::sqrt(best);  // exact within h
+    }
+    std::nth_element(nearest.begin(), nearest.begin() + n / 2, nearest.end());
+    if (std::isfinite(nearest[n / 2])) return nearest[n / 2];
+  }
+  return INFINITY;  // not reached for finite points
+}
+
 Footprint convexHull(std::vector<std::array<double, 2>> p) {
   std::sort(p.begin(), p.end());
   p.erase(std::unique(p.begin(), p.end()), p.end());

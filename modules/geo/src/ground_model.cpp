@@ -157,10 +157,58 @@ std::vector<float> groundHeights(const std::vector<float>& surface,
   return ground;
 }
 
+std::vector<float> groundUnderPoints(const std::vector<float>& e, const std::vector<float>& n,
+                                     const std::vector<float>& up,
+                                     const std::vector<std::uint8_t>& use, double cell,
+                                     double window) {
+  checkSize(n.size(), e.size(), "n");
+  checkSize(up.size(), e.size(), "up");
+  checkSize(use.size(), e.size(), "use");
+  if (!(cell > 0) || !(window > 0)) {
+    throw Error("<ground model>", "cell / window", "> 0",
+                std::to_string(cell) + " / " + std::to_string(window));
+  }
+  double e0 = INFINITY, e1 = -INFINITY, n0 = INFINITY, n1 = -INFINITY;
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (!use[i] || !std::isfinite(e[i]) || !std::isfinite(n[i]) || !std::isfinite(up[i])) continue;
+    e0 = std::min<double>(e0, e[i]), e1 = std::max<double>(e1, e[i]);
+    n0 = std::min<double>(n0, n[i]), n1 = std::max<double>(n1, n[i]);
+  }
+  if (!(e1 >= e0)) return std::vector<float>(e.size(), kNone);
+  const double w = std::floor((e1 - e0) / cell) + 1, h = std::floor((n1 - n0) / cell) + 1;
+  if (w * h > 64e6) {
+    throw Error(
+        "<ground model>", "cell", "a grid of at most 64 million cells over the points",
+        std::to_string(w) + " x " + std::to_string(h) + " cells of " + std::to_string(cell));
+  }
+  const int width = static_cast<int>(w), height = static_cast<int>(h);
+  const auto cellOf = [&](float x, float y) {
+    const int i = std::clamp(static_cast<int>(std::floor((x - e0) / cell)), 0, width - 1);
+    const int j = std::clamp(static_cast<int>(std::floor((y - n0) / cell)), 0, height - 1);
+    return static_cast<std::size_t>(j) * width + i;
+  };
+  std::vector<float> surface(static_cast<std::size_t>(width) * height, -INFINITY);
+  std::vector<std::uint8_t> covered(surface.size(), 0);
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (!use[i] || !std::isfinite(e[i]) || !std::isfinite(n[i]) || !std::isfinite(up[i])) continue;
+    const std::size_t c = cellOf(e[i], n[i]);
+    surface[c] = std::max(surface[c], up[i]);
+    covered[c] = 1;
+  }
+  GroundModelOptions options;
+  options.window_cells = std::max(1, static_cast<int>(std::lround(window / cell)));
+  const std::vector<float> ground = groundHeights(surface, covered, width, height, options);
+  std::vector<float> out(e.size(), kNone);
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (std::isfinite(e[i]) && std::isfinite(n[i])) out[i] = ground[cellOf(e[i], n[i])];
+  }
+  return out;
+}
+
 LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
                                   const std::vector<float>& surface,
                                   const std::vector<float>& ground, int num_classes,
-                                  double raised_height, double share) {
+                                  double raised_height, double share, double min_near_ground) {
   checkSize(surface.size(), classes.size(), "surface");
   checkSize(ground.size(), classes.size(), "ground");
   if (!(share > 0 && share <= 1)) {
@@ -192,7 +240,7 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
     for (float h : heights) near += std::abs(h) < 0.5 * raised_height;
   }
   out.near_ground = classified ? double(near) / classified : 0.0;
-  if (out.near_ground < kMinNearGround) return out;
+  if (out.near_ground < min_near_ground) return out;
   for (int k = 0; k < num_classes; ++k) {
     if (out.median_above_ground[k] < 0.5 * raised_height) out.ground.push_back(k);
   }

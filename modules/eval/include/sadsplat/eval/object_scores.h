@@ -39,6 +39,11 @@ struct ObjectScores {
 std::vector<std::vector<std::size_t>> euclideanClusters(
     const std::vector<std::array<float, 3>>& points, double tolerance, std::size_t min_points);
 
+/// \brief The median distance from a point to its nearest other point (0 for fewer than two
+/// points): the spacing at which a cloud samples its surfaces, from which a clustering tolerance
+/// can be chosen.
+double medianNeighbourDistance(const std::vector<std::array<float, 3>>& points);
+
 /// \brief Counter-clockwise convex hull of points on a plane (Andrew's monotone chain); fewer
 /// than three distinct points give what there is.
 Footprint convexHull(std::vector<std::array<double, 2>> points);

@@ -34,6 +34,19 @@ std::vector<float> groundHeights(const std::vector<float>& surface,
                                  const std::vector<std::uint8_t>& covered, int width, int height,
                                  const GroundModelOptions& options = {});
 
+/// \brief The ground under scattered points given in a frame whose third axis is up (e, n, up),
+/// e.g. the centres of a model's Gaussians: the points marked in `use` are binned into square
+/// cells of side `cell` over their extent, each cell's surface is its highest point (a surface
+/// model of the points), groundHeights of that grid (`window` in the points' units, rounded to
+/// whole cells), and each point (marked or not) takes the ground of the cell it lies in (points
+/// beyond the marked ones' extent: the nearest edge cell's). All NaN when no point is marked.
+/// \throws sadsplat::Error for sizes that do not match, a cell or window <= 0, or a grid of more
+/// than 64 million cells
+std::vector<float> groundUnderPoints(const std::vector<float>& e, const std::vector<float>& n,
+                                     const std::vector<float>& up,
+                                     const std::vector<std::uint8_t>& use, double cell,
+                                     double window);
+
 /// \brief The class map's cells that lie too low for their class.
 struct LowRaisedCells {
   /// Per class (index = class id): the median height above the ground of its cells (NaN for a
@@ -55,12 +68,14 @@ constexpr double kMinNearGround = 0.3;
 /// \brief Finds them: a class is raised when its cells stand at a median of at least
 /// `raised_height` above the ground (buildings, trees; not roads, grass, cars); a cell of a raised
 /// class lower than `share` x its class's median above the ground is listed. `classes` holds
-/// class ids (255: no class). A class without cells is neither raised nor ground.
+/// class ids (255: no class). A class without cells is neither raised nor ground. Below
+/// `min_near_ground` (LowRaisedCells::near_ground) nothing is listed.
 /// \throws sadsplat::Error for sizes that do not match, share outside (0, 1] or raised_height <= 0
 LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
                                   const std::vector<float>& surface,
                                   const std::vector<float>& ground, int num_classes,
-                                  double raised_height, double share);
+                                  double raised_height, double share,
+                                  double min_near_ground = kMinNearGround);
 
 }  // namespace geo
 }  // namespace sadsplat
