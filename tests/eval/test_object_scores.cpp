@@ -29,6 +29,27 @@ TEST(ObjectScores, ClustersJoinCentresWithinTheTolerance) {
   EXPECT_EQ(eval::euclideanClusters(p, 0.8, 2).size(), 1u);
 }
 
+// The spacing of a roof sampled every 2 m (plus a far, lonely point and a close pair) is 2 m,
+// whatever the bounding box; a spacing far below the footprint's density estimate is found too.
+TEST(ObjectScores, MedianNeighbourDistanceIsTheSamplingSpacing) {
+  std::vector<std::array<float, 3>> roof;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 20; ++j) roof.push_back({2.f * i, 2.f * j, 12.f});
+  roof.push_back({500.f, 500.f, 0.f});
+  roof.push_back({-100.f, 0.f, 0.f});
+  roof.push_back({-100.f, 0.3f, 0.f});
+  EXPECT_NEAR(eval::medianNeighbourDistance(roof), 2.0, 1e-6);
+  std::vector<std::array<float, 3>> dense;
+  for (int i = 0; i < 40; ++i) dense.push_back({0.01f * i, 0.f, 0.f});
+  dense.push_back({1000.f, 1000.f, 0.f});
+  EXPECT_NEAR(eval::medianNeighbourDistance(dense), 0.01, 1e-5);
+  EXPECT_EQ(eval::medianNeighbourDistance({{1.f, 2.f, 3.f}}), 0.0);
+  // A line (no footprint area: the search starts tiny and widens) of points 100 m apart.
+  std::vector<std::array<float, 3>> line;
+  for (int i = 0; i < 10; ++i) line.push_back({100.f * i, 0.f, 0.f});
+  EXPECT_NEAR(eval::medianNeighbourDistance(line), 100.0, 1e-6);
+}
+
 TEST(ObjectScores, HullsAndFootprintIou) {
   const eval::Footprint hull =
       eval::convexHull({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 0.5}, {0, 0}});
