@@ -1,12 +1,14 @@
 // building_footprints: the objects of one class of a trained sadsplat model, with PCL.
 //
-//   building_footprints MODEL.ply|pcd CLASSES.json CLASS OUT_DIR [TOLERANCE_M] [MIN_POINTS]
+//   building_footprints MODEL.ply|pcd CLASSES.json CLASS OUT_DIR [TOLERANCE_M|auto] [MIN_POINTS]
 //                       [GROUND_CLASS]
 //
 // 1. read the semantic Gaussians (sadsplat::io::readGaussians),
 // 2. keep one class (sadsplat::filters::ClassExtraction, a pcl::FilterIndices),
 // 3. remove outliers (pcl::StatisticalOutlierRemoval on the centres),
-// 4. split into objects (pcl::EuclideanClusterExtraction),
+// 4. split into objects (pcl::EuclideanClusterExtraction; the tolerance by default 4 x the
+//    median distance between neighbouring centres, at least 1 m: a compact model samples its
+//    roofs every 0.4-1.2 m, and a fixed 1 m splits its buildings into fragments),
 // 5. write OUT_DIR/object_<id>.pcd (the object's Gaussians, every field) and OUT_DIR/objects.csv:
 //    id, Gaussians, centroid, and the oriented bounding box (pcl::MomentOfInertiaEstimation);
 // 6. with Open3D (sadsplat::interop): the ground plane of GROUND_CLASS (default road) by Open3D's
@@ -20,6 +22,8 @@
 #include <pcl/segmentation/extract_clusters.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,9 +31,9 @@
 #include <string>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/filters/class_extraction.h"
 #include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/scene.h"
-#include "sadsplat/filters/class_extraction.h"
 #if WITH_OPEN3D
 #include "sadsplat/interop/open3d_conversion.h"
 #endif
@@ -61,12 +65,12 @@ bool groundPlane(const std::shared_ptr<Gaussians>& all, const std::string& groun
 int main(int argc, char** argv) {
   if (argc < 5) {
     std::cerr << "usage: building_footprints MODEL.ply CLASSES.json CLASS OUT_DIR "
-                 "[TOLERANCE_M=1.0] [MIN_POINTS=20]\n";
+                 "[TOLERANCE_M=auto] [MIN_POINTS=20] [GROUND_CLASS=road]\n";
     return 2;
   }
   const std::string model = argv[1], classes_json = argv[2], class_name = argv[3];
   const std::filesystem::path out_dir = argv[4];
-  const double tolerance = argc > 5 ? std::stod(argv[5]) : 1.0;
+  const std::string tolerance_arg = argc > 5 ? argv[5] : "auto";
   const int min_points = argc > 6 ? std::stoi(argv[6]) : 20;
   const std::string ground_class = argc > 7 ? argv[7] : "road";
   try {
@@ -91,6 +95,38 @@ int main(int argc, char** argv) {
 
     // 4: objects.
     auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+    tree->setInputCloud(centres, inliers);
+    double tolerance = 0;
+    if (tolerance_arg == "auto") {
+      std::vector<float> nearest;
+      pcl::Indices found(2);
+      std::vector<float> d2(2);
+      for (const auto i : *inliers) {
+        if (tree->nearestKSearch((*centres)[i], 2, found, d2) == 2)
+          nearest.push_back(std::sqrt(d2[1]));
+      }
+      double spacing = 0;
+      if (!nearest.empty()) {
+        std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+        spacing = nearest[nearest.size() / 2];
+      }
+      tolerance = std::max(1.0, 4 * spacing);  // as sadsplat's eval::autoClusterTolerance
+      std::cout << "cluster tolerance " << tolerance << " (4 x the median spacing " << spacing
+                << ", at least 1)\n";
+    } else {
+      std::size_t used = 0;
+      try {
+        tolerance = std::stod(tolerance_arg, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != tolerance_arg.size() || !(tolerance > 0)) {
+        std::cerr << "building_footprints: error: TOLERANCE_M: expected a positive number of "
+                     "metres or auto, got "
+                  << tolerance_arg << "\n";
+        return 1;
+      }
+    }
     std::vector<pcl::PointIndices> objects;
     pcl::EuclideanClusterExtraction<pcl::PointXYZ> clusters;
     clusters.setInputCloud(centres);

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -476,6 +477,47 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_EQ(j["min_views"], 0);
 }
 
+// `extract --raised-check`: a run's building Gaussians without those at ground height (a
+// subset of the plain extraction); a file or a share outside [0, 1] is an error naming the flag.
+TEST_F(MapProducts, ExtractRaisedCheckLeavesOutBuildingGaussiansAtGroundHeight) {
+  test::TempDir dir;
+  std::string out, checked_out;
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " extract " + run() + " --class building --out " + dir.file("plain.ply"), &out),
+      0)
+      << out;
+  ASSERT_EQ(test::runCommand(kCli + " extract " + run() + " --class building --raised-check 0.5 " +
+                                 "--out " + dir.file("checked.ply"),
+                             &checked_out),
+            0)
+      << checked_out;
+  EXPECT_NE(checked_out.find("raised-class check (0.5)"), std::string::npos) << checked_out;
+  const auto plain = io::readGaussians(dir.file("plain.ply"));
+  const auto checked = io::readGaussians(dir.file("checked.ply"));
+  EXPECT_LE(checked.size(), plain.size());
+  std::size_t found = 0;  // every checked Gaussian is one of the plain extraction's
+  for (const auto& c : checked) {
+    for (const auto& p : plain) {
+      if (p.x == c.x && p.y == c.y && p.z == c.z) {
+        ++found;
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(found, checked.size());
+  EXPECT_EQ(test::runCommand(kCli + " extract " + run() + " --class building --raised-check 2 " +
+                                 "--out " + dir.file("x.ply"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("--raised-check"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(kCli + " extract " + dir.file("plain.ply") +
+                                 " --class 0 --raised-check 0.33 --out " + dir.file("y.ply"),
+                             &out),
+            1);
+  EXPECT_NE(out.find("a run directory"), std::string::npos) << out;
+}
+
 TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   std::string out;
   ASSERT_EQ(test::runCommand(kCli + " eval " + run() + " --3d", &out), 0) << out;
@@ -499,6 +541,16 @@ TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   EXPECT_GT(j["objects"]["true"].get<int>(), 10) << j.dump();
   EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["true"].get<int>());
   EXPECT_LE(j["objects"]["matched"].get<int>(), j["objects"]["predicted"].get<int>());
+  // The example's automatic tolerance: 4 x the building Gaussians' spacing, at least 1 m.
+  EXPECT_NEAR(j["objects"]["cluster_tolerance_m"].get<double>(),
+              std::max(1.0, 4 * j["building_spacing_m"].get<double>()), 1e-9);
+  EXPECT_EQ(j["objects_tolerance_1m"]["cluster_tolerance_m"].get<double>(), 1.0);
+  EXPECT_EQ(j["objects_raised_check"]["true"], j["objects"]["true"]);
+  ASSERT_EQ(j["objects_by_spacing"].size(), 5u);
+  for (const auto& entry : j["objects_by_spacing"]) {
+    EXPECT_GE(entry["cluster_tolerance_m"].get<double>(), 1.0) << entry.dump();
+    EXPECT_LE(entry["f1_raised_check"].get<double>(), 1.0) << entry.dump();
+  }
   // The cloud `extract --on-surface M` hands out, for three M: more kept as M grows.
   ASSERT_EQ(j["on_surface"].size(), 3u) << j.dump();
   std::int64_t previous = 0;

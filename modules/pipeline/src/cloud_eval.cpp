@@ -142,13 +142,21 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
       truth_footprints.push_back({{f.x0, f.y0}, {f.x1, f.y0}, {f.x1, f.y1}, {f.x0, f.y1}});
     }
   }
-  const eval::ObjectScoreOptions object_options;
-  const auto buildingObjects = [&](const std::vector<eval::CloudPoint>& cloud_points) {
+  // The example's extraction: the class's opaque centres, clustered at its automatic tolerance
+  // (eval::autoClusterTolerance of their spacing).
+  const auto centresOf = [&](const std::vector<eval::CloudPoint>& cloud_points) {
     std::vector<std::array<float, 3>> centres;
     for (const eval::CloudPoint& p : cloud_points) {
       if (p.cls == building && p.opacity >= options.opaque) centres.push_back(p.xyz);
     }
-    return eval::scoreObjects(centres, truth_footprints, object_options);
+    return centres;
+  };
+  const double spacing = eval::medianNeighbourDistance(centresOf(points));
+  eval::ObjectScoreOptions object_options;
+  object_options.tolerance = eval::autoClusterTolerance(spacing);
+  const auto buildingObjects = [&](const std::vector<eval::CloudPoint>& cloud_points,
+                                   const eval::ObjectScoreOptions& o) {
+    return eval::scoreObjects(centresOf(cloud_points), truth_footprints, o);
   };
   // The cloud `extract --on-surface M` hands out: the Gaussians at most M from the surface the
   // views render where they draw.
@@ -169,8 +177,9 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
                           {"distance_p90_m", k.p90_metres},
                           {"completeness_all", k.completeness_all}});
     if (building >= 0) {
-      on_surface.back()["objects_f1"] = buildingObjects(kept).f1;
-      on_surface.back()["objects_f1_raised_check"] = buildingObjects(kept_checked).f1;
+      on_surface.back()["objects_f1"] = buildingObjects(kept, object_options).f1;
+      on_surface.back()["objects_f1_raised_check"] =
+          buildingObjects(kept_checked, object_options).f1;
     }
   }
   j["on_surface"] = on_surface;
@@ -178,35 +187,34 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
   j["completeness"] = perClass(run.scene.classes, s.completeness);
   j["completeness_all"] = s.completeness_all;
   if (building >= 0) {
-    const eval::ObjectScores o = buildingObjects(points);
-    j["objects"] = buildingObjectsJson(o, {{"cluster_tolerance_m", object_options.tolerance},
-                                           {"min_points", object_options.min_points},
-                                           {"match_iou", object_options.match_iou}});
-    j["objects_raised_check"] = buildingObjectsJson(
-        buildingObjects(checked_points), {{"cluster_tolerance_m", object_options.tolerance},
-                                          {"min_points", object_options.min_points},
-                                          {"match_iou", object_options.match_iou},
-                                          {"raised_check", raised_options.share},
-                                          {"gaussians_unclassed", low.cells.size()},
-                                          {"near_ground_share", low.near_ground}});
-    // The clustering tolerance from the cloud's own spacing (a compact model samples its roofs
-    // more sparsely than 1 m): k x the median nearest-neighbour distance of the class's opaque
-    // centres, at least the fixed tolerance; with the raised-class check.
-    std::vector<std::array<float, 3>> centres;
-    for (const eval::CloudPoint& p : checked_points) {
-      if (p.cls == building && p.opacity >= options.opaque) centres.push_back(p.xyz);
-    }
-    const double spacing = eval::medianNeighbourDistance(centres);
+    const auto extraction = [&](const eval::ObjectScoreOptions& o) {
+      return nlohmann::json{{"cluster_tolerance_m", o.tolerance},
+                            {"min_points", o.min_points},
+                            {"match_iou", o.match_iou}};
+    };
+    j["building_spacing_m"] = spacing;
+    nlohmann::json rule = extraction(object_options);
+    rule["tolerance_rule"] = "auto: 4 x the median neighbour spacing, at least 1 m";
+    j["objects"] = buildingObjectsJson(buildingObjects(points, object_options), rule);
+    eval::ObjectScoreOptions fixed;  // 1 m: the example's tolerance before the automatic one
+    j["objects_tolerance_1m"] =
+        buildingObjectsJson(buildingObjects(points, fixed), extraction(fixed));
+    nlohmann::json checked = extraction(object_options);
+    checked.update({{"raised_check", raised_options.share},
+                    {"gaussians_unclassed", low.cells.size()},
+                    {"near_ground_share", low.near_ground}});
+    j["objects_raised_check"] =
+        buildingObjectsJson(buildingObjects(checked_points, object_options), checked);
+    // Other multiples of the spacing, with and without the raised-class check.
     nlohmann::json by_spacing = nlohmann::json::array();
     for (const double k : {1.5, 2.0, 3.0, 4.0, 6.0}) {
-      eval::ObjectScoreOptions o = object_options;
-      o.tolerance = std::max(object_options.tolerance, k * spacing);
-      const eval::ObjectScores scores = eval::scoreObjects(centres, truth_footprints, o);
-      by_spacing.push_back(buildingObjectsJson(scores, {{"spacing_factor", k},
-                                                        {"cluster_tolerance_m", o.tolerance},
-                                                        {"min_points", o.min_points}}));
+      eval::ObjectScoreOptions o;
+      o.tolerance = std::max(o.tolerance, k * spacing);
+      nlohmann::json entry = extraction(o);
+      entry.update(
+          {{"spacing_factor", k}, {"f1_raised_check", buildingObjects(checked_points, o).f1}});
+      by_spacing.push_back(buildingObjectsJson(buildingObjects(points, o), entry));
     }
-    j["building_spacing_m"] = spacing;
     j["objects_by_spacing"] = by_spacing;
   }
   const std::string text = j.dump(2) + "\n";
