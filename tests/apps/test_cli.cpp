@@ -95,13 +95,14 @@ TEST(Cli, PseudoLabelOptionsReachTheBuiltinBackend) {
 TEST(Cli, PickViewsNamesTheViewsSynthLabelsWithAuto) {
   test::TempDir dir;
   std::string out;
-  const std::string synth = kCli + " synth --kind port --seed 2 --capture grid-oblique --views 70 " +
+  const std::string synth = kCli +
+                            " synth --kind port --seed 2 --capture grid-oblique --views 70 " +
                             "--width 96 --height 54 --points 3000 --cache " + dir.file("s.cache");
   ASSERT_EQ(test::runCommand(synth + " --labelled auto", &out), 0) << out;
-  ASSERT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") + " --json " +
-                                 dir.file("pick.json"),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::runCommand(
+          kCli + " pick-views " + dir.file("s.cache") + " --json " + dir.file("pick.json"), &out),
+      0)
       << out;
   EXPECT_NE(out.find("annotate these 3 photo(s)"), std::string::npos) << out;
   const nlohmann::json j = nlohmann::json::parse(test::readFile(dir.file("pick.json")));
@@ -124,12 +125,35 @@ TEST(Cli, PickViewsNamesTheViewsSynthLabelsWithAuto) {
   EXPECT_EQ(more.at("kept").size(), 3u);
   EXPECT_NEAR(more.at("kept_share").get<double>(),
               j.at("picked").back().at("cumulative_share").get<double>(), 1e-12);
+  // With the default views (0, 7, 28: the mission's first nadir photos) ship and crane are never
+  // annotated: pseudo-labels says so and points to pick-views.
+  ASSERT_EQ(
+      test::runCommand(kCli + " synth --kind port --seed 2 --capture grid-oblique --views 70 " +
+                           "--width 96 --height 54 --points 3000 --cache " + dir.file("d.cache"),
+                       &out),
+      0)
+      << out;
+  ASSERT_EQ(test::runCommand(
+                kCli + " pseudo-labels " + dir.file("d.cache") + " --out " + dir.file("d_pl.cache"),
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("warning: no annotated photo (3 labelled training views) shows ship, crane"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("pick-views"), std::string::npos) << out;
+  // The views pick-views names show every class: no warning.
+  ASSERT_EQ(test::runCommand(
+                kCli + " pseudo-labels " + dir.file("s.cache") + " --out " + dir.file("s_pl.cache"),
+                &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("warning: no annotated photo"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(synth + " --labelled 0,x", &out), 1);
   EXPECT_NE(out.find("--labelled"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(kCli + " pick-views " + dir.file("none.cache"), &out), 1);
   EXPECT_NE(out.find("none.cache"), std::string::npos) << out;
-  EXPECT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") + " --count 0", &out),
-            1);
+  EXPECT_EQ(test::runCommand(kCli + " pick-views " + dir.file("s.cache") + " --count 0", &out), 1);
   EXPECT_NE(out.find("count"), std::string::npos) << out;
 }
 

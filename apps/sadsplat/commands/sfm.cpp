@@ -56,7 +56,9 @@ class SfmCommand : public Command {
   int run(const Invocation&) override {
     o_.progress = &std::cout;
     pipeline::sfmRun(o_);
-    std::cout << "next: sadsplat train " << o_.out << " --out RUN\n";
+    std::cout << "next: sadsplat train " << o_.out << " --out RUN (RGB only), or for classes: "
+              << "sadsplat pick-views " << o_.out << " (the photos to annotate), then "
+              << "sadsplat import " << o_.out << " --annotations FILE_OR_FOLDER --out S.cache\n";
     return 0;
   }
 

@@ -102,7 +102,8 @@ void warnOfUnannotatedClasses(const io::Scene& scene, std::ostream* progress) {
   *progress << "warning: no annotated photo (" << views << " labelled training views) shows "
             << missing << ": neither the annotations nor the pseudo-labels can teach "
             << (missing.find(',') == std::string::npos ? "it" : "them")
-            << "; annotate a photo where each appears\n";
+            << "; annotate a photo where each appears (`sadsplat pick-views SCENE "
+               "--keep-labelled` names photos that see the ground the annotated ones do not)\n";
 }
 
 }  // namespace
