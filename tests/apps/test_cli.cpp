@@ -133,6 +133,10 @@ TEST(Cli, PickViewsNamesTheViewsSynthLabelsWithAuto) {
                        &out),
       0)
       << out;
+  // `info` says how much of the ground the annotated views see and which photo adds the most.
+  ASSERT_EQ(test::runCommand(kCli + " info " + dir.file("d.cache"), &out), 0) << out;
+  EXPECT_NE(out.find("annotated views see "), std::string::npos) << out;
+  EXPECT_NE(out.find("the photo that adds the most: view_0"), std::string::npos) << out;
   ASSERT_EQ(test::runCommand(
                 kCli + " pseudo-labels " + dir.file("d.cache") + " --out " + dir.file("d_pl.cache"),
                 &out),
@@ -169,6 +173,7 @@ TEST(Cli, ImportInfoAndExtractWorkOnTheFixture) {
   EXPECT_NE(out.find("views: 8 (train 6, test 2, labelled 2)"), std::string::npos) << out;
   EXPECT_NE(out.find("image size: 32x24"), std::string::npos) << out;
   EXPECT_NE(out.find("2 building"), std::string::npos) << out;
+  EXPECT_NE(out.find("annotated views see 100.0 % of the ground"), std::string::npos) << out;
 
   auto cloud = test::randomGaussians(40, 52, 3);
   io::writeGaussianPly(dir.file("m.ply"), cloud);

@@ -1,9 +1,11 @@
 // `sadsplat info FILE`: what a cloud, scene directory or scene cache holds.
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
 #include "commands.h"
 #include "sadsplat/gaussians/memory_estimate.h"
+#include "sadsplat/geo/annotation_views.h"
 #include "sadsplat/io/file_info.h"
 #include "sadsplat/io/scene_cache.h"
 
@@ -26,6 +28,27 @@ std::string trainingMemory(const io::Scene& scene) {
   return out.str();
 }
 
+// How much of the ground the annotated views see, and the photo that would add the most
+// (geo/annotation_views.h): empty for a scene without annotated views or sparse points.
+std::string annotationCoverage(const io::Scene& scene) {
+  const bool labelled = std::any_of(scene.views.begin(), scene.views.end(),
+                                    [](const io::View& v) { return v.labelled && v.train; });
+  if (!labelled || scene.points.empty()) return "";
+  geo::AnnotationViewOptions options;
+  options.count = 1;
+  options.keep_labelled = true;
+  const geo::AnnotationViews c = geo::chooseAnnotationViews(scene, options, "<info>");
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(1);
+  out << "annotated views see " << 100 * c.kept_share << " % of the ground (sparse points)";
+  if (!c.picked.empty()) {
+    out << "; the photo that adds the most: " << scene.views[c.picked[0]].name << " (+"
+        << 100 * (c.cumulative_share[0] - c.kept_share) << " %, `pick-views --keep-labelled`)";
+  }
+  return out.str() + "\n";
+}
+
 class InfoCommand : public Command {
  public:
   CLI::App* add(CLI::App& app) override {
@@ -42,7 +65,8 @@ class InfoCommand : public Command {
       std::cout << io::describeCameras(path_);
     } else if (io::isSceneCache(path_)) {
       const io::Scene scene = io::readSceneCache(path_);
-      std::cout << io::describeSceneCache(path_, scene) << trainingMemory(scene);
+      std::cout << io::describeSceneCache(path_, scene) << annotationCoverage(scene)
+                << trainingMemory(scene);
     } else {
       std::cout << io::describeFile(path_);
     }
