@@ -28,6 +28,55 @@ struct Box {
   }
 };
 
+// Points binned into cubic cells of side `cell`: every point within `cell` of a point lies in one
+// of the 27 cells around it.
+class CellGrid {
+ public:
+  CellGrid(const std::vector<std::array<float, 3>>& points, double cell)
+      : points_(points), cell_(cell) {
+    for (std::size_t i = 0; i < points.size(); ++i) cells_[keyOf(points[i])].push_back(i);
+  }
+  // Calls f(j, squared distance) for every other point j in the 27 cells around point i.
+  template <class F>
+  void forEachNear(std::size_t i, F&& f) const {
+    const auto [kx, ky, kz] = keyOf(points_[i]);
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(Key{kx + dx, ky + dy, kz + dz});
+          if (it == cells_.end()) continue;
+          for (std::size_t j : it->second) {
+            if (j == i) continue;
+            double d2 = 0;
+            for (int c = 0; c < 3; ++c) {
+              const double d = double(points_[i][c]) - points_[j][c];
+              d2 += d * d;
+            }
+            f(j, d2);
+          }
+        }
+      }
+    }
+  }
+
+ private:
+  using Key = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return static_cast<std::size_t>(std::get<0>(k) * 73856093LL ^ std::get<1>(k) * 19349663LL ^
+                                      std::get<2>(k) * 83492791LL);
+    }
+  };
+  Key keyOf(const std::array<float, 3>& p) const {
+    return Key{static_cast<std::int64_t>(std::floor(p[0] / cell_)),
+               static_cast<std::int64_t>(std::floor(p[1] / cell_)),
+               static_cast<std::int64_t>(std::floor(p[2] / cell_))};
+  }
+  const std::vector<std::array<float, 3>>& points_;
+  double cell_;
+  std::unordered_map<Key, std::vector<std::size_t>, KeyHash> cells_;
+};
+
 bool inside(const Footprint& poly, double x, double y) {
   bool in = false;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
@@ -47,44 +96,14 @@ std::vector<std::vector<std::size_t>> euclideanClusters(
   const std::size_t n = points.size();
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), std::size_t{0});
-  // Cells of the tolerance's size: a neighbour lies in one of the 27 cells around a point.
-  using Key = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return static_cast<std::size_t>(std::get<0>(k) * 73856093LL ^ std::get<1>(k) * 19349663LL ^
-                                      std::get<2>(k) * 83492791LL);
-    }
-  };
-  std::unordered_map<Key, std::vector<std::size_t>, KeyHash> cells;
-  const auto keyOf = [&](const std::array<float, 3>& p) {
-    return Key{static_cast<std::int64_t>(std::floor(p[0] / tolerance)),
-               static_cast<std::int64_t>(std::floor(p[1] / tolerance)),
-               static_cast<std::int64_t>(std::floor(p[2] / tolerance))};
-  };
-  for (std::size_t i = 0; i < n; ++i) cells[keyOf(points[i])].push_back(i);
+  const CellGrid grid(points, tolerance);
   const double t2 = tolerance * tolerance;
   for (std::size_t i = 0; i < n; ++i) {
-    const auto [kx, ky, kz] = keyOf(points[i]);
-    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-      for (std::int64_t dy = -1; dy <= 1; ++dy) {
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(Key{kx + dx, ky + dy, kz + dz});
-          if (it == cells.end()) continue;
-          for (std::size_t j : it->second) {
-            if (j <= i) continue;
-            double d2 = 0;
-            for (int c = 0; c < 3; ++c) {
-              const double d = double(points[i][c]) - points[j][c];
-              d2 += d * d;
-            }
-            if (d2 <= t2) {
-              const std::size_t a = findRoot(parent, i), b = findRoot(parent, j);
-              if (a != b) parent[std::max(a, b)] = std::min(a, b);
-            }
-          }
-        }
-      }
-    }
+    grid.forEachNear(i, [&](std::size_t j, double d2) {
+      if (j < i || d2 > t2) return;
+      const std::size_t a = findRoot(parent, i), b = findRoot(parent, j);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    });
   }
   std::unordered_map<std::size_t, std::size_t> cluster_of_root;
   std::vector<std::vector<std::size_t>> clusters;
@@ -111,42 +130,12 @@ double medianNeighbourDistance(const std::vector<std::array<float, 3>>& points) 
   // Start from the spacing of n points spread over the footprint; double it until more than half
   // of the points have a neighbour within it (their nearest distances are then exact).
   double h = std::max(1e-6, std::sqrt((hi[0] - lo[0]) * (hi[1] - lo[1]) / n));
-  using Key = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return std::hash<std::int64_t>()(std::get<0>(k) * 73856093LL ^ std::get<1>(k) * 19349663LL ^
-                                       std::get<2>(k) * 83492791LL);
-    }
-  };
   for (int round = 0; round < 64; ++round, h *= 2) {
-    std::unordered_map<Key, std::vector<std::size_t>, KeyHash> cells;
-    const auto keyOf = [&](const std::array<float, 3>& p) {
-      return Key{static_cast<std::int64_t>(std::floor(p[0] / h)),
-                 static_cast<std::int64_t>(std::floor(p[1] / h)),
-                 static_cast<std::int64_t>(std::floor(p[2] / h))};
-    };
-    for (std::size_t i = 0; i < n; ++i) cells[keyOf(points[i])].push_back(i);
+    const CellGrid grid(points, h);
     std::vector<double> nearest(n, INFINITY);
     for (std::size_t i = 0; i < n; ++i) {
-      const auto [kx, ky, kz] = keyOf(points[i]);
       double best = INFINITY;
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        for (std::int64_t dy = -1; dy <= 1; ++dy) {
-          for (std::int64_t dz = -1; dz <= 1; ++dz) {
-            const auto it = cells.find(Key{kx + dx, ky + dy, kz + dz});
-            if (it == cells.end()) continue;
-            for (std::size_t j : it->second) {
-              if (j == i) continue;
-              double d2 = 0;
-              for (int c = 0; c < 3; ++c) {
-                const double d = double(points[i][c]) - points[j][c];
-                d2 += d * d;
-              }
-              best = std::min(best, d2);
-            }
-          }
-        }
-      }
+      grid.forEachNear(i, [&](std::size_t, double d2) { best = std::min(best, d2); });
       if (std::sqrt(best) <= h) nearest[i] = std::sqrt(best);  // exact within h
     }
     std::nth_element(nearest.begin(), nearest.begin() + n / 2, nearest.end());
