@@ -18,6 +18,18 @@ std::array<double, 9> PinholeCamera::rotation() const {
           2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
 }
 
+bool PointProjector::project(const std::array<float, 3>& x, double* u, double* v, double* z) const {
+  const auto& R = R_;
+  const auto& t = camera_.tvec;
+  const double xc = R[0] * x[0] + R[1] * x[1] + R[2] * x[2] + t[0];
+  const double yc = R[3] * x[0] + R[4] * x[1] + R[5] * x[2] + t[1];
+  *z = R[6] * x[0] + R[7] * x[1] + R[8] * x[2] + t[2];
+  if (!(*z > 1e-6)) return false;
+  *u = camera_.fx * xc / *z + camera_.cx;
+  *v = camera_.fy * yc / *z + camera_.cy;
+  return *u >= 0 && *v >= 0 && *u < camera_.width && *v < camera_.height;
+}
+
 void PinholeCamera::validate(const std::string& origin, const std::string& field) const {
   if (width <= 0 || height <= 0 ||
       static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > kMaxImagePixels) {
@@ -38,10 +50,12 @@ void PinholeCamera::validate(const std::string& origin, const std::string& field
   double qnorm2 = 0;
   for (double q : qvec) qnorm2 += q * q;
   if (!(qnorm2 > 1e-12 && std::isfinite(qnorm2))) {
-    throw Error(origin, field + " qvec", "a non-zero rotation quaternion (finite)", "zero or not finite");
+    throw Error(origin, field + " qvec", "a non-zero rotation quaternion (finite)",
+                "zero or not finite");
   }
   for (double t : tvec) {
-    if (!std::isfinite(t)) throw Error(origin, field + " tvec", "a finite translation", "not finite");
+    if (!std::isfinite(t))
+      throw Error(origin, field + " tvec", "a finite translation", "not finite");
   }
 }
 

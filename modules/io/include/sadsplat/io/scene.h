@@ -38,6 +38,19 @@ struct PinholeCamera {
   void validate(const std::string& origin, const std::string& field) const;
 };
 
+/// \brief A camera's projection of world points into its image, R(qvec) computed once.
+class PointProjector {
+ public:
+  explicit PointProjector(const PinholeCamera& camera) : camera_(camera), R_(camera.rotation()) {}
+  /// \brief The pixel (u, v) and camera depth z of world point `x`; false when it lies behind the
+  /// camera (z not above 1e-6, or not a number) or outside the image ([0, width) x [0, height)).
+  bool project(const std::array<float, 3>& x, double* u, double* v, double* z) const;
+
+ private:
+  const PinholeCamera& camera_;
+  std::array<double, 9> R_;
+};
+
 /// \brief An 8-bit image, row-major, channels interleaved.
 struct Image8 {
   int width = 0;
@@ -85,8 +98,8 @@ struct ViewPseudoLabels {
 struct ViewPixelsInCache {
   std::string path;
   std::uint32_t version = 0;
-  std::size_t classes = 0;          ///< the scene's class count (label ids are checked against it)
-  std::uint64_t view_offset = 0;    ///< the VIEW chunk's content: offset in the file, size
+  std::size_t classes = 0;        ///< the scene's class count (label ids are checked against it)
+  std::uint64_t view_offset = 0;  ///< the VIEW chunk's content: offset in the file, size
   std::uint64_t view_size = 0;
   std::uint64_t pseudo_offset = 0;  ///< the PSLB chunk's content (size 0: no pseudo-labels)
   std::uint64_t pseudo_size = 0;
