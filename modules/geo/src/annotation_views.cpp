@@ -10,25 +10,14 @@ namespace sadsplat {
 namespace geo {
 namespace {
 
-double footprintQuantile(std::vector<double> values, double q) {
-  std::sort(values.begin(), values.end());
-  return values[static_cast<std::size_t>(std::floor(q * (values.size() - 1)))];
-}
-
 // The footprint cells view `view` sees: cells of the points that project into its image.
 std::vector<char> footprintCellsSeen(const io::View& view, const io::Scene& scene,
                                      const std::vector<int>& cell_of, std::size_t cells) {
   std::vector<char> seen(cells, 0);
-  const io::PinholeCamera& cam = view.camera;
-  const auto R = cam.rotation();
+  const io::PointProjector camera(view.camera);
+  double u = 0, v = 0, z = 0;
   for (std::size_t i = 0; i < scene.points.size(); ++i) {
-    if (cell_of[i] < 0) continue;
-    const auto& x = scene.points[i].xyz;
-    const double z = R[6] * x[0] + R[7] * x[1] + R[8] * x[2] + cam.tvec[2];
-    if (!(z > 1e-6)) continue;
-    const double u = cam.fx * (R[0] * x[0] + R[1] * x[1] + R[2] * x[2] + cam.tvec[0]) / z + cam.cx;
-    const double v = cam.fy * (R[3] * x[0] + R[4] * x[1] + R[5] * x[2] + cam.tvec[1]) / z + cam.cy;
-    if (u >= 0 && u < cam.width && v >= 0 && v < cam.height) seen[cell_of[i]] = 1;
+    if (cell_of[i] >= 0 && camera.project(scene.points[i].xyz, &u, &v, &z)) seen[cell_of[i]] = 1;
   }
   return seen;
 }
@@ -62,17 +51,10 @@ AnnotationViews chooseAnnotationViews(const io::Scene& scene, const AnnotationVi
   if (candidates.empty()) throw Error(origin, "split", "at least one training view", "none");
 
   // The footprint: square cells on the ground plane over the points' 1st..99th percentiles.
-  const MapFrame ground = localMapFrame(sceneUp(scene));
+  const GroundPoints ground = groundPoints(scene);
   const std::size_t np = scene.points.size();
-  std::vector<double> es(np), ns(np);
-  for (std::size_t i = 0; i < np; ++i) {
-    const auto& x = scene.points[i].xyz;
-    const auto local = ground.toLocal({x[0], x[1], x[2]});
-    es[i] = local[0];
-    ns[i] = local[1];
-  }
-  const double e0 = footprintQuantile(es, 0.01), e1 = footprintQuantile(es, 0.99);
-  const double n0 = footprintQuantile(ns, 0.01), n1 = footprintQuantile(ns, 0.99);
+  const std::vector<double>&es = ground.e, &ns = ground.n;
+  const double e0 = ground.e0, e1 = ground.e1, n0 = ground.n0, n1 = ground.n1;
   AnnotationViews out;
   out.cell_size = std::max({e1 - e0, n1 - n0, 1e-9}) / options.cells;
   const int ce = std::max(1, static_cast<int>(std::ceil((e1 - e0) / out.cell_size)));

@@ -12,13 +12,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The value at quantile q (0..1) of `values` (sorted in place).
-double quantileOf(std::vector<double>& values, double q) {
-  std::sort(values.begin(), values.end());
-  const std::size_t i = static_cast<std::size_t>(std::floor(q * (values.size() - 1)));
-  return values[i];
-}
-
 // Edges of `cells` intervals: even between lo and hi inside, infinite outside.
 std::vector<double> gridEdges(int cells, double lo, double hi) {
   std::vector<double> edges(cells + 1);
@@ -42,7 +35,9 @@ int intervalOf(const std::vector<double>& edges, double x) {
 
 nlohmann::json rectJson(const GroundRect& r) {
   // JSON has no infinity: an unbounded side is null.
-  const auto side = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };
+  const auto side = [](double x) {
+    return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
+  };
   return {{"e0", side(r.e0)}, {"e1", side(r.e1)}, {"n0", side(r.n0)}, {"n1", side(r.n1)}};
 }
 
@@ -122,8 +117,8 @@ std::array<int, 2> gridShape(int blocks, double width, double height) {
     if (blocks % rows != 0) continue;
     const int columns = blocks / rows;
     // How far the cells are from square: |log(cell width / cell height)|.
-    const double cost = std::abs(std::log((std::max(width, 1e-9) / columns) /
-                                          (std::max(height, 1e-9) / rows)));
+    const double cost =
+        std::abs(std::log((std::max(width, 1e-9) / columns) / (std::max(height, 1e-9) / rows)));
     if (cost < best_cost - 1e-12) {
       best_cost = cost;
       best = {rows, columns};
@@ -138,19 +133,11 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
   if (scene.points.empty())
     throw Error(origin, "points", "sparse points to place the blocks", "none");
   BlockPartition p;
-  p.ground = localMapFrame(sceneUp(scene));
+  const GroundPoints ground = groundPoints(scene);
+  p.ground = ground.frame;
   const std::size_t np = scene.points.size();
-  std::vector<std::array<double, 2>> en(np);
-  std::vector<double> es(np), ns(np);
-  for (std::size_t i = 0; i < np; ++i) {
-    const auto& x = scene.points[i].xyz;
-    const auto local = p.ground.toLocal({x[0], x[1], x[2]});
-    en[i] = {local[0], local[1]};
-    es[i] = local[0];
-    ns[i] = local[1];
-  }
-  const double e_lo = quantileOf(es, 0.01), e_hi = quantileOf(es, 0.99);
-  const double n_lo = quantileOf(ns, 0.01), n_hi = quantileOf(ns, 0.99);
+  const std::vector<double>&es = ground.e, &ns = ground.n;
+  const double e_lo = ground.e0, e_hi = ground.e1, n_lo = ground.n0, n_hi = ground.n1;
   const auto shape = gridShape(options.blocks, e_hi - e_lo, n_hi - n_lo);
   p.rows = shape[0];
   p.columns = shape[1];
@@ -170,7 +157,7 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
       const auto gn = grownInterval(p.n_edges, r, grow_n);
       b.grown = {ge[0], ge[1], gn[0], gn[1]};
       for (std::size_t i = 0; i < np; ++i) {
-        if (!b.grown.contains(en[i][0], en[i][1])) continue;
+        if (!b.grown.contains(es[i], ns[i])) continue;
         b.points.push_back(static_cast<int>(i));
         grown_of[i].push_back(b.index);
       }
@@ -179,23 +166,18 @@ BlockPartition partitionScene(const io::Scene& scene, const BlockOptions& option
   }
   // Which points each view sees, and the share of them in each block's cell and grown cell.
   std::vector<int> cell_of(np);
-  for (std::size_t i = 0; i < np; ++i) cell_of[i] = p.blockAt(en[i][0], en[i][1]);
+  for (std::size_t i = 0; i < np; ++i) cell_of[i] = p.blockAt(es[i], ns[i]);
   bool any_train = false;
   p.view_cell_shares.resize(scene.views.size());
   for (std::size_t v = 0; v < scene.views.size(); ++v) {
     const io::View& view = scene.views[v];
     any_train = any_train || view.train;
-    const io::PinholeCamera& cam = view.camera;
-    const auto R = cam.rotation();
+    const io::PointProjector camera(view.camera);
     std::vector<int> in_block(p.blocks.size(), 0), in_cell(p.blocks.size(), 0);
     int seen = 0;
+    double u = 0, w = 0, z = 0;
     for (std::size_t i = 0; i < np; ++i) {
-      const auto& x = scene.points[i].xyz;
-      const double z = R[6] * x[0] + R[7] * x[1] + R[8] * x[2] + cam.tvec[2];
-      if (!(z > 1e-6)) continue;
-      const double u = cam.fx * (R[0] * x[0] + R[1] * x[1] + R[2] * x[2] + cam.tvec[0]) / z + cam.cx;
-      const double w = cam.fy * (R[3] * x[0] + R[4] * x[1] + R[5] * x[2] + cam.tvec[1]) / z + cam.cy;
-      if (!(u >= 0 && u < cam.width && w >= 0 && w < cam.height)) continue;
+      if (!camera.project(scene.points[i].xyz, &u, &w, &z)) continue;
       ++seen;
       ++in_cell[cell_of[i]];
       for (int b : grown_of[i]) ++in_block[b];

@@ -1,6 +1,7 @@
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/geo/geodesy.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -111,6 +112,36 @@ MapFrame localMapFrame(const Vec3& up_in) {
   f.wkt = localCrsWkt();
   f.scene_to_local = {east[0], east[1], east[2], north[0], north[1], north[2], up[0], up[1], up[2]};
   return f;
+}
+
+namespace {
+// The value at quantile q (0..1) of `values` (sorted in place).
+double sortedQuantile(std::vector<double>& values, double q) {
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(std::floor(q * (values.size() - 1)))];
+}
+}  // namespace
+
+GroundPoints groundPoints(const io::Scene& scene) {
+  GroundPoints g;
+  g.frame = localMapFrame(sceneUp(scene));
+  const std::size_t np = scene.points.size();
+  g.e.resize(np);
+  g.n.resize(np);
+  for (std::size_t i = 0; i < np; ++i) {
+    const auto& x = scene.points[i].xyz;
+    const auto local = g.frame.toLocal({x[0], x[1], x[2]});
+    g.e[i] = local[0];
+    g.n[i] = local[1];
+  }
+  if (np == 0) return g;
+  std::vector<double> sorted = g.e;
+  g.e0 = sortedQuantile(sorted, 0.01);
+  g.e1 = sortedQuantile(sorted, 0.99);
+  sorted = g.n;
+  g.n0 = sortedQuantile(sorted, 0.01);
+  g.n1 = sortedQuantile(sorted, 0.99);
+  return g;
 }
 
 std::string localCrsWkt() {

@@ -55,6 +55,17 @@ std::array<double, 3> sceneUp(const io::Scene& scene);
 /// orthogonal to up (or y when x is nearly parallel to up).
 MapFrame localMapFrame(const std::array<double, 3>& up);
 
+/// \brief The scene's sparse points on its ground plane: the frame localMapFrame(sceneUp(scene)),
+/// each point's (e, n) in it, and the 1st and 99th percentiles of e and of n (the extent a few
+/// outlying points do not stretch; the value at floor(q (count - 1)) of the sorted values).
+struct GroundPoints {
+  MapFrame frame;
+  std::vector<double> e, n;  ///< per scene point
+  double e0 = 0, e1 = 0, n0 = 0, n1 = 0;
+};
+/// \brief Them, for a scene with at least one sparse point.
+GroundPoints groundPoints(const io::Scene& scene);
+
 /// \brief The UTM frame of a georeferenced scene, its similarity fitted on a 5 x 5 grid over the
 /// ENU rectangle [e0, e1] x [n0, n1] (the footprint).
 /// \throws sadsplat::Error without GDAL, or when PROJ cannot make the transformation
