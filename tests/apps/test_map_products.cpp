@@ -472,6 +472,18 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_GT(j["dsm"]["rmse_m"].get<double>(), 0.0);
   EXPECT_LE(j["dsm"]["median_abs_m"].get<double>(), j["dsm"]["rmse_m"].get<double>() * 3);
   EXPECT_TRUE(j["dsm"]["per_class"]["building"].contains("rmse_m")) << out;
+  // Away from the walls (the height steps) some cells remain, and the robust spread is there.
+  EXPECT_GT(j["dsm"]["off_step_cells"].get<int>(), 0) << out;
+  EXPECT_LT(j["dsm"]["off_step_cells"].get<int>(), j["dsm"]["cells"].get<int>()) << out;
+  EXPECT_GT(j["dsm"]["nmad_m"].get<double>(), 0.0) << out;
+  // The class map near the grid's centre: three discs, the largest the widest.
+  ASSERT_EQ(j["miou_within"].size(), 3u) << out;
+  EXPECT_DOUBLE_EQ(j["miou_within"][0]["radius_m"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(j["miou_within"][2]["radius_m"].get<double>(), 90.0);
+  for (const auto& w : j["miou_within"]) {
+    EXPECT_GT(w["miou"].get<double>(), 0.0);
+    EXPECT_LE(w["miou"].get<double>(), 1.0);
+  }
   EXPECT_EQ(j["height"], "first");
   EXPECT_EQ(j["class_from"], "blend");
   EXPECT_EQ(j["min_views"], 0);

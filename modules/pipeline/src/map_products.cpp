@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/eval/dsm_scores.h"
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/geo/ground_model.h"
@@ -404,6 +405,23 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   }
   confusion.add(gt.data(), pred.data(), gt.size());
   const auto iou = confusion.perClassIou();
+  // The same score over the cells near the grid's centre (what an orbit looks at): within these
+  // shares of the half of the grid's shorter side.
+  nlohmann::json within = nlohmann::json::array();
+  const double half = 0.5 * grid.gsd * std::min(grid.width, grid.height);
+  for (const double share : {0.5, 0.7, 0.9}) {
+    eval::ConfusionMatrix near(C);
+    const double r = share * half;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      if (truth[i] >= C || !img.covered[i]) continue;
+      const double dx = (static_cast<double>(i % grid.width) + 0.5 - 0.5 * grid.width) * grid.gsd;
+      const double dy = (static_cast<double>(i / grid.width) + 0.5 - 0.5 * grid.height) * grid.gsd;
+      if (dx * dx + dy * dy > r * r) continue;
+      const std::int64_t p = img.classes[i];
+      near.add(&truth[i], &p, 1);
+    }
+    within.push_back({{"radius_share", share}, {"radius_m", r}, {"miou", near.meanIou()}});
+  }
   nlohmann::json j;
   j["truth"] = truth_source;
   j["gsd"] = grid.gsd;
@@ -418,6 +436,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();
+  j["miou_within"] = within;
   nlohmann::json per_class = nlohmann::json::object(), area = nlohmann::json::object();
   const double cell_area = grid.gsd * grid.gsd;
   for (int c = 0; c < C; ++c) {
@@ -442,34 +461,27 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["per_class_iou"] = per_class;
   j["area"] = area;
   // DSM error (the rendered elevation against the true top surface's height) over covered cells
-  // of the labelled area, all and per true class: roofs, ground, vegetation apart.
+  // of the labelled area, all and per true class: roofs, ground, vegetation apart; also away
+  // from the truth's height steps (walls), where a fraction of a cell costs metres.
   if (!true_heights.empty()) {
-    std::vector<std::vector<float>> errors(C + 1);
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      const std::uint8_t g = truth[i];
-      if (g >= C || !img.covered[i] || !std::isfinite(true_heights[i]) ||
-          !std::isfinite(img.elevation[i])) {
-        continue;
-      }
-      const float e = img.elevation[i] - true_heights[i];
-      errors[g].push_back(e);
-      errors[C].push_back(e);
-    }
-    const auto summary = [](std::vector<float> e) {
+    eval::DsmScoreOptions dsm_options;
+    const eval::DsmScores scores = eval::scoreDsm(img.elevation, true_heights, truth, img.covered,
+                                                  grid.width, grid.height, C, dsm_options);
+    const auto summary = [](const eval::HeightErrors& e) {
       nlohmann::json d;
-      d["cells"] = e.size();
-      if (e.empty()) return d;
-      double sq = 0;
-      for (float v : e) sq += double(v) * v;
-      d["rmse_m"] = std::sqrt(sq / e.size());
-      for (float& v : e) v = std::fabs(v);
-      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-      d["median_abs_m"] = e[e.size() / 2];
+      d["cells"] = e.cells;
+      if (e.cells == 0) return d;
+      d["rmse_m"] = e.rmse_m;
+      d["median_abs_m"] = e.median_abs_m;
+      d["nmad_m"] = e.nmad_m;
+      d["off_step_cells"] = e.off_step_cells;
+      d["off_step_rmse_m"] = e.off_step_cells ? nlohmann::json(e.off_step_rmse_m) : nullptr;
       return d;
     };
-    nlohmann::json dsm = summary(errors[C]);
+    nlohmann::json dsm = summary(scores.all);
+    dsm["step_m"] = dsm_options.step_m;
     nlohmann::json dsm_class = nlohmann::json::object();
-    for (int c = 0; c < C; ++c) dsm_class[run.scene.classes[c].name] = summary(errors[c]);
+    for (int c = 0; c < C; ++c) dsm_class[run.scene.classes[c].name] = summary(scores.per_class[c]);
     dsm["per_class"] = dsm_class;
     j["dsm"] = dsm;
   }
