@@ -316,6 +316,61 @@ TEST_F(MapProducts, OrthoRaisedCheckChangesOnlyRaisedCellsToGroundClasses) {
   }
 }
 
+// A float GeoTIFF's band 1 as GDAL's own tool reads it (gdal_translate to XYZ text), row by row.
+std::vector<double> gdalFloats(const std::string& tif, const std::string& xyz) {
+  std::string out;
+  EXPECT_EQ(test::runCommand("gdal_translate -q -of XYZ " + tif + " " + xyz, &out), 0) << out;
+  std::ifstream f(xyz);
+  std::vector<double> v;
+  double x, y, z;
+  while (f >> x >> y >> z) v.push_back(z);
+  return v;
+}
+
+// `ortho --pit-depth`: the DSM cells it changes are of a ground class and raised by more than the
+// depth; nothing else changes, and ortho.json counts them.
+TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
+  const auto ortho = [&](const std::string& args, const std::string& name) {
+    std::string out;
+    const std::string dir = dir_->file(name);
+    EXPECT_EQ(
+        test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 " + args + " --out " + dir, &out),
+        0)
+        << out;
+    return dir;
+  };
+  const std::string plain = ortho("--pit-depth 0", "ortho_pits_off"),
+                    filled = ortho("--pit-depth 0.5 --ground-window 8", "ortho_pits");
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(filled + "/ortho.json"));
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(plain + "/ortho.json"))["pit_depth"], 0.0);
+  ASSERT_EQ(j["pit_depth"].get<double>(), 0.5);
+  const std::vector<ClassInfo> classes = classesOf(run());
+  std::set<std::size_t> ground;
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    const nlohmann::json& h = j["class_height_above_ground"][classes[c].name];
+    if (!h.is_null() && h.get<double>() < 1.25) ground.insert(c);
+  }
+  const std::vector<double> a = gdalFloats(plain + "/dsm.tif", dir_->file("a.xyz"));
+  const std::vector<double> b = gdalFloats(filled + "/dsm.tif", dir_->file("b.xyz"));
+  const geo::Raster cls = geo::readByteRaster(filled + "/classes.tif");
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), cls.bytes.size());
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == b[i]) continue;
+    ++changed;
+    EXPECT_GT(b[i], a[i] + 0.5) << i;
+    EXPECT_TRUE(ground.count(cls.bytes[i])) << int(cls.bytes[i]);
+  }
+  EXPECT_NEAR(j["pit_filled_share"].get<double>(), double(changed) / a.size(), 1e-12);
+  if (!j["pit_depth_applied"].get<bool>()) EXPECT_EQ(changed, 0u);
+  std::string out;
+  EXPECT_EQ(test::runCommand(
+                kCli + " ortho " + run() + " --pit-depth -1 --out " + dir_->file("bad_pits"), &out),
+            1);
+  EXPECT_NE(out.find("--pit-depth"), std::string::npos) << out;
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");

@@ -37,6 +37,8 @@ class EvalCommand : public Command {
     c->add_option("--raised-check", ortho_options_.raised_check,
                   "--ortho: as `ortho --raised-check`")
         ->default_val(0.33);
+    c->add_option("--pit-depth", ortho_options_.pit_depth, "--ortho: as `ortho --pit-depth`")
+        ->default_val(1.0);
     c->add_option("--ground-window", ortho_options_.ground_window,
                   "--ortho: as `ortho --ground-window`")
         ->default_val(20);

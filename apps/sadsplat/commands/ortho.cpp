@@ -58,9 +58,16 @@ class OrthoCommand : public Command {
                   "median takes the most likely ground class (0: off; skipped with a warning "
                   "where the DSM shows no ground)")
         ->default_val(0.33);
+    c->add_option("--pit-depth", o_.pit_depth,
+                  "a DSM cell of a ground class (roads, grass, water: classes whose cells stand "
+                  "at a median below 1.25 m above the ground) more than this below the median "
+                  "height of the ground classes around it takes that height: the surface fell "
+                  "through thin ground Gaussians (map units; 0: off; skipped with --raised-check's "
+                  "warning)")
+        ->default_val(1.0);
     c->add_option("--ground-window", o_.ground_window,
-                  "--raised-check: the ground is a low percentile of the DSM in windows of this "
-                  "side (map units)")
+                  "--raised-check, --pit-depth: the ground is a low percentile of the DSM in "
+                  "windows of this side (map units)")
         ->default_val(20);
     c->add_option("--vectors", o_.vectors,
                   "classes (names, comma-separated) whose regions are also written as polygons "

@@ -259,5 +259,28 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
   return out;
 }
 
+GroundPits findGroundPits(const std::vector<std::uint8_t>& classes,
+                          const std::vector<float>& surface, const std::vector<int>& ground_classes,
+                          int width, int height, int window_cells, double depth) {
+  checkSize(surface.size(), classes.size(), "surface");
+  if (!(depth > 0))
+    throw Error("<ground model>", "pit depth", "a depth > 0", std::to_string(depth));
+  std::vector<std::uint8_t> is_ground(256, 0);
+  for (int c : ground_classes) is_ground.at(static_cast<std::size_t>(c)) = 1;
+  std::vector<std::uint8_t> ground_cell(classes.size(), 0);
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    ground_cell[c] = is_ground[classes[c]] && std::isfinite(surface[c]);
+  }
+  GroundModelOptions options;
+  options.window_cells = window_cells;
+  options.percentile = 0.5;
+  GroundPits pits;
+  pits.level = groundHeights(surface, ground_cell, width, height, options);
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    if (ground_cell[c] && surface[c] < pits.level[c] - depth) pits.cells.push_back(c);
+  }
+  return pits;
+}
+
 }  // namespace geo
 }  // namespace sadsplat

@@ -86,11 +86,16 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--raised-check", "a share of the raised class's height in [0, 1] (0: off)",
                 std::to_string(o.raised_check));
   }
+  if (!(o.pit_depth >= 0 && std::isfinite(o.pit_depth))) {
+    throw Error(what, "--pit-depth", "a depth >= 0 in map units (0: off)",
+                std::to_string(o.pit_depth));
+  }
   if (!(o.ground_window > 0 && std::isfinite(o.ground_window))) {
     throw Error(what, "--ground-window", "a window side > 0 in map units",
                 std::to_string(o.ground_window));
   }
   r.raised_share = o.raised_check;
+  r.pit_depth = o.pit_depth;
   r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
@@ -104,8 +109,11 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
 void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
                     const std::vector<ClassInfo>& classes) {
   j["raised_check"] = o.raised_check;
-  if (o.raised_check <= 0) return;
+  j["pit_depth"] = o.pit_depth;
+  if (o.raised_check <= 0 && o.pit_depth <= 0) return;
   j["ground_window"] = o.ground_window;
+  const std::size_t cells = img.classes.size();
+  j["pit_filled_share"] = cells ? double(img.filled_pits) / cells : 0.0;
   nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
   for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
     const double h = img.class_height_above_ground[c];
@@ -117,7 +125,8 @@ void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImag
   const std::size_t n = img.classes.size();
   j["raised_lowered_share"] = n ? double(img.lowered_cells) / n : 0.0;
   j["near_ground_share"] = img.near_ground;
-  j["raised_check_applied"] = img.near_ground >= geo::kMinNearGround;
+  j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
+  j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
 }  // namespace

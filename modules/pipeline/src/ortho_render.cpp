@@ -224,11 +224,14 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
   out.ground =
       geo::groundHeights(out.elevation, out.covered, grid.width, grid.height, ground_options);
   const int k = static_cast<int>(trainer.numClasses());
-  const geo::LowRaisedCells low = geo::findLowRaisedCells(
-      out.classes, out.elevation, out.ground, k, options.raised_height, options.raised_share);
+  const geo::LowRaisedCells low =
+      geo::findLowRaisedCells(out.classes, out.elevation, out.ground, k, options.raised_height,
+                              options.raised_share > 0 ? options.raised_share : 1.0);
   out.class_height_above_ground = low.median_above_ground;
   out.raised_classes = low.raised;
+  out.ground_classes = low.ground;
   out.near_ground = low.near_ground;
+  if (options.raised_share <= 0) return;
   out.lowered_cells = static_cast<std::int64_t>(low.cells.size());
   if (low.cells.empty()) return;
   std::vector<std::uint8_t> lower(out.classes.size(), 0);
@@ -258,6 +261,20 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
       }
     }
   }
+}
+
+// OrthoRenderOptions::pit_depth: the ground-class cells in a pit take the level of the ground
+// classes around them (geo::findGroundPits).
+void fillGroundPits(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
+  const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
+  std::vector<float> surface(out.elevation.size(), NAN);
+  for (std::size_t c = 0; c < surface.size(); ++c) {
+    if (out.covered[c]) surface[c] = out.elevation[c];
+  }
+  const geo::GroundPits pits = geo::findGroundPits(
+      out.classes, surface, out.ground_classes, grid.width, grid.height, window, options.pit_depth);
+  for (std::size_t c : pits.cells) out.elevation[c] = pits.level[c];
+  out.filled_pits = static_cast<std::int64_t>(pits.cells.size());
 }
 
 }  // namespace
@@ -398,16 +415,29 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     }
     out.few_views = few.numel();
   }
-  if (options.raised_share > 0 && trainer.numClasses() > 0) {
+  if ((options.raised_share > 0 || options.pit_depth > 0) && trainer.numClasses() > 0) {
     lowerRaisedCells(trainer, grid, options, keep, tile, out);
-    if (progress && out.near_ground < geo::kMinNearGround) {
-      *progress << "  ortho: warning: --raised-check skipped: only "
-                << std::lround(100 * out.near_ground)
-                << " % of the classified cells lie near the ground the DSM suggests (pits or "
-                   "no visible ground; try --min-views 2)\n";
-    } else if (progress) {
-      *progress << "  ortho: " << out.lowered_cells << " cells of a raised class at ground height"
-                << " given the most likely ground class\n";
+    const char* checks = options.raised_share > 0 && options.pit_depth > 0
+                             ? "--raised-check and --pit-depth"
+                         : options.raised_share > 0 ? "--raised-check"
+                                                    : "--pit-depth";
+    if (out.near_ground < geo::kMinNearGround) {
+      if (progress) {
+        *progress << "  ortho: warning: " << checks << " skipped: only "
+                  << std::lround(100 * out.near_ground)
+                  << " % of the classified cells lie near the ground the DSM suggests (pits or "
+                     "no visible ground; try --min-views 2)\n";
+      }
+    } else {
+      if (options.pit_depth > 0) fillGroundPits(grid, options, out);
+      if (progress && options.raised_share > 0) {
+        *progress << "  ortho: " << out.lowered_cells << " cells of a raised class at ground height"
+                  << " given the most likely ground class\n";
+      }
+      if (progress && options.pit_depth > 0) {
+        *progress << "  ortho: " << out.filled_pits << " cells of a ground class more than "
+                  << options.pit_depth << " below the ground classes around them raised to them\n";
+      }
     }
   }
   return out;

@@ -49,6 +49,9 @@ struct OrthoRunOptions {
   /// --raised-check SHARE (OrthoRenderOptions::raised_share; 0: off). 0.33 of 0.25 / 0.33 / 0.5
   /// on the benchmark's 34 runs (docs/measurements/cloud_3d): every class map gained.
   double raised_check = 0.33;
+  /// --pit-depth M (OrthoRenderOptions::pit_depth; 0: off): ground-class cells more than M below
+  /// the ground classes around them take their height (docs/measurements/cloud_3d).
+  double pit_depth = 1.0;
   double ground_window = 20;  ///< --ground-window M (OrthoRenderOptions::ground_window)
   /// --vectors: classes (names) whose regions go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;

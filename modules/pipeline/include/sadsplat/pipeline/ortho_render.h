@@ -95,6 +95,13 @@ struct OrthoRenderOptions {
   /// block's buildings) carry the building class at ground height. 0: off (here; `ortho` and
   /// `eval --ortho` ask for 0.33, map_products.h).
   double raised_share = 0;
+  /// The DSM's cells of a ground class (those whose median stands below half raised_height
+  /// above the ground: roads, grass, water) more than this below the median height of the ground
+  /// classes' cells around them (windows of ground_window) take that height: the first surface
+  /// fell through thin ground Gaussians to those under the ground (geo::findGroundPits). Needs
+  /// the ground model, so it is skipped where the raised check is (too few cells near the
+  /// ground). 0: off (here; `ortho` and `eval --ortho` ask for 1, map_products.h).
+  double pit_depth = 0;
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
@@ -112,13 +119,16 @@ struct OrthoImages {
   std::vector<float> elevation;   ///< map height of the rendered surface (OrthoSurface)
   std::vector<float> confidence;  ///< Trainer::classCosines of the class (0 without classes)
   std::int64_t few_views = 0;     ///< cells with a surface made nodata by min_views
-  /// With OrthoRenderOptions::raised_share: the ground height per cell (NaN: no surface at
-  /// all), each class's median height above it, the raised classes and how many cells they lost.
+  /// With OrthoRenderOptions::raised_share or pit_depth: the ground height per cell (NaN: no
+  /// surface at all), each class's median height above it, the raised classes and how many cells
+  /// they lost.
   std::vector<float> ground;
   std::vector<double> class_height_above_ground;
   std::vector<int> raised_classes;
   std::int64_t lowered_cells = 0;
-  double near_ground = 0;  ///< geo::LowRaisedCells::near_ground (the check's precondition)
+  std::vector<int> ground_classes;  ///< geo::LowRaisedCells::ground
+  std::int64_t filled_pits = 0;     ///< cells OrthoRenderOptions::pit_depth raised
+  double near_ground = 0;           ///< geo::LowRaisedCells::near_ground (the check's precondition)
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.
