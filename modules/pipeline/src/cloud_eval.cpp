@@ -216,6 +216,17 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
       by_spacing.push_back(buildingObjectsJson(buildingObjects(points, o), entry));
     }
     j["objects_by_spacing"] = by_spacing;
+    // Fixed tolerances in metres (a ceiling on the automatic rule: neighbours closer than the
+    // tolerance join one object).
+    nlohmann::json by_tolerance = nlohmann::json::array();
+    for (const double metres : {1.5, 2.0, 2.5, 3.0, 4.0}) {
+      eval::ObjectScoreOptions o;
+      o.tolerance = metres;
+      nlohmann::json entry = extraction(o);
+      entry["f1_raised_check"] = buildingObjects(checked_points, o).f1;
+      by_tolerance.push_back(buildingObjectsJson(buildingObjects(points, o), entry));
+    }
+    j["objects_by_tolerance"] = by_tolerance;
   }
   const std::string text = j.dump(2) + "\n";
   io::writeTextFileAtomically(run_dir + "/metrics_3d.json", text);
