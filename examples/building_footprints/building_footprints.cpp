@@ -8,7 +8,8 @@
 // 3. remove outliers (pcl::StatisticalOutlierRemoval on the centres),
 // 4. split into objects (pcl::EuclideanClusterExtraction; the tolerance by default 4 x the
 //    median distance between neighbouring centres, at least 1 m: a compact model samples its
-//    roofs every 0.4-1.2 m, and a fixed 1 m splits its buildings into fragments),
+//    roofs every 0.4-1.2 m, and a fixed 1 m splits its buildings into fragments; at most 3 m:
+//    a drone mission's sparser roofs would otherwise join buildings across the streets),
 // 5. write OUT_DIR/object_<id>.pcd (the object's Gaussians, every field) and OUT_DIR/objects.csv:
 //    id, Gaussians, centroid, and the oriented bounding box (pcl::MomentOfInertiaEstimation);
 // 6. with Open3D (sadsplat::interop): the ground plane of GROUND_CLASS (default road) by Open3D's
@@ -110,9 +111,10 @@ int main(int argc, char** argv) {
         std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
         spacing = nearest[nearest.size() / 2];
       }
-      tolerance = std::max(1.0, 4 * spacing);  // as sadsplat's eval::autoClusterTolerance
+      // As sadsplat's eval::autoClusterTolerance (metres).
+      tolerance = std::min(3.0, std::max(1.0, 4 * spacing));
       std::cout << "cluster tolerance " << tolerance << " (4 x the median spacing " << spacing
-                << ", at least 1)\n";
+                << ", at least 1, at most 3)\n";
     } else {
       std::size_t used = 0;
       try {

@@ -136,5 +136,12 @@ TEST(ObjectScores, RasterObjectsAreConnectedRegionsMatchedByIou) {
   EXPECT_NEAR(s.best_iou[2], 0.0, 1e-12);
 }
 
+TEST(ObjectScores, AutoToleranceIsFourSpacingsBetweenOneAndThreeMetres) {
+  EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.1), 1.0);   // floor
+  EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.5), 2.0);   // 4 x spacing
+  EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(1.68), 3.0);  // a mission's spacing: the ceiling
+  EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.0), 1.0);
+}
+
 }  // namespace
 }  // namespace sadsplat

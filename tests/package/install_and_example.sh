@@ -44,7 +44,7 @@ run_example() {  # PREFIX NAME
   # At least one object; its PCD holds as many Gaussians as the table says.
   rows=$(($(wc -l <"$tmp/objects_$2/objects.csv") - 1))
   [ "$rows" -ge 1 ] || { echo "no objects found"; exit 1; }
-  # The automatic tolerance (4 x the median spacing, at least 1 m) says what it chose.
+  # The automatic tolerance (4 x the median spacing, 1 to 3 m) says what it chose.
   "$tmp/ex_$2/building_footprints" "$tmp/run/model.ply" "$tmp/run/classes.json" building \
     "$tmp/objects_auto_$2" | tee "$tmp/auto_$2.log"
   grep -q "^cluster tolerance " "$tmp/auto_$2.log" || { echo "no automatic tolerance"; exit 1; }

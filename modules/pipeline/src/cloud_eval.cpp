@@ -194,7 +194,7 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
     };
     j["building_spacing_m"] = spacing;
     nlohmann::json rule = extraction(object_options);
-    rule["tolerance_rule"] = "auto: 4 x the median neighbour spacing, at least 1 m";
+    rule["tolerance_rule"] = "auto: 4 x the median neighbour spacing, at least 1 m, at most 3 m";
     j["objects"] = buildingObjectsJson(buildingObjects(points, object_options), rule);
     eval::ObjectScoreOptions fixed;  // 1 m: the example's tolerance before the automatic one
     j["objects_tolerance_1m"] =
