@@ -75,6 +75,16 @@ class MapProducts : public ::testing::Test {
   }
   static std::string run() { return trained("scene"); }
   static std::string geoRun() { return trained("geo_scene"); }
+  // `ortho` of the shared run at 0.5 m with `args`, into a folder `name`; its path.
+  static std::string ortho(const std::string& args, const std::string& name) {
+    std::string out;
+    const std::string dir = dir_->file(name);
+    EXPECT_EQ(
+        test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 " + args + " --out " + dir, &out),
+        0)
+        << out;
+    return dir;
+  }
   static test::TempDir* dir_;
 };
 test::TempDir* MapProducts::dir_ = nullptr;
@@ -265,15 +275,6 @@ TEST_F(MapProducts, OrthoOnSurfaceMapsOnlyTheGaussiansNearTheRenderedSurface) {
 // which classes are raised; the cells it changes were of a raised class and are now of a ground
 // class (median below half the raised height), nothing else changes.
 TEST_F(MapProducts, OrthoRaisedCheckChangesOnlyRaisedCellsToGroundClasses) {
-  const auto ortho = [&](const std::string& args, const std::string& name) {
-    std::string out;
-    const std::string dir = dir_->file(name);
-    EXPECT_EQ(
-        test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 " + args + " --out " + dir, &out),
-        0)
-        << out;
-    return dir;
-  };
   const std::string plain = ortho("--raised-check 0", "ortho_plain"),
                     checked = ortho("--raised-check 0.5 --ground-window 8", "ortho_raised");
   const nlohmann::json j = nlohmann::json::parse(test::readFile(checked + "/ortho.json"));
@@ -330,15 +331,6 @@ std::vector<double> gdalFloats(const std::string& tif, const std::string& xyz) {
 // `ortho --pit-depth`: the DSM cells it changes are of a ground class and raised by more than the
 // depth; nothing else changes, and ortho.json counts them.
 TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
-  const auto ortho = [&](const std::string& args, const std::string& name) {
-    std::string out;
-    const std::string dir = dir_->file(name);
-    EXPECT_EQ(
-        test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 " + args + " --out " + dir, &out),
-        0)
-        << out;
-    return dir;
-  };
   const std::string plain = ortho("--pit-depth 0", "ortho_pits_off"),
                     filled = ortho("--pit-depth 0.5 --ground-window 8", "ortho_pits");
   const nlohmann::json j = nlohmann::json::parse(test::readFile(filled + "/ortho.json"));
