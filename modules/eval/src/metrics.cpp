@@ -1,5 +1,8 @@
 #include "sadsplat/eval/metrics.h"
 
+#include <algorithm>
+#include <string>
+
 #include "sadsplat/common/error.h"
 
 namespace sadsplat {
@@ -78,6 +81,37 @@ double ConfusionMatrix::overallAccuracy() const {
   for (int c = 0; c < n_; ++c) correct += at(c, c);
   const std::int64_t t = total();
   return t ? static_cast<double>(correct) / static_cast<double>(t) : 0.0;
+}
+
+ConfusionMatrix confusionWithin(const std::vector<std::uint8_t>& truth,
+                                const std::vector<std::uint8_t>& predicted,
+                                const std::vector<std::uint8_t>& covered, int width, int height,
+                                double cell, double radius, int num_classes) {
+  const std::size_t n = static_cast<std::size_t>(std::max(0, width)) * std::max(0, height);
+  if (truth.size() != n || predicted.size() != n || covered.size() != n) {
+    throw Error("<class map scores>", "grid",
+                "truth, prediction and cover of " + std::to_string(n) + " cells each",
+                std::to_string(truth.size()) + ", " + std::to_string(predicted.size()) + ", " +
+                    std::to_string(covered.size()));
+  }
+  ConfusionMatrix m(num_classes);
+  for (int y = 0; y < height; ++y) {
+    const double dy = (y + 0.5 - 0.5 * height) * cell;
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      if (truth[i] >= num_classes || !covered[i]) continue;
+      const double dx = (x + 0.5 - 0.5 * width) * cell;
+      if (dx * dx + dy * dy > radius * radius) continue;
+      if (predicted[i] >= num_classes) {
+        throw Error("<class map scores>", "prediction",
+                    "a class below " + std::to_string(num_classes) + " where covered",
+                    std::to_string(predicted[i]));
+      }
+      const std::int64_t p = predicted[i];
+      m.add(&truth[i], &p, 1);
+    }
+  }
+  return m;
 }
 
 }  // namespace eval

@@ -419,16 +419,9 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   nlohmann::json within = nlohmann::json::array();
   const double half = 0.5 * grid.gsd * std::min(grid.width, grid.height);
   for (const double share : {0.5, 0.7, 0.9}) {
-    eval::ConfusionMatrix near(C);
     const double r = share * half;
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      if (truth[i] >= C || !img.covered[i]) continue;
-      const double dx = (static_cast<double>(i % grid.width) + 0.5 - 0.5 * grid.width) * grid.gsd;
-      const double dy = (static_cast<double>(i / grid.width) + 0.5 - 0.5 * grid.height) * grid.gsd;
-      if (dx * dx + dy * dy > r * r) continue;
-      const std::int64_t p = img.classes[i];
-      near.add(&truth[i], &p, 1);
-    }
+    const eval::ConfusionMatrix near = eval::confusionWithin(
+        truth, img.classes, img.covered, grid.width, grid.height, grid.gsd, r, C);
     within.push_back({{"radius_share", share}, {"radius_m", r}, {"miou", near.meanIou()}});
   }
   nlohmann::json j;

@@ -36,5 +36,15 @@ class ConfusionMatrix {
   std::vector<std::int64_t> counts_;
 };
 
+/// \brief The confusion matrix of a class map ([height x width] row-major, cells `cell` wide)
+/// over the cells whose centre lies within `radius` of the grid's centre: `truth` values >=
+/// num_classes and cells where `covered` is 0 are left out; `predicted` must be a class where
+/// covered. For an orbit capture the centre is what the photos look at.
+/// \throws sadsplat::Error when the sizes disagree or a covered prediction is not a class
+ConfusionMatrix confusionWithin(const std::vector<std::uint8_t>& truth,
+                                const std::vector<std::uint8_t>& predicted,
+                                const std::vector<std::uint8_t>& covered, int width, int height,
+                                double cell, double radius, int num_classes);
+
 }  // namespace eval
 }  // namespace sadsplat
