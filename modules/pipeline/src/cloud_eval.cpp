@@ -205,27 +205,25 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
                     {"near_ground_share", low.near_ground}});
     j["objects_raised_check"] =
         buildingObjectsJson(buildingObjects(checked_points, object_options), checked);
-    // Other multiples of the spacing, with and without the raised-class check.
-    nlohmann::json by_spacing = nlohmann::json::array();
-    for (const double k : {1.5, 2.0, 3.0, 4.0, 6.0}) {
+    // Other tolerances, with and without the raised-class check.
+    const auto scoredAt = [&](double tolerance, const nlohmann::json& extra) {
       eval::ObjectScoreOptions o;
-      o.tolerance = std::max(o.tolerance, k * spacing);
+      o.tolerance = tolerance;
       nlohmann::json entry = extraction(o);
-      entry.update(
-          {{"spacing_factor", k}, {"f1_raised_check", buildingObjects(checked_points, o).f1}});
-      by_spacing.push_back(buildingObjectsJson(buildingObjects(points, o), entry));
+      entry.update(extra);
+      entry["f1_raised_check"] = buildingObjects(checked_points, o).f1;
+      return buildingObjectsJson(buildingObjects(points, o), entry);
+    };
+    nlohmann::json by_spacing = nlohmann::json::array(), by_tolerance = nlohmann::json::array();
+    for (const double k : {1.5, 2.0, 3.0, 4.0, 6.0}) {  // multiples of the spacing, >= 1 m
+      by_spacing.push_back(scoredAt(std::max(1.0, k * spacing), {{"spacing_factor", k}}));
     }
-    j["objects_by_spacing"] = by_spacing;
     // Fixed tolerances in metres (a ceiling on the automatic rule: neighbours closer than the
     // tolerance join one object).
-    nlohmann::json by_tolerance = nlohmann::json::array();
     for (const double metres : {1.5, 2.0, 2.5, 3.0, 4.0}) {
-      eval::ObjectScoreOptions o;
-      o.tolerance = metres;
-      nlohmann::json entry = extraction(o);
-      entry["f1_raised_check"] = buildingObjects(checked_points, o).f1;
-      by_tolerance.push_back(buildingObjectsJson(buildingObjects(points, o), entry));
+      by_tolerance.push_back(scoredAt(metres, nlohmann::json::object()));
     }
+    j["objects_by_spacing"] = by_spacing;
     j["objects_by_tolerance"] = by_tolerance;
   }
   const std::string text = j.dump(2) + "\n";

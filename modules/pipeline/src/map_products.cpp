@@ -112,8 +112,6 @@ void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImag
   j["pit_depth"] = o.pit_depth;
   if (o.raised_check <= 0 && o.pit_depth <= 0) return;
   j["ground_window"] = o.ground_window;
-  const std::size_t cells = img.classes.size();
-  j["pit_filled_share"] = cells ? double(img.filled_pits) / cells : 0.0;
   nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
   for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
     const double h = img.class_height_above_ground[c];
@@ -124,6 +122,7 @@ void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImag
   j["raised_classes"] = raised;
   const std::size_t n = img.classes.size();
   j["raised_lowered_share"] = n ? double(img.lowered_cells) / n : 0.0;
+  j["pit_filled_share"] = n ? double(img.filled_pits) / n : 0.0;
   j["near_ground_share"] = img.near_ground;
   j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;

@@ -264,15 +264,13 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
 }
 
 // OrthoRenderOptions::pit_depth: the ground-class cells in a pit take the level of the ground
-// classes around them (geo::findGroundPits).
+// classes around them (geo::findGroundPits; an uncovered cell has no class, 255, so its
+// elevation is never read).
 void fillGroundPits(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
   const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
-  std::vector<float> surface(out.elevation.size(), NAN);
-  for (std::size_t c = 0; c < surface.size(); ++c) {
-    if (out.covered[c]) surface[c] = out.elevation[c];
-  }
-  const geo::GroundPits pits = geo::findGroundPits(
-      out.classes, surface, out.ground_classes, grid.width, grid.height, window, options.pit_depth);
+  const geo::GroundPits pits =
+      geo::findGroundPits(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
+                          window, options.pit_depth);
   for (std::size_t c : pits.cells) out.elevation[c] = pits.level[c];
   out.filled_pits = static_cast<std::int64_t>(pits.cells.size());
 }
