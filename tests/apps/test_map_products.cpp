@@ -394,6 +394,8 @@ TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   EXPECT_NE(vectors.find("Layer name: classes"), std::string::npos) << vectors;
   EXPECT_NE(vectors.find("UTM zone 15N"), std::string::npos) << vectors;
   EXPECT_NE(vectors.find("area_m2: Real"), std::string::npos) << vectors;
+  EXPECT_NE(vectors.find("object_id: Integer"), std::string::npos) << vectors;
+  EXPECT_NE(vectors.find("height_m: Real"), std::string::npos) << vectors;
   const nlohmann::json ortho = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
   const int polygons = ortho["vectors"]["polygons"].get<int>();
   EXPECT_GT(polygons, 0);
@@ -534,6 +536,25 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_EQ(j["height"], "first");
   EXPECT_EQ(j["class_from"], "blend");
   EXPECT_EQ(j["min_views"], 0);
+  // Building objects of the map, cut at the default DSM step and at six steps (0: the plain
+  // regions); cutting never makes fewer objects than the plain regions, and every count is
+  // bounded by the true and predicted objects.
+  ASSERT_TRUE(j.contains("objects")) << out;
+  EXPECT_DOUBLE_EQ(j["objects"]["object_step_m"].get<double>(), 1.5);
+  ASSERT_EQ(j["objects_by_step"].size(), 6u) << out;
+  EXPECT_DOUBLE_EQ(j["objects_by_step"][0]["object_step_m"].get<double>(), 0.0);
+  EXPECT_EQ(j["objects_by_step"][3], j["objects"]);
+  EXPECT_GT(j["objects"]["true"].get<int>(), 10) << out;
+  for (const auto& o : j["objects_by_step"]) {
+    EXPECT_EQ(o["true"], j["objects"]["true"]);
+    EXPECT_LE(o["matched"].get<int>(), o["predicted"].get<int>());
+    EXPECT_LE(o["matched"].get<int>(), o["true"].get<int>());
+  }
+  EXPECT_GE(j["objects_by_step"][5]["predicted"].get<int>(),
+            j["objects_by_step"][0]["predicted"].get<int>());
+  // A negative step is an error naming the flag.
+  EXPECT_NE(test::runCommand(kCli + " eval " + run() + " --ortho --object-step -1", &out), 0);
+  EXPECT_NE(out.find("--object-step"), std::string::npos) << out;
 }
 
 // `extract --raised-check`: a run's building Gaussians without those at ground height (a

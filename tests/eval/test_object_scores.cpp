@@ -97,45 +97,6 @@ TEST(ObjectScores, MatchesOneToOneAtHalfTheFootprint) {
   EXPECT_NEAR(t.precision, 0.5, 1e-12);
 }
 
-TEST(ObjectScores, RasterObjectsAreConnectedRegionsMatchedByIou) {
-  // 10 x 6 cells: two predicted regions (one touching only diagonally joins), a speck.
-  const int W = 10, H = 6;
-  std::vector<std::uint8_t> mask(W * H, 0);
-  const auto set = [&](int x, int y) { mask[y * W + x] = 1; };
-  for (int y = 0; y < 3; ++y) {
-    for (int x = 0; x < 3; ++x) set(x, y);  // region A: 3 x 3
-  }
-  set(3, 3);  // diagonal neighbour of A's corner (2, 2): joins A
-  for (int y = 0; y < 4; ++y) {
-    for (int x = 6; x < 9; ++x) set(x, y);  // region B: 3 x 4
-  }
-  set(5, 5);  // a speck
-  const std::vector<int> labels = eval::connectedComponents(mask, W, H);
-  EXPECT_EQ(labels[0], 1);
-  EXPECT_EQ(labels[3 * W + 3], 1);
-  EXPECT_EQ(labels[6], 2);
-  EXPECT_EQ(labels[5 * W + 5], 3);
-  EXPECT_EQ(labels[9], 0);
-  // Truth: A's 3 x 3 exactly (IoU 9 / 10), and B's left two columns (IoU 8 / 12 = 0.67), and a
-  // building nothing found.
-  std::vector<int> truth(W * H, 0);
-  for (int y = 0; y < 3; ++y) {
-    for (int x = 0; x < 3; ++x) truth[y * W + x] = 1;
-  }
-  for (int y = 0; y < 4; ++y) {
-    for (int x = 6; x < 8; ++x) truth[y * W + x] = 2;
-  }
-  truth[5 * W + 0] = 3;
-  const eval::ObjectScores s = eval::scoreRasterObjects(labels, truth, 2);
-  EXPECT_EQ(s.predicted, 2u);  // the speck is under 2 cells
-  EXPECT_EQ(s.true_objects, 3u);
-  EXPECT_EQ(s.matched, 2u);
-  EXPECT_NEAR(s.precision, 1.0, 1e-12);
-  EXPECT_NEAR(s.recall, 2.0 / 3, 1e-12);
-  EXPECT_NEAR(s.mean_matched_iou, (0.9 + 8.0 / 12) / 2, 1e-12);
-  EXPECT_NEAR(s.best_iou[2], 0.0, 1e-12);
-}
-
 TEST(ObjectScores, AutoToleranceIsFourSpacingsBetweenOneAndThreeMetres) {
   EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.1), 1.0);   // floor
   EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.5), 2.0);   // 4 x spacing

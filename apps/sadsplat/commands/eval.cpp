@@ -39,6 +39,9 @@ class EvalCommand : public Command {
         ->default_val(0.33);
     c->add_option("--pit-depth", ortho_options_.pit_depth, "--ortho: as `ortho --pit-depth`")
         ->default_val(1.0);
+    c->add_option("--object-step", ortho_options_.object_step,
+                  "--ortho: the building objects as `ortho --object-step` cuts them")
+        ->default_val(1.5);
     c->add_option("--ground-window", ortho_options_.ground_window,
                   "--ortho: as `ortho --ground-window`")
         ->default_val(20);

@@ -70,9 +70,15 @@ class OrthoCommand : public Command {
                   "windows of this side (map units)")
         ->default_val(20);
     c->add_option("--vectors", o_.vectors,
-                  "classes (names, comma-separated) whose regions are also written as polygons "
-                  "to OUT/vectors.gpkg (GeoPackage: class, area_m2; the map's CRS)")
+                  "classes (names, comma-separated) whose objects are also written as polygons "
+                  "to OUT/vectors.gpkg (GeoPackage: object_id, class, height_m, area_m2; the "
+                  "map's CRS)")
         ->delimiter(',');
+    c->add_option("--object-step", o_.object_step,
+                  "--vectors: a class's regions are cut into objects where the DSM steps by more "
+                  "than this between neighbouring cells (neighbouring buildings of different "
+                  "heights; map units; 0: the plain regions)")
+        ->default_val(1.5);
     return c;
   }
   int run(const Invocation&) override {

@@ -191,34 +191,6 @@ double footprintIou(const Footprint& a, const Footprint& b, double cell) {
   return either ? double(both) / either : 0.0;
 }
 
-std::vector<int> connectedComponents(const std::vector<std::uint8_t>& mask, int width, int height) {
-  std::vector<int> label(mask.size(), 0);
-  std::vector<std::size_t> stack;
-  int next = 0;
-  for (std::size_t start = 0; start < mask.size(); ++start) {
-    if (!mask[start] || label[start]) continue;
-    label[start] = ++next;
-    stack.push_back(start);
-    while (!stack.empty()) {
-      const std::size_t k = stack.back();
-      stack.pop_back();
-      const int x = static_cast<int>(k % width), y = static_cast<int>(k / width);
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-          const std::size_t n = static_cast<std::size_t>(ny) * width + nx;
-          if (mask[n] && !label[n]) {
-            label[n] = next;
-            stack.push_back(n);
-          }
-        }
-      }
-    }
-  }
-  return label;
-}
-
 namespace {
 
 // Greedy one-to-one matching of (iou, truth, predicted) pairs at iou >= match_iou, best first.

@@ -1,7 +1,9 @@
 #include "sadsplat/geo/vector_files.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "sadsplat/common/error.h"
@@ -60,32 +62,38 @@ std::size_t writeGeoPackageLayer(const std::string& path, const std::string& lay
 
 }  // namespace
 
-std::size_t writeClassPolygons(const std::string& path, const Raster& classes, const MapGrid& grid,
-                               const std::vector<std::string>& names,
-                               const ClassPolygonOptions& o) {
-  if (classes.bands != 1 || classes.type != Raster::Type::kByte) {
-    throw Error(path, "class map", "a 1-band 8-bit raster of class ids", "another raster");
+std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>& labels, int width,
+                                int height, const std::vector<MapObjectAttributes>& objects,
+                                const MapGrid& grid, const std::vector<std::string>& names,
+                                const ObjectPolygonOptions& o) {
+  if (width <= 0 || height <= 0 ||
+      labels.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
+    throw Error(path, "object labels", std::to_string(width) + " x " + std::to_string(height),
+                std::to_string(labels.size()) + " cells");
   }
-  classes.check(path);
+  std::vector<std::uint8_t> mask(labels.size(), 0);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] < 0 || static_cast<std::size_t>(labels[i]) > objects.size()) {
+      throw Error(path, "object labels", "0 .. " + std::to_string(objects.size()),
+                  std::to_string(labels[i]));
+    }
+    mask[i] = labels[i] > 0;
+  }
   gdal::init();
-  // The class ids and a mask of the selected classes, in memory.
+  // The object ids and a mask of the cells with one, in memory.
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  gdal::Dataset raster(mem->Create("", classes.width, classes.height, 2, GDT_Byte, nullptr));
+  gdal::Dataset raster(mem->Create("", width, height, 2, GDT_Int32, nullptr));
   if (!raster) gdal::failed(path, "polygonize");
   double transform[6] = {grid.x0, grid.gsd, 0, grid.y0, 0, -grid.gsd};
   raster->SetGeoTransform(transform);
-  std::vector<std::uint8_t> mask(classes.bytes.size(), 0);
-  for (std::size_t i = 0; i < mask.size(); ++i) {
-    mask[i] =
-        std::find(o.classes.begin(), o.classes.end(), int(classes.bytes[i])) != o.classes.end();
-  }
-  GDALRasterBand* ids = raster->GetRasterBand(1);
-  GDALRasterBand* selected = raster->GetRasterBand(2);
-  if (ids->RasterIO(GF_Write, 0, 0, classes.width, classes.height,
-                    const_cast<std::uint8_t*>(classes.bytes.data()), classes.width, classes.height,
-                    GDT_Byte, 0, 0, nullptr) != CE_None ||
-      selected->RasterIO(GF_Write, 0, 0, classes.width, classes.height, mask.data(), classes.width,
-                         classes.height, GDT_Byte, 0, 0, nullptr) != CE_None) {
+  std::vector<std::int32_t> ids(labels.begin(), labels.end());
+  std::vector<std::int32_t> selected(mask.begin(), mask.end());
+  GDALRasterBand* id_band = raster->GetRasterBand(1);
+  GDALRasterBand* mask_band = raster->GetRasterBand(2);
+  if (id_band->RasterIO(GF_Write, 0, 0, width, height, ids.data(), width, height, GDT_Int32, 0, 0,
+                        nullptr) != CE_None ||
+      mask_band->RasterIO(GF_Write, 0, 0, width, height, selected.data(), width, height, GDT_Int32,
+                          0, 0, nullptr) != CE_None) {
     gdal::failed(path, "polygonize");
   }
   // Polygonized into a memory layer first: then filtered, simplified and written.
@@ -93,33 +101,42 @@ std::size_t writeClassPolygons(const std::string& path, const Raster& classes, c
   gdal::Dataset scratch(memory->Create("", 0, 0, 0, GDT_Unknown, nullptr));
   if (!scratch) gdal::failed(path, "polygonize");
   OGRLayer* raw = scratch->CreateLayer("raw", nullptr, wkbPolygon, nullptr);
-  OGRFieldDefn id_field("class_id", OFTInteger);
+  OGRFieldDefn id_field("object_id", OFTInteger);
   if (!raw || raw->CreateField(&id_field) != OGRERR_NONE) gdal::failed(path, "polygonize");
   char eight[] = "8CONNECTED=8";
   char* options[] = {eight, nullptr};
-  if (GDALPolygonize(ids, selected, raw, 0, options, nullptr, nullptr) != CE_None) {
+  if (GDALPolygonize(id_band, mask_band, raw, 0, options, nullptr, nullptr) != CE_None) {
     gdal::failed(path, "polygonize");
   }
   return writeGeoPackageLayer(
       path, o.layer, grid.wkt, wkbMultiPolygon,
-      {{"class_id", OFTInteger}, {"class", OFTString}, {"area_m2", OFTReal}}, [&](OGRLayer* layer) {
+      {{"object_id", OFTInteger},
+       {"class_id", OFTInteger},
+       {"class", OFTString},
+       {"height_m", OFTReal},
+       {"area_m2", OFTReal}},
+      [&](OGRLayer* layer) {
         std::size_t written = 0;
         raw->ResetReading();
         for (std::unique_ptr<OGRFeature> f(raw->GetNextFeature()); f;
              f.reset(raw->GetNextFeature())) {
           const OGRGeometry* g = f->GetGeometryRef();
-          if (!g) continue;
+          const int id = f->GetFieldAsInteger(0);
+          if (!g || id <= 0) continue;
           std::unique_ptr<OGRGeometry> shape(
               o.simplify > 0 ? g->SimplifyPreserveTopology(o.simplify) : g->clone());
           if (!shape || shape->IsEmpty()) continue;
           const double a = OGR_G_Area(OGRGeometry::ToHandle(shape.get()));
           if (a < o.min_area) continue;
-          const int id = f->GetFieldAsInteger(0);
+          const MapObjectAttributes& object = objects[static_cast<std::size_t>(id) - 1];
+          const int c = object.class_id;
           OGRFeature feature(layer->GetLayerDefn());
-          feature.SetField("class_id", id);
-          feature.SetField("class", id >= 0 && id < static_cast<int>(names.size())
-                                        ? names[static_cast<std::size_t>(id)].c_str()
+          feature.SetField("object_id", id);
+          feature.SetField("class_id", c);
+          feature.SetField("class", c >= 0 && c < static_cast<int>(names.size())
+                                        ? names[static_cast<std::size_t>(c)].c_str()
                                         : "");
+          feature.SetField("height_m", object.height);
           feature.SetField("area_m2", a);
           feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
           if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
@@ -165,8 +182,9 @@ std::size_t writeLabelledPolygons(const std::string& path, const std::string&, c
               "a build without it");
 }
 
-std::size_t writeClassPolygons(const std::string& path, const Raster&, const MapGrid&,
-                               const std::vector<std::string>&, const ClassPolygonOptions&) {
+std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>&, int, int,
+                                const std::vector<MapObjectAttributes>&, const MapGrid&,
+                                const std::vector<std::string>&, const ObjectPolygonOptions&) {
   throw Error(path, "GeoPackage", "a sadsplat build with GDAL (Debian: libgdal-dev)",
               "a build without it");
 }

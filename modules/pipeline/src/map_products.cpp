@@ -16,6 +16,7 @@
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/geo/ground_model.h"
+#include "sadsplat/geo/map_objects.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/geo/vector_files.h"
 #include "sadsplat/io/atomic_file.h"
@@ -90,6 +91,10 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--pit-depth", "a depth >= 0 in map units (0: off)",
                 std::to_string(o.pit_depth));
   }
+  if (!(o.object_step >= 0 && std::isfinite(o.object_step))) {
+    throw Error(what, "--object-step", "a height step >= 0 in map units (0: plain regions)",
+                std::to_string(o.object_step));
+  }
   if (!(o.ground_window > 0 && std::isfinite(o.ground_window))) {
     throw Error(what, "--ground-window", "a window side > 0 in map units",
                 std::to_string(o.ground_window));
@@ -128,6 +133,47 @@ void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImag
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
+// Map objects smaller than this merge into the neighbour of their class they border most (the
+// slivers the height cut leaves along walls); also the smallest building the map scores.
+constexpr double kMinObjectM2 = 20;
+
+// The objects of each class in `wanted` on the map: its covered cells split where the surface
+// model steps by more than `step` (geo::mapObjects), numbered across the classes, each with its
+// class and the median height of its cells.
+struct ClassObjects {
+  std::vector<int> labels;
+  std::vector<geo::MapObjectAttributes> objects;
+};
+ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,
+                          std::size_t min_cells) {
+  const std::size_t n = img.classes.size();
+  ClassObjects out;
+  out.labels.assign(n, 0);
+  geo::MapObjectOptions options;
+  options.max_step = step;
+  options.min_cells = min_cells;
+  for (const int c : wanted) {
+    std::vector<std::uint8_t> mask(n, 0);
+    for (std::size_t i = 0; i < n; ++i) mask[i] = img.covered[i] && img.classes[i] == c;
+    const std::vector<int> labels =
+        geo::mapObjects(mask, img.elevation, img.width, img.height, options);
+    const int first = static_cast<int>(out.objects.size());
+    int count = 0;
+    for (const int l : labels) count = std::max(count, l);
+    std::vector<std::vector<float>> heights(static_cast<std::size_t>(count));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!labels[i]) continue;
+      out.labels[i] = first + labels[i];
+      heights[static_cast<std::size_t>(labels[i]) - 1].push_back(img.elevation[i]);
+    }
+    for (std::vector<float>& h : heights) {
+      std::nth_element(h.begin(), h.begin() + h.size() / 2, h.end());
+      out.objects.push_back({c, h.empty() ? 0.0 : double(h[h.size() / 2])});
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string orthoRun(const OrthoRunOptions& o) {
@@ -148,7 +194,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   io::OutputSet files(o.out, outputs);
   OpenedRun run = openRun(o.run);
   // The classes of --vectors, checked before the render.
-  geo::ClassPolygonOptions v;
+  std::vector<int> vector_classes;
   std::vector<std::string> names;
   for (const ClassInfo& c : run.scene.classes) names.push_back(c.name);
   if (!o.vectors.empty() && run.trainer->numClasses() == 0) {
@@ -161,7 +207,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
       for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
       throw Error("<ortho>", "--vectors", "class names of the model (" + known + ")", name);
     }
-    v.classes.push_back(static_cast<int>(it - names.begin()));
+    vector_classes.push_back(static_cast<int>(it - names.begin()));
   }
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
@@ -199,9 +245,13 @@ std::string orthoRun(const OrthoRunOptions& o) {
     for (const ClassInfo& c : classes) ids.palette.push_back(c.color);
     geo::writeGeoTiff(files.path("classes.tif"), ids, &map);
     if (!o.vectors.empty()) {
+      geo::ObjectPolygonOptions v;
       v.simplify = grid.gsd;
       v.min_area = 4 * grid.gsd * grid.gsd;
-      polygons = geo::writeClassPolygons(files.path("vectors.gpkg"), ids, map, names, v);
+      const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / (gsd * gsd)));
+      const ClassObjects objects = classObjects(img, vector_classes, o.object_step, min_cells);
+      polygons = geo::writeObjectPolygons(files.path("vectors.gpkg"), objects.labels, img.width,
+                                          img.height, objects.objects, map, names, v);
     }
     geo::Raster preview = geo::Raster::bytesOf(img.width, img.height, 4);
     preview.last_band_is_alpha = true;
@@ -301,7 +351,12 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["height_datum"] = grid.frame.georeferenced
                           ? "the photos' GPS altitude reference (origin altitude + local up)"
                           : "the scene frame's up axis";
-  if (!o.vectors.empty()) j["vectors"] = {{"file", "vectors.gpkg"}, {"polygons", polygons}};
+  if (!o.vectors.empty()) {
+    j["vectors"] = {{"file", "vectors.gpkg"},
+                    {"polygons", polygons},
+                    {"object_step_m", o.object_step},
+                    {"merged_under_m2", kMinObjectM2}};
+  }
   j["files"] = semantic ? nlohmann::json{"orthophoto.tif", "classes.tif", "dsm.tif",
                                          "confidence.tif", "classes.csv"}
                         : nlohmann::json{"orthophoto.tif", "dsm.tif", "classes.csv"};
@@ -486,12 +541,13 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     dsm["per_class"] = dsm_class;
     j["dsm"] = dsm;
   }
-  // Buildings as map objects: 8-connected regions of building cells (at least kMinObjectM2)
-  // against the world's standing buildings rasterised on the grid, matched at IoU >= 0.5.
+  // Buildings as map objects: the building cells split where the DSM steps by more than
+  // render.object_step (as `ortho --vectors` writes them; slivers under kMinObjectM2 merged, and
+  // objects under it not counted) against the world's standing buildings rasterised on the
+  // grid, matched at IoU >= 0.5; also for other steps (0: the plain 8-connected regions).
   int building = -1;
   for (int c = 0; c < C; ++c) building = run.scene.classes[c].name == "building" ? c : building;
   if (dsm_world && !true_heights.empty() && building >= 0) {
-    constexpr double kMinObjectM2 = 20;
     const std::size_t n_cells = static_cast<std::size_t>(grid.width) * grid.height;
     std::vector<int> truth_objects(n_cells, 0);
     const auto footprints =
@@ -510,13 +566,18 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
         }
       }
     }
-    std::vector<std::uint8_t> mask(n_cells, 0);
-    for (std::size_t i = 0; i < n_cells; ++i)
-      mask[i] = img.covered[i] && img.classes[i] == building;
-    const eval::ObjectScores o = eval::scoreRasterObjects(
-        eval::connectedComponents(mask, grid.width, grid.height), truth_objects,
-        static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area)));
-    j["objects"] = buildingObjectsJson(o, {{"min_area_m2", kMinObjectM2}, {"match_iou", 0.5}});
+    const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area));
+    const auto objectScores = [&](double step) {
+      const ClassObjects objects = classObjects(img, {building}, step, min_cells);
+      const eval::ObjectScores o =
+          eval::scoreRasterObjects(objects.labels, truth_objects, min_cells);
+      return buildingObjectsJson(
+          o, {{"min_area_m2", kMinObjectM2}, {"object_step_m", step}, {"match_iou", 0.5}});
+    };
+    j["objects"] = objectScores(render.object_step);
+    nlohmann::json by_step = nlohmann::json::array();
+    for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) by_step.push_back(objectScores(step));
+    j["objects_by_step"] = by_step;
   }
   const std::string text = j.dump(2) + "\n";
   io::writeTextFileAtomically(run_dir + "/ortho_metrics.json", text);

@@ -71,13 +71,10 @@ double footprintIou(const Footprint& a, const Footprint& b, double cell);
 ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
                           const std::vector<Footprint>& truth, const ObjectScoreOptions& options);
 
-/// \brief 8-connected components of a mask (row-major, `width` x `height`, non-zero = in):
-/// labels 1..n in row-major order of their first cell, 0 outside the mask.
-std::vector<int> connectedComponents(const std::vector<std::uint8_t>& mask, int width, int height);
-
-/// \brief Objects on a raster: `predicted` and `truth` label the cells of one grid (0 = no
-/// object, 1..n an object); predicted objects under `min_cells` are dropped; objects matched one
-/// to one at IoU >= match_iou, best first. ObjectScores::predicted_footprints stays empty.
+/// \brief Objects on a raster (e.g. geo::mapObjects'): `predicted` and `truth` label the cells of
+/// one grid (0 = no object, 1..n an object); predicted objects under `min_cells` are dropped;
+/// objects matched one to one at IoU >= match_iou, best first. ObjectScores::predicted_footprints
+/// stays empty.
 ObjectScores scoreRasterObjects(const std::vector<int>& predicted, const std::vector<int>& truth,
                                 std::size_t min_cells, double match_iou = 0.5);
 

@@ -53,17 +53,21 @@ struct OrthoRunOptions {
   /// the ground classes around them take their height (docs/measurements/cloud_3d).
   double pit_depth = 1.0;
   double ground_window = 20;  ///< --ground-window M (OrthoRenderOptions::ground_window)
-  /// --vectors: classes (names) whose regions go to OUT/vectors.gpkg as polygons (none: no file)
+  /// --vectors: classes (names) whose objects go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;
+  /// --object-step M: a class's regions are cut into objects where the DSM steps by more than M
+  /// between neighbouring cells (geo/map_objects.h; 0: the plain regions); what --vectors writes
+  /// and `eval --ortho` scores as building objects.
+  double object_step = 1.5;
   std::ostream* progress = nullptr;
 };
 
 /// \brief Writes OUT/orthophoto.tif (RGBA), classes.tif (class ids with a colour table, 255 =
 /// nodata), dsm.tif (float32 height, -9999 = nodata), confidence.tif (float32, -1 = nodata),
 /// their PNG previews, classes.csv (pixels, area in m^2 and share per class) and ortho.json (the
-/// grid, CRS and fit); with `vectors`, vectors.gpkg (geo/vector_files.h: the classes' regions as
-/// polygons simplified to one cell, those under four cells left out). Returns a short summary for
-/// the terminal.
+/// grid, CRS and fit); with `vectors`, vectors.gpkg (geo/vector_files.h: the classes' objects,
+/// geo/map_objects.h, as polygons simplified to one cell, those under four cells left out). Returns
+/// a short summary for the terminal.
 std::string orthoRun(const OrthoRunOptions& options);
 
 /// \brief `sadsplat eval RUN --ortho`: renders the class map on the grid of the scene's
