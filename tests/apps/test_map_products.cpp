@@ -552,6 +552,15 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   }
   EXPECT_GE(j["objects_by_step"][5]["predicted"].get<int>(),
             j["objects_by_step"][0]["predicted"].get<int>());
+  // The matched objects' heights against the true buildings' tops, one error per match.
+  for (const char* key : {"height_m", "height_above_ground_m"}) {
+    EXPECT_EQ(j["objects"][key]["objects"], j["objects"]["matched"]) << key;
+    if (j["objects"]["matched"].get<int>() == 0) continue;
+    EXPECT_GE(j["objects"][key]["median_abs_error"].get<double>(), 0.0) << key;
+    EXPECT_GE(j["objects"][key]["rmse"].get<double>(),
+              j["objects"][key]["median_abs_error"].get<double>() * 0.5)
+        << key;
+  }
   // A negative step is an error naming the flag.
   EXPECT_NE(test::runCommand(kCli + " eval " + run() + " --ortho --object-step -1", &out), 0);
   EXPECT_NE(out.find("--object-step"), std::string::npos) << out;

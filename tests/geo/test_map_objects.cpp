@@ -58,6 +58,11 @@ TEST(MapObjects, PlainRegionsAreEightConnectedAndScoredByIou) {
   EXPECT_NEAR(s.recall, 2.0 / 3, 1e-12);
   EXPECT_NEAR(s.mean_matched_iou, (0.9 + 8.0 / 12) / 2, 1e-12);
   EXPECT_NEAR(s.best_iou[2], 0.0, 1e-12);
+  // The pairs, by the objects' labels: A with truth 1, B with truth 2; the speck is not kept.
+  EXPECT_EQ(s.true_labels, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(s.predicted_labels, (std::vector<int>{1, 2}));
+  ASSERT_EQ(s.matches.size(), 2u);
+  for (const auto& [t, p] : s.matches) EXPECT_EQ(s.true_labels[t], s.predicted_labels[p]);
 }
 
 // 12 x 5 cells of one class: a roof at 10 m (x 0-4), a column bridging the gap at 0.3 m (x 5),
@@ -157,7 +162,9 @@ TEST(MapObjects, PolygonsInAGeoPackageCarryTheObjects) {
   geo::MapObjectOptions o;
   o.min_cells = 6;
   const std::vector<int> labels = geo::mapObjects(m.mask, m.heights, m.W, m.H, o);
-  const std::vector<geo::MapObjectAttributes> objects = {{1, 10.0}, {1, 16.0}};
+  std::vector<geo::MapObjectAttributes> objects(2);
+  objects[0] = {1, 10.0, 9.5};  // its height above the ground known, the other's not
+  objects[1] = {1, 16.0};
   test::TempDir dir;
   const std::string path = dir.file("objects.gpkg");
   const geo::MapGrid grid{100.0, 200.0, 0.5, ""};
@@ -165,8 +172,8 @@ TEST(MapObjects, PolygonsInAGeoPackageCarryTheObjects) {
       geo::writeObjectPolygons(path, labels, m.W, m.H, objects, grid, {"road", "building"}, {}),
       2u);
   std::string out;
-  ASSERT_EQ(test::runCommand("ogrinfo -q -sql \"SELECT object_id, class, height_m, area_m2 FROM "
-                             "classes ORDER BY object_id\" " +
+  ASSERT_EQ(test::runCommand("ogrinfo -q -sql \"SELECT object_id, class, height_m, "
+                             "height_above_ground_m, area_m2 FROM classes ORDER BY object_id\" " +
                                  path,
                              &out),
             0)
@@ -175,6 +182,8 @@ TEST(MapObjects, PolygonsInAGeoPackageCarryTheObjects) {
   EXPECT_NE(out.find("area_m2 (Real) = 6.25"), std::string::npos) << out;
   EXPECT_NE(out.find("height_m (Real) = 16"), std::string::npos) << out;
   EXPECT_NE(out.find("area_m2 (Real) = 8.75"), std::string::npos) << out;  // bridge + right
+  EXPECT_NE(out.find("height_above_ground_m (Real) = 9.5"), std::string::npos) << out;
+  EXPECT_NE(out.find("height_above_ground_m (Real) = (null)"), std::string::npos) << out;
   EXPECT_NE(out.find("class (String) = building"), std::string::npos) << out;
   // A label no object describes is an error naming the file.
   EXPECT_THROW(geo::writeObjectPolygons(path, labels, m.W, m.H, {{1, 10.0}}, grid, {"a", "b"}, {}),

@@ -203,6 +203,7 @@ void matchPairs(std::vector<std::tuple<double, std::size_t, std::size_t>> pairs,
   for (const auto& [iou, t, p] : pairs) {
     if (iou < match_iou || true_used[t] || pred_used[p]) continue;
     true_used[t] = pred_used[p] = 1;
+    s->matches.emplace_back(t, p);
     ++s->matched;
     iou_sum += iou;
   }
@@ -231,12 +232,15 @@ ObjectScores scoreRasterObjects(const std::vector<int>& predicted, const std::ve
   std::vector<int> kept(max_p + 1, -1);
   ObjectScores s;
   for (int p = 1; p <= max_p; ++p) {
-    if (area_p[p] >= min_cells && area_p[p] > 0) kept[p] = static_cast<int>(s.predicted++);
+    if (area_p[p] < min_cells || area_p[p] == 0) continue;
+    kept[p] = static_cast<int>(s.predicted++);
+    s.predicted_labels.push_back(p);
   }
-  for (int t = 1; t <= max_t; ++t) s.true_objects += area_t[t] > 0;
   std::vector<int> true_index(max_t + 1, -1);
-  for (int t = 1, k = 0; t <= max_t; ++t) {
-    if (area_t[t] > 0) true_index[t] = k++;
+  for (int t = 1; t <= max_t; ++t) {
+    if (area_t[t] == 0) continue;
+    true_index[t] = static_cast<int>(s.true_objects++);
+    s.true_labels.push_back(t);
   }
   s.best_iou.assign(s.true_objects, 0.0);
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;

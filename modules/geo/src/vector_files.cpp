@@ -1,6 +1,7 @@
 #include "sadsplat/geo/vector_files.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -114,6 +115,7 @@ std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>&
        {"class_id", OFTInteger},
        {"class", OFTString},
        {"height_m", OFTReal},
+       {"height_above_ground_m", OFTReal},
        {"area_m2", OFTReal}},
       [&](OGRLayer* layer) {
         std::size_t written = 0;
@@ -137,6 +139,11 @@ std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>&
                                         ? names[static_cast<std::size_t>(c)].c_str()
                                         : "");
           feature.SetField("height_m", object.height);
+          if (std::isfinite(object.height_above_ground)) {
+            feature.SetField("height_above_ground_m", object.height_above_ground);
+          } else {
+            feature.SetFieldNull(feature.GetFieldIndex("height_above_ground_m"));
+          }
           feature.SetField("area_m2", a);
           feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
           if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");

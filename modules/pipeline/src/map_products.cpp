@@ -133,13 +133,30 @@ void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImag
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
+// Errors of object heights (predicted - true): how many, median and median absolute, RMSE.
+nlohmann::json heightErrorsJson(std::vector<double> e) {
+  nlohmann::json j = {{"objects", e.size()}};
+  if (e.empty()) return j;
+  double sq = 0;
+  for (double v : e) sq += v * v;
+  std::vector<double> a(e.size());
+  std::transform(e.begin(), e.end(), a.begin(), [](double v) { return std::abs(v); });
+  std::sort(e.begin(), e.end());
+  std::sort(a.begin(), a.end());
+  j["median_error"] = e[e.size() / 2];
+  j["median_abs_error"] = a[a.size() / 2];
+  j["rmse"] = std::sqrt(sq / e.size());
+  return j;
+}
+
 // Map objects smaller than this merge into the neighbour of their class they border most (the
 // slivers the height cut leaves along walls); also the smallest building the map scores.
 constexpr double kMinObjectM2 = 20;
 
 // The objects of each class in `wanted` on the map: its covered cells split where the surface
 // model steps by more than `step` (geo::mapObjects), numbered across the classes, each with its
-// class and the median height of its cells.
+// class, the median height of its cells and, where the render has a ground model, their median
+// height above it.
 struct ClassObjects {
   std::vector<int> labels;
   std::vector<geo::MapObjectAttributes> objects;
@@ -161,14 +178,26 @@ ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted
     int count = 0;
     for (const int l : labels) count = std::max(count, l);
     std::vector<std::vector<float>> heights(static_cast<std::size_t>(count));
+    std::vector<std::vector<float>> above(static_cast<std::size_t>(count));
     for (std::size_t i = 0; i < n; ++i) {
       if (!labels[i]) continue;
       out.labels[i] = first + labels[i];
-      heights[static_cast<std::size_t>(labels[i]) - 1].push_back(img.elevation[i]);
+      const auto k = static_cast<std::size_t>(labels[i]) - 1;
+      heights[k].push_back(img.elevation[i]);
+      if (i < img.ground.size() && std::isfinite(img.ground[i])) {
+        above[k].push_back(img.elevation[i] - img.ground[i]);
+      }
     }
-    for (std::vector<float>& h : heights) {
-      std::nth_element(h.begin(), h.begin() + h.size() / 2, h.end());
-      out.objects.push_back({c, h.empty() ? 0.0 : double(h[h.size() / 2])});
+    const auto median = [](std::vector<float>& v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return double(v[v.size() / 2]);
+    };
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      geo::MapObjectAttributes a;
+      a.class_id = c;
+      a.height = heights[k].empty() ? 0.0 : median(heights[k]);
+      if (!above[k].empty()) a.height_above_ground = median(above[k]);
+      out.objects.push_back(a);
     }
   }
   return out;
@@ -571,8 +600,24 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       const ClassObjects objects = classObjects(img, {building}, step, min_cells);
       const eval::ObjectScores o =
           eval::scoreRasterObjects(objects.labels, truth_objects, min_cells);
-      return buildingObjectsJson(
+      nlohmann::json scored = buildingObjectsJson(
           o, {{"min_area_m2", kMinObjectM2}, {"object_step_m", step}, {"match_iou", 0.5}});
+      // The matched objects' heights (as `ortho --vectors` writes them) against the true
+      // building's top: the world's ground is z = 0, so its top is also its height above ground.
+      std::vector<double> dsm_errors, above_errors;
+      for (const auto& [t, p] : o.matches) {
+        const synth::ObjectFootprint& f =
+            footprints[static_cast<std::size_t>(o.true_labels[t]) - 1];
+        const double top = dsm_world->objects()[static_cast<std::size_t>(f.object)].hi[2];
+        const geo::MapObjectAttributes& a =
+            objects.objects[static_cast<std::size_t>(o.predicted_labels[p]) - 1];
+        dsm_errors.push_back(a.height - top);
+        if (std::isfinite(a.height_above_ground))
+          above_errors.push_back(a.height_above_ground - top);
+      }
+      scored["height_m"] = heightErrorsJson(dsm_errors);
+      scored["height_above_ground_m"] = heightErrorsJson(above_errors);
+      return scored;
     };
     j["objects"] = objectScores(render.object_step);
     nlohmann::json by_step = nlohmann::json::array();

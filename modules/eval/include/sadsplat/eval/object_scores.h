@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace sadsplat {
@@ -32,6 +33,13 @@ struct ObjectScores {
   /// Per true object: the best IoU of any predicted footprint (0 when none overlaps).
   std::vector<double> best_iou;
   std::vector<Footprint> predicted_footprints;  ///< convex hulls, counter-clockwise
+  /// The matched pairs: (true object, predicted object), 0-based in the order the objects were
+  /// given (scoreObjects: `truth`, the clusters; scoreRasterObjects: true_labels,
+  /// predicted_labels).
+  std::vector<std::pair<std::size_t, std::size_t>> matches;
+  /// scoreRasterObjects: the labels of the true objects and of the predicted objects kept,
+  /// ascending.
+  std::vector<int> true_labels, predicted_labels;
 };
 
 /// \brief Euclidean clusters of `points` (indices into it, each cluster sorted, clusters in

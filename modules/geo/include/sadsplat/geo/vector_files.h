@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,14 +26,16 @@ struct ObjectPolygonOptions {
 struct MapObjectAttributes {
   int class_id = 0;
   double height = 0;  ///< e.g. the median of the surface model over its cells
+  /// e.g. the median of the surface model above the ground model (NaN: unknown, a null field)
+  double height_above_ground = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// \brief Writes the objects of a map as polygons to a GeoPackage: `labels` (row-major,
 /// `width` x `height` cells on `grid`; 0 = none, k = objects[k - 1]) polygonized, one layer,
-/// fields object_id (k), class_id, class (`names[class_id]`), height_m and area_m2 (the
-/// simplified polygon's area, map units^2). Returns the number of polygons written.
-/// \throws sadsplat::Error naming `path` when it cannot be written (or without GDAL), or when
-/// the labels do not fit the size or name an object not in `objects`
+/// fields object_id (k), class_id, class (`names[class_id]`), height_m, height_above_ground_m
+/// (null where unknown) and area_m2 (the simplified polygon's area, map units^2). Returns the
+/// number of polygons written. \throws sadsplat::Error naming `path` when it cannot be written (or
+/// without GDAL), or when the labels do not fit the size or name an object not in `objects`
 std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>& labels, int width,
                                 int height, const std::vector<MapObjectAttributes>& objects,
                                 const MapGrid& grid, const std::vector<std::string>& names,
