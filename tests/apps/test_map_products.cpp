@@ -409,6 +409,15 @@ TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
             0)
       << sums;
   EXPECT_NE(sums.find("class (String) = building"), std::string::npos) << sums;
+  // Every polygon OGC-valid as GEOS checks it.
+  std::string validity;
+  ASSERT_EQ(test::runCommand("ogrinfo -q -dialect SQLite -sql \"SELECT COUNT(*) - "
+                             "SUM(ST_IsValid(geom)) AS invalid FROM classes\" " +
+                                 dir + "/vectors.gpkg 2>&1",
+                             &validity),
+            0)
+      << validity;
+  EXPECT_NE(validity.find("invalid (Integer) = 0"), std::string::npos) << validity;
   EXPECT_EQ(sums.find("class (String) = tree"), std::string::npos) << sums;
   // The grid holds the origin's UTM position (the scene's frame is centred near its origin).
   const auto origin_utm = geo::enuToUtm(

@@ -190,5 +190,35 @@ TEST(MapObjects, PolygonsInAGeoPackageCarryTheObjects) {
                Error);
 }
 
+// Cells of one object joined only at a corner (8-connected) polygonize into a ring that touches
+// itself there; the written polygon is OGC-valid as GEOS checks it (SQLite dialect's ST_IsValid),
+// with the cells' whole area.
+TEST(MapObjects, CornerJoinedCellsGiveValidPolygons) {
+  if (!geo::haveGdal()) GTEST_SKIP() << "built without GDAL";
+  if (test::runCommand("ogrinfo --version") != 0) GTEST_SKIP() << "no ogrinfo (gdal-bin)";
+  // 4 x 3 cells: a 2 x 2 block and one cell at its lower-right corner's diagonal.
+  const int W = 4, H = 3;
+  std::vector<std::uint8_t> mask(W * H, 0);
+  for (const int k : {0, 1, W, W + 1, 2 * W + 2}) mask[k] = 1;
+  geo::MapObjectOptions o;
+  o.max_step = 0;
+  const std::vector<int> labels = geo::mapObjects(mask, {}, W, H, o);
+  ASSERT_EQ(labels[2 * W + 2], 1);  // one object
+  test::TempDir dir;
+  const std::string path = dir.file("corner.gpkg");
+  EXPECT_EQ(geo::writeObjectPolygons(path, labels, W, H, {{0, 1.0}}, {0.0, 3.0, 1.0, ""},
+                                     {"building"}, {}),
+            1u);
+  std::string out;
+  ASSERT_EQ(test::runCommand("ogrinfo -q -dialect SQLite -sql \"SELECT ST_IsValid(geom) AS valid, "
+                             "ST_Area(geom) AS area FROM classes\" " +
+                                 path + " 2>&1",
+                             &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("valid (Integer) = 1"), std::string::npos) << out;
+  EXPECT_NE(out.find("area (Real) = 5"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace sadsplat

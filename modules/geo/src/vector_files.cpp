@@ -61,6 +61,36 @@ std::size_t writeGeoPackageLayer(const std::string& path, const std::string& lay
   return written;
 }
 
+// The polygonal parts of `g` into `out` (a collection's members, recursively).
+void addPolygons(const OGRGeometry* g, OGRMultiPolygon* out) {
+  switch (wkbFlatten(g->getGeometryType())) {
+    case wkbPolygon:
+      out->addGeometry(g);
+      break;
+    case wkbMultiPolygon:
+    case wkbGeometryCollection:
+      for (const OGRGeometry* part : *g->toGeometryCollection()) addPolygons(part, out);
+      break;
+    default:  // points and lines MakeValid may leave where a region was one cell thin
+      break;
+  }
+}
+
+// OGC-valid polygons of `shape`: cells joined only at a corner polygonize into a ring that
+// touches itself there, which GEOS (QGIS's processing, PostGIS) calls invalid; GEOS's MakeValid
+// splits such rings, and the polygonal parts of what it returns are kept.
+std::unique_ptr<OGRMultiPolygon> validPolygons(std::unique_ptr<OGRGeometry> shape) {
+  CPLPushErrorHandler(CPLQuietErrorHandler);  // GEOS's notes on each invalid ring
+  if (!shape->IsValid()) {
+    std::unique_ptr<OGRGeometry> fixed(shape->MakeValid());
+    if (fixed) shape = std::move(fixed);
+  }
+  CPLPopErrorHandler();
+  auto out = std::make_unique<OGRMultiPolygon>();
+  addPolygons(shape.get(), out.get());
+  return out;
+}
+
 }  // namespace
 
 std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>& labels, int width,
@@ -125,10 +155,12 @@ std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>&
           const OGRGeometry* g = f->GetGeometryRef();
           const int id = f->GetFieldAsInteger(0);
           if (!g || id <= 0) continue;
-          std::unique_ptr<OGRGeometry> shape(
+          std::unique_ptr<OGRGeometry> simplified(
               o.simplify > 0 ? g->SimplifyPreserveTopology(o.simplify) : g->clone());
-          if (!shape || shape->IsEmpty()) continue;
-          const double a = OGR_G_Area(OGRGeometry::ToHandle(shape.get()));
+          if (!simplified || simplified->IsEmpty()) continue;
+          std::unique_ptr<OGRMultiPolygon> shape = validPolygons(std::move(simplified));
+          if (shape->IsEmpty()) continue;
+          const double a = shape->get_Area();
           if (a < o.min_area) continue;
           const MapObjectAttributes& object = objects[static_cast<std::size_t>(id) - 1];
           const int c = object.class_id;
@@ -145,7 +177,7 @@ std::size_t writeObjectPolygons(const std::string& path, const std::vector<int>&
             feature.SetFieldNull(feature.GetFieldIndex("height_above_ground_m"));
           }
           feature.SetField("area_m2", a);
-          feature.SetGeometryDirectly(OGRGeometryFactory::forceToMultiPolygon(shape.release()));
+          feature.SetGeometryDirectly(shape.release());
           if (layer->CreateFeature(&feature) != OGRERR_NONE) gdal::failed(path, "feature");
           ++written;
         }
