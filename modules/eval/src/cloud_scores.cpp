@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
 
 namespace sadsplat {
 namespace eval {
@@ -36,12 +37,7 @@ std::vector<double> iouOf(const std::vector<double>& m, int n, double* miou, dou
   return iou;
 }
 
-double quantile(std::vector<float> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
+double quantile(std::vector<float> v, double q) { return quantileInPlace(v, q); }
 
 }  // namespace
 
@@ -116,8 +112,8 @@ CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruth
     for (int dz = -1; dz <= 1 && !hit; ++dz) {
       for (int dy = -1; dy <= 1 && !hit; ++dy) {
         for (int dx = -1; dx <= 1 && !hit; ++dx) {
-          const auto range = opaque_at.equal_range(key(q.xyz[0] + dx * voxel, q.xyz[1] + dy * voxel,
-                                                       q.xyz[2] + dz * voxel));
+          const auto range = opaque_at.equal_range(
+              key(q.xyz[0] + dx * voxel, q.xyz[1] + dy * voxel, q.xyz[2] + dz * voxel));
           for (auto it = range.first; it != range.second && !hit; ++it) {
             const auto& c = it->second;
             const float d2 = (c[0] - q.xyz[0]) * (c[0] - q.xyz[0]) +

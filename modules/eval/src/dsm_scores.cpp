@@ -5,18 +5,13 @@
 #include <string>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
 
 namespace sadsplat {
 namespace eval {
 namespace {
 
-double medianOf(std::vector<double> v) {
-  const std::size_t n = v.size();
-  std::nth_element(v.begin(), v.begin() + n / 2, v.end());
-  const double upper = v[n / 2];
-  if (n % 2) return upper;
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + n / 2));
-}
+double medianOf(std::vector<double> v) { return medianInPlace(v); }
 
 HeightErrors summarise(const std::vector<double>& errors, const std::vector<double>& off_step) {
   HeightErrors h;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
 
 namespace sadsplat {
 namespace geo {
@@ -26,12 +27,8 @@ constexpr double kInlierSigmas = 3.4393;
 Eigen::Vector3d vec(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 std::array<double, 3> arr(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
+// The upper median of a copy (0 for none).
+double median(std::vector<double> v) { return quantileInPlace(v, 0.5); }
 
 using Complex = std::complex<double>;
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
 
 namespace sadsplat {
 namespace geo {
@@ -17,12 +18,6 @@ void checkSize(std::size_t got, std::size_t cells, const char* field) {
   if (got != cells) {
     throw Error("<ground model>", field, std::to_string(cells) + " cells", std::to_string(got));
   }
-}
-
-float median(std::vector<float>& v) {
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
 }
 
 // Where the pixel centres of a row (or column) of `cells` fall between the centres of windows of
@@ -107,7 +102,7 @@ std::vector<float> groundHeights(const std::vector<float>& surface,
           if (!std::isnan(v)) values.push_back(v);
         }
       }
-      smooth[static_cast<std::size_t>(j) * wx + i] = median(values);
+      smooth[static_cast<std::size_t>(j) * wx + i] = quantileInPlace(values, 0.5);
     }
   }
   // Windows without surface: the mean of their known neighbours, ring by ring.
@@ -228,7 +223,7 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
   std::vector<char> raised(num_classes, 0);
   for (int k = 0; k < num_classes; ++k) {
     if (above[k].empty()) continue;
-    out.median_above_ground[k] = median(above[k]);
+    out.median_above_ground[k] = quantileInPlace(above[k], 0.5);
     if (out.median_above_ground[k] >= raised_height) {
       raised[k] = 1;
       out.raised.push_back(k);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
 #include "sadsplat/eval/dsm_scores.h"
 #include "sadsplat/eval/metrics.h"
 #include "sadsplat/eval/object_scores.h"
@@ -141,11 +142,9 @@ nlohmann::json heightErrorsJson(std::vector<double> e) {
   for (double v : e) sq += v * v;
   std::vector<double> a(e.size());
   std::transform(e.begin(), e.end(), a.begin(), [](double v) { return std::abs(v); });
-  std::sort(e.begin(), e.end());
-  std::sort(a.begin(), a.end());
-  j["median_error"] = e[e.size() / 2];
-  j["median_abs_error"] = a[a.size() / 2];
   j["rmse"] = std::sqrt(sq / e.size());
+  j["median_error"] = quantileInPlace(e, 0.5);
+  j["median_abs_error"] = quantileInPlace(a, 0.5);
   return j;
 }
 
@@ -188,15 +187,11 @@ ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted
         above[k].push_back(img.elevation[i] - img.ground[i]);
       }
     }
-    const auto median = [](std::vector<float>& v) {
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      return double(v[v.size() / 2]);
-    };
     for (std::size_t k = 0; k < heights.size(); ++k) {
       geo::MapObjectAttributes a;
       a.class_id = c;
-      a.height = heights[k].empty() ? 0.0 : median(heights[k]);
-      if (!above[k].empty()) a.height_above_ground = median(above[k]);
+      a.height = quantileInPlace(heights[k], 0.5);
+      if (!above[k].empty()) a.height_above_ground = quantileInPlace(above[k], 0.5);
       out.objects.push_back(a);
     }
   }
