@@ -212,30 +212,40 @@ at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::Ras
   return trainer.renderCamera(camera, keep).features;
 }
 
-// OrthoRenderOptions::raised_share: the ground under the DSM, the raised classes, and the cells
-// of a raised class at ground height given the most likely ground class (the tiles that hold one
-// are rendered again for their features).
-void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                      const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
-                      OrthoImages& out) {
+// The ground under the DSM and each class against it (geo::groundHeights, findLowRaisedCells):
+// the raised and the ground classes, their heights above the ground, the share of cells near it,
+// all what the raised check and the pit fill need. Returns the cells of a raised class lower than
+// OrthoRenderOptions::raised_share of its class's height (none with the check off).
+std::vector<std::size_t> placeClassesOnGround(const OrthoGrid& grid,
+                                              const OrthoRenderOptions& options, int num_classes,
+                                              OrthoImages& out) {
   geo::GroundModelOptions ground_options;
   ground_options.window_cells =
       std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
   out.ground =
       geo::groundHeights(out.elevation, out.covered, grid.width, grid.height, ground_options);
-  const int k = static_cast<int>(trainer.numClasses());
-  const geo::LowRaisedCells low =
-      geo::findLowRaisedCells(out.classes, out.elevation, out.ground, k, options.raised_height,
-                              options.raised_share > 0 ? options.raised_share : 1.0);
+  geo::LowRaisedCells low = geo::findLowRaisedCells(
+      out.classes, out.elevation, out.ground, num_classes, options.raised_height,
+      options.raised_share > 0 ? options.raised_share : 1.0);
   out.class_height_above_ground = low.median_above_ground;
   out.raised_classes = low.raised;
   out.ground_classes = low.ground;
   out.near_ground = low.near_ground;
-  if (options.raised_share <= 0) return;
-  out.lowered_cells = static_cast<std::int64_t>(low.cells.size());
-  if (low.cells.empty()) return;
+  if (options.raised_share <= 0) return {};
+  return std::move(low.cells);
+}
+
+// OrthoRenderOptions::raised_share: the `cells` of a raised class at ground height given the most
+// likely ground class (out.ground_classes; the tiles that hold one are rendered again for their
+// features).
+void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                      const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
+                      const std::vector<std::size_t>& cells, OrthoImages& out) {
+  const int k = static_cast<int>(trainer.numClasses());
+  out.lowered_cells = static_cast<std::int64_t>(cells.size());
+  if (cells.empty()) return;
   std::vector<std::uint8_t> lower(out.classes.size(), 0);
-  for (std::size_t c : low.cells) lower[c] = 1;
+  for (std::size_t c : cells) lower[c] = 1;
   for (const OrthoTile& t : orthoTiles(grid, tile)) {
     bool any = false;
     for (int y = 0; y < t.h && !any; ++y) {
@@ -246,7 +256,7 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
     at::Tensor cosines = trainer.classCosines(
         classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
     at::Tensor others = at::ones({k}, at::kBool);
-    for (int c : low.ground) others[c] = false;
+    for (int c : out.ground_classes) others[c] = false;
     cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
     const auto best = cosines.max(2);
     const at::Tensor conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
@@ -414,7 +424,9 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     out.few_views = few.numel();
   }
   if ((options.raised_share > 0 || options.pit_depth > 0) && trainer.numClasses() > 0) {
-    lowerRaisedCells(trainer, grid, options, keep, tile, out);
+    const std::vector<std::size_t> low =
+        placeClassesOnGround(grid, options, static_cast<int>(trainer.numClasses()), out);
+    lowerRaisedCells(trainer, grid, options, keep, tile, low, out);
     const char* checks = options.raised_share > 0 && options.pit_depth > 0
                              ? "--raised-check and --pit-depth"
                          : options.raised_share > 0 ? "--raised-check"
