@@ -398,6 +398,16 @@ std::string orthoRun(const OrthoRunOptions& o) {
         << 100.0 * pixels[c] / std::max<std::int64_t>(1, classified) << " %\n";
     }
   }
+  if (!o.vectors.empty()) {
+    s << "  vectors.gpkg: " << polygons << " polygons of ";
+    for (std::size_t k = 0; k < o.vectors.size(); ++k) s << (k ? ", " : "") << o.vectors[k];
+    s << std::setprecision(2) << std::defaultfloat;
+    if (o.object_step > 0) {
+      s << " (regions cut where the DSM steps by more than " << o.object_step << ")\n";
+    } else {
+      s << " (plain regions)\n";
+    }
+  }
   return s.str();
 }
 
