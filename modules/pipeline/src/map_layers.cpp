@@ -1,0 +1,120 @@
+#include "map_layers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "sadsplat/common/error.h"
+#include "sadsplat/common/order_statistics.h"
+#include "sadsplat/geo/ground_model.h"
+#include "sadsplat/geo/map_objects.h"
+
+namespace sadsplat {
+namespace pipeline {
+
+OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what) {
+  OrthoRenderOptions r;
+  r.height = parseOrthoSurface(o.height, "--height");
+  r.classes = parseOrthoSurface(o.class_from, "--class-from");
+  if (o.min_views < 0) {
+    throw Error(what, "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
+  }
+  if (!(o.min_spread >= 0 && o.min_spread <= 360)) {
+    throw Error(what, "--min-spread", "degrees in [0, 360]", std::to_string(o.min_spread));
+  }
+  if (!(o.depth_tolerance > 0 && o.depth_tolerance <= 1)) {
+    throw Error(what, "--depth-tolerance", "a share of the depth in (0, 1]",
+                std::to_string(o.depth_tolerance));
+  }
+  if (!(o.on_surface >= 0 && std::isfinite(o.on_surface))) {
+    throw Error(what, "--on-surface", "a distance >= 0 in scene units (0: off)",
+                std::to_string(o.on_surface));
+  }
+  if (!(o.raised_check >= 0 && o.raised_check <= 1)) {
+    throw Error(what, "--raised-check", "a share of the raised class's height in [0, 1] (0: off)",
+                std::to_string(o.raised_check));
+  }
+  if (!(o.pit_depth >= 0 && std::isfinite(o.pit_depth))) {
+    throw Error(what, "--pit-depth", "a depth >= 0 in map units (0: off)",
+                std::to_string(o.pit_depth));
+  }
+  if (!(o.object_step >= 0 && std::isfinite(o.object_step))) {
+    throw Error(what, "--object-step", "a height step >= 0 in map units (0: plain regions)",
+                std::to_string(o.object_step));
+  }
+  if (!(o.ground_window > 0 && std::isfinite(o.ground_window))) {
+    throw Error(what, "--ground-window", "a window side > 0 in map units",
+                std::to_string(o.ground_window));
+  }
+  r.raised_share = o.raised_check;
+  r.pit_depth = o.pit_depth;
+  r.ground_window = o.ground_window;
+  r.min_views = o.min_views;
+  r.min_spread_degrees = o.min_spread;
+  r.max_surface_gap = o.on_surface;
+  r.depth_tolerance = o.depth_tolerance;
+  return r;
+}
+
+void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
+                    const std::vector<ClassInfo>& classes) {
+  j["raised_check"] = o.raised_check;
+  j["pit_depth"] = o.pit_depth;
+  if (o.raised_check <= 0 && o.pit_depth <= 0) return;
+  j["ground_window"] = o.ground_window;
+  nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
+  for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
+    const double h = img.class_height_above_ground[c];
+    heights[classes[c].name] = std::isfinite(h) ? nlohmann::json(h) : nlohmann::json(nullptr);
+  }
+  for (int c : img.raised_classes) raised.push_back(classes.at(c).name);
+  j["class_height_above_ground"] = heights;
+  j["raised_classes"] = raised;
+  const std::size_t n = img.classes.size();
+  j["raised_lowered_share"] = n ? double(img.lowered_cells) / n : 0.0;
+  j["pit_filled_share"] = n ? double(img.filled_pits) / n : 0.0;
+  j["near_ground_share"] = img.near_ground;
+  j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
+  j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
+}
+
+ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,
+                          std::size_t min_cells) {
+  const std::size_t n = img.classes.size();
+  ClassObjects out;
+  out.labels.assign(n, 0);
+  geo::MapObjectOptions options;
+  options.max_step = step;
+  options.min_cells = min_cells;
+  for (const int c : wanted) {
+    std::vector<std::uint8_t> mask(n, 0);
+    for (std::size_t i = 0; i < n; ++i) mask[i] = img.covered[i] && img.classes[i] == c;
+    const std::vector<int> labels =
+        geo::mapObjects(mask, img.elevation, img.width, img.height, options);
+    const int first = static_cast<int>(out.objects.size());
+    int count = 0;
+    for (const int l : labels) count = std::max(count, l);
+    std::vector<std::vector<float>> heights(static_cast<std::size_t>(count));
+    std::vector<std::vector<float>> above(static_cast<std::size_t>(count));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!labels[i]) continue;
+      out.labels[i] = first + labels[i];
+      const auto k = static_cast<std::size_t>(labels[i]) - 1;
+      heights[k].push_back(img.elevation[i]);
+      if (i < img.ground.size() && std::isfinite(img.ground[i])) {
+        above[k].push_back(img.elevation[i] - img.ground[i]);
+      }
+    }
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      geo::MapObjectAttributes a;
+      a.class_id = c;
+      a.height = quantileInPlace(heights[k], 0.5);
+      if (!above[k].empty()) a.height_above_ground = quantileInPlace(above[k], 0.5);
+      out.objects.push_back(a);
+    }
+  }
+  return out;
+}
+
+}  // namespace pipeline
+}  // namespace sadsplat

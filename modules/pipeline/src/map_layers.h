@@ -1,0 +1,44 @@
+#pragma once
+// What `ortho` and `eval --ortho` share (internal to the pipeline): their render options checked,
+// the raised check's summary, and the map's objects of a class (geo::mapObjects on the render).
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "sadsplat/common/class_info.h"
+#include "sadsplat/geo/vector_files.h"
+#include "sadsplat/pipeline/map_products.h"
+#include "sadsplat/pipeline/ortho_render.h"
+
+namespace sadsplat {
+namespace pipeline {
+
+// The render options `ortho` and `eval --ortho` share, checked before any file is read (errors
+// name `what`, the command, and the flag); the cameras come with the scene.
+OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what);
+
+// What the raised-class check did (OrthoRenderOptions::raised_share), for ortho.json and
+// ortho_metrics.json.
+void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
+                    const std::vector<ClassInfo>& classes);
+
+// Map objects smaller than this merge into the neighbour of their class they border most (the
+// slivers the height cut leaves along walls); also the smallest building the map scores.
+constexpr double kMinObjectM2 = 20;
+
+// The objects of each class in `wanted` on the map: its covered cells split where the surface
+// model steps by more than `step` (geo::mapObjects), numbered across the classes, each with its
+// class, the median height of its cells and, where the render has a ground model, their median
+// height above it.
+struct ClassObjects {
+  std::vector<int> labels;
+  std::vector<geo::MapObjectAttributes> objects;
+};
+ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,
+                          std::size_t min_cells);
+
+}  // namespace pipeline
+}  // namespace sadsplat
