@@ -56,8 +56,14 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   return r;
 }
 
-void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
-                    const std::vector<ClassInfo>& classes) {
+void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
+                      const std::vector<ClassInfo>& classes) {
+  j["height"] = o.height;
+  j["class_from"] = o.class_from;
+  j["min_views"] = o.min_views;
+  j["min_spread_degrees"] = o.min_spread;
+  j["depth_tolerance"] = o.depth_tolerance;
+  j["on_surface_m"] = o.on_surface;
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
   if (o.raised_check <= 0 && o.pit_depth <= 0) return;

@@ -1,6 +1,6 @@
 #pragma once
-// What `ortho` and `eval --ortho` share (internal to the pipeline): their render options checked,
-// the raised check's summary, and the map's objects of a class (geo::mapObjects on the render).
+// What `ortho` and `eval --ortho` share (internal to the pipeline): their render options checked
+// and summarised, and the map's objects of a class (geo::mapObjects on the render).
 
 #include <nlohmann/json.hpp>
 
@@ -20,10 +20,11 @@ namespace pipeline {
 // name `what`, the command, and the flag); the cameras come with the scene.
 OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what);
 
-// What the raised-class check did (OrthoRenderOptions::raised_share), for ortho.json and
+// How the map was rendered (the surface, the class, the view checks) and what the raised-class
+// check and the pit fill did (OrthoRenderOptions::raised_share, pit_depth), for ortho.json and
 // ortho_metrics.json.
-void addRaisedCheck(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
-                    const std::vector<ClassInfo>& classes);
+void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
+                      const std::vector<ClassInfo>& classes);
 
 // Map objects smaller than this merge into the neighbour of their class they border most (the
 // slivers the height cut leaves along walls); also the smallest building the map scores.

@@ -204,14 +204,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["width"] = grid.width;
   j["height"] = grid.height;
   j["covered_share"] = n ? double(covered) / n : 0.0;
-  j["height"] = o.height;
-  j["class_from"] = o.class_from;
-  j["min_views"] = o.min_views;
-  j["min_spread_degrees"] = o.min_spread;
-  j["depth_tolerance"] = o.depth_tolerance;
-  j["on_surface_m"] = o.on_surface;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
-  addRaisedCheck(j, o, img, run.scene.classes);
+  addRenderOptions(j, o, img, run.scene.classes);  // its "height" (the surface) replaces the grid's
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
   j["similarity_fit_residual_m"] = grid.frame.fit_residual;

@@ -148,13 +148,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   j["truth"] = truth_source;
   j["gsd"] = grid.gsd;
   j["cells"] = labelled;
-  j["height"] = render.height;
-  j["class_from"] = render.class_from;
-  j["min_views"] = render.min_views;
-  j["min_spread_degrees"] = render.min_spread;
-  j["depth_tolerance"] = render.depth_tolerance;
-  j["on_surface_m"] = render.on_surface;
-  addRaisedCheck(j, render, img, run.scene.classes);
+  addRenderOptions(j, render, img, run.scene.classes);
   j["uncovered_share"] = labelled ? double(uncovered) / labelled : 0.0;
   j["miou"] = confusion.meanIou();
   j["oacc"] = confusion.overallAccuracy();
