@@ -451,6 +451,120 @@ TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   EXPECT_NEAR(points[0].x, origin_utm[0][0] + model[0].x, 2.0);  // ENU ~ UTM, within 1 km
 }
 
+// `ortho --object-clouds`: each map object's Gaussians in objects/, with the ids of
+// vectors.gpkg: of the object's class, opaque, their centroid over the object's polygon, counted
+// alike in objects.csv, ortho.json and the files.
+TEST_F(MapProducts, OrthoObjectCloudsHoldTheGaussiansOverEachObject) {
+  std::string out;
+  EXPECT_NE(test::runCommand(kCli + " ortho " + run() + " --gsd 0.5 --object-clouds --out " +
+                                 dir_->file("no_vectors"),
+                             &out),
+            0);
+  EXPECT_NE(out.find("--object-clouds"), std::string::npos) << out;
+  EXPECT_NE(out.find("--vectors"), std::string::npos) << out;
+  EXPECT_NE(test::runCommand(kCli + " ortho " + run() +
+                                 " --gsd 0.5 --vectors building --object-clouds "
+                                 "--object-min-opacity 1 --out " +
+                                 dir_->file("no_vectors"),
+                             &out),
+            0);
+  EXPECT_NE(out.find("--object-min-opacity"), std::string::npos) << out;
+  // (The test's briefly trained model has few opaque Gaussians: the translucent ones too.)
+  const std::string dir =
+      ortho("--vectors building,tree --object-clouds --object-min-opacity 0.05", "object_clouds");
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
+  ASSERT_TRUE(j.contains("object_clouds")) << j.dump();
+  // The polygons' bounding boxes by object id, as OGR reads them.
+  std::string boxes;
+  ASSERT_EQ(test::runCommand("ogrinfo -q -dialect SQLite -sql \"SELECT object_id, class_id, "
+                             "ST_MinX(geom) AS x0, ST_MaxX(geom) AS x1, ST_MinY(geom) AS y0, "
+                             "ST_MaxY(geom) AS y1 FROM classes\" " +
+                                 dir + "/vectors.gpkg",
+                             &boxes),
+            0)
+      << boxes;
+  std::map<int, std::array<double, 5>> polygons;  // class, x0, x1, y0, y1
+  {
+    std::istringstream in(boxes);
+    std::string line;
+    int id = -1;
+    std::array<double, 5> box{};
+    int filled = 0;
+    while (std::getline(in, line)) {
+      const std::size_t eq = line.find(" = ");
+      if (eq == std::string::npos) continue;
+      const double v = std::stod(line.substr(eq + 3));
+      const std::string key = line.substr(0, line.find(" ("));
+      const std::size_t at = key.find_first_not_of(' ');
+      const std::string name = key.substr(at);
+      if (name == "object_id") id = static_cast<int>(v), filled = 0;
+      const std::vector<std::string> keys = {"class_id", "x0", "x1", "y0", "y1"};
+      const auto k = std::find(keys.begin(), keys.end(), name);
+      if (k != keys.end()) box[k - keys.begin()] = v, ++filled;
+      if (filled == 5) polygons[id] = box, filled = 0;
+    }
+  }
+  ASSERT_GT(polygons.size(), 0u) << boxes;
+  const auto classes = classesOf(run());
+  std::ifstream csv(dir + "/objects/objects.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line,
+            "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
+            "height_m,file");
+  std::size_t files = 0, gaussians = 0;
+  std::set<int> ids;
+  int checked = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    std::string cell;
+    while (std::getline(row, cell, ',')) f.push_back(cell);
+    if (!line.empty() && line.back() == ',') f.push_back("");
+    ASSERT_EQ(f.size(), 11u) << line;
+    const int id = std::stoi(f[0]), cls = std::stoi(f[1]);
+    ids.insert(id);
+    EXPECT_EQ(f[2], classes[cls].name) << line;
+    EXPECT_TRUE(f[2] == "building" || f[2] == "tree") << line;
+    const std::size_t n = std::stoul(f[3]);
+    if (n == 0) {
+      EXPECT_TRUE(f[10].empty()) << line;
+      continue;
+    }
+    ASSERT_EQ(f[10], "object_" + f[0] + ".pcd") << line;
+    const auto cloud = io::readGaussians(dir + "/objects/" + f[10]);
+    ASSERT_EQ(cloud.size(), n) << line;
+    double sx = 0, sy = 0, sz = 0;
+    for (const GaussianPoint& p : cloud) {
+      EXPECT_EQ(p.label, static_cast<std::uint32_t>(cls)) << line;
+      EXPECT_GE(p.opacity, std::log(0.05f / 0.95f)) << line;  // opacity >= 0.05 (a logit)
+      sx += p.x, sy += p.y, sz += p.z;
+    }
+    EXPECT_NEAR(std::stod(f[4]), sx / n, 1e-3) << line;
+    EXPECT_NEAR(std::stod(f[5]), sy / n, 1e-3) << line;
+    EXPECT_NEAR(std::stod(f[6]), sz / n, 1e-3) << line;
+    ++files, gaussians += n;
+    const auto polygon = polygons.find(id);
+    if (polygon == polygons.end()) continue;  // under four cells: no polygon
+    const auto& b = polygon->second;
+    EXPECT_EQ(b[0], cls) << line;
+    const double x = std::stod(f[7]), y = std::stod(f[8]);
+    EXPECT_GE(x, b[1] - 0.5) << line;  // within a cell (the polygons are simplified to one)
+    EXPECT_LE(x, b[2] + 0.5) << line;
+    EXPECT_GE(y, b[3] - 0.5) << line;
+    EXPECT_LE(y, b[4] + 0.5) << line;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  for (const auto& [id, box] : polygons) EXPECT_EQ(ids.count(id), 1u) << id;
+  EXPECT_EQ(j["object_clouds"]["files"].get<std::size_t>(), files);
+  EXPECT_EQ(j["object_clouds"]["gaussians"].get<std::size_t>(), gaussians);
+  EXPECT_EQ(
+      io::filesIn(dir + "/objects", [](const std::string& f) { return io::endsWith(f, ".pcd"); })
+          .size(),
+      files);
+}
+
 TEST_F(MapProducts, ExtractWritesOneClassAsLasWithAMapOverride) {
   std::string out;
   test::writeFile(dir_->file("map.json"), "{\"road\": 77}");
@@ -561,6 +675,12 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   }
   EXPECT_GE(j["objects_by_step"][5]["predicted"].get<int>(),
             j["objects_by_step"][0]["predicted"].get<int>());
+  // The cloud's building objects grouped by the map's (ortho --object-clouds), for each step.
+  ASSERT_TRUE(j.contains("cloud_objects")) << out;
+  EXPECT_EQ(j["cloud_objects"]["true"], j["objects"]["true"]);
+  EXPECT_DOUBLE_EQ(j["cloud_objects"]["f1"].get<double>(), j["objects"]["cloud_f1"].get<double>());
+  EXPECT_LE(j["cloud_objects"]["matched"].get<int>(), j["cloud_objects"]["predicted"].get<int>());
+  for (const auto& o : j["objects_by_step"]) EXPECT_TRUE(o.contains("cloud_f1")) << o.dump();
   // The matched objects' heights against the true buildings' tops, one error per match.
   for (const char* key : {"height_m", "height_above_ground_m"}) {
     EXPECT_EQ(j["objects"][key]["objects"], j["objects"]["matched"]) << key;

@@ -97,6 +97,34 @@ TEST(ObjectScores, MatchesOneToOneAtHalfTheFootprint) {
   EXPECT_NEAR(t.precision, 0.5, 1e-12);
 }
 
+// Two roofs 0.75 m apart: clustering at 1 m joins them into one object that matches neither;
+// grouped by other means (e.g. the map's objects under them) each roof is its own and matches.
+TEST(ObjectScores, GroupedPointsAreScoredAsGivenNotClustered) {
+  const std::vector<eval::Footprint> truth = {{{0, 0}, {10, 0}, {10, 10}, {0, 10}},
+                                              {{10.5, 0}, {20.5, 0}, {20.5, 10}, {10.5, 10}}};
+  std::vector<std::array<float, 3>> p;
+  addRoof(&p, 0.25f, 0.25f, 9.75f, 9.75f, 8);
+  const std::size_t first = p.size();
+  addRoof(&p, 10.5f, 0.25f, 20.25f, 9.75f, 8);  // as high: one Euclidean cluster
+  const eval::ObjectScores clustered = eval::scoreObjects(p, truth, {});
+  EXPECT_EQ(clustered.predicted, 1u);
+  EXPECT_EQ(clustered.matched, 0u);
+  std::vector<std::vector<std::size_t>> groups(3);
+  for (std::size_t i = 0; i < p.size(); ++i) groups[i < first ? 0 : 1].push_back(i);
+  groups[2] = {0, 1, 2};  // under min_points (20): not an object
+  const eval::ObjectScores grouped = eval::scoreGroupedPoints(p, groups, truth, {});
+  EXPECT_EQ(grouped.predicted, 2u);
+  EXPECT_EQ(grouped.matched, 2u);
+  EXPECT_NEAR(grouped.f1, 1.0, 1e-12);
+  ASSERT_EQ(grouped.matches.size(), 2u);
+  for (const auto& [t, g] : grouped.matches) EXPECT_EQ(t, g);
+  EXPECT_NEAR(grouped.best_iou[0], 0.9025, 0.01);  // the hull of the centres: 9.5 x 9.5
+  EXPECT_NEAR(grouped.best_iou[1], 0.9025, 0.01);  // 10.5 .. 20.0 x 0.25 .. 9.75
+  // An index outside the points is an error, not a read past the end.
+  EXPECT_THROW(eval::scoreGroupedPoints(p, {std::vector<std::size_t>(20, p.size())}, truth, {}),
+               std::out_of_range);
+}
+
 TEST(ObjectScores, AutoToleranceIsFourSpacingsBetweenOneAndThreeMetres) {
   EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.1), 1.0);   // floor
   EXPECT_DOUBLE_EQ(eval::autoClusterTolerance(0.5), 2.0);   // 4 x spacing

@@ -79,6 +79,13 @@ class OrthoCommand : public Command {
                   "than this between neighbouring cells (neighbouring buildings of different "
                   "heights; map units; 0: the plain regions)")
         ->default_val(1.5);
+    c->add_flag("--object-clouds", o_.object_clouds,
+                "--vectors: also OUT/objects/: each object's Gaussians (its class, centre over the "
+                "object) as object_<id>.pcd, ids as in vectors.gpkg, and objects.csv");
+    c->add_option("--object-min-opacity", o_.object_min_opacity,
+                  "--object-clouds: only Gaussians at least this opaque (0: all, as a splat "
+                  "viewer draws the object)")
+        ->default_val(0.5);
     return c;
   }
   int run(const Invocation&) override {

@@ -258,12 +258,19 @@ ObjectScores scoreRasterObjects(const std::vector<int>& predicted, const std::ve
 
 ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
                           const std::vector<Footprint>& truth, const ObjectScoreOptions& o) {
+  return scoreGroupedPoints(points, euclideanClusters(points, o.tolerance, o.min_points), truth, o);
+}
+
+ObjectScores scoreGroupedPoints(const std::vector<std::array<float, 3>>& points,
+                                const std::vector<std::vector<std::size_t>>& groups,
+                                const std::vector<Footprint>& truth, const ObjectScoreOptions& o) {
   ObjectScores s;
   s.true_objects = truth.size();
-  for (const auto& cluster : euclideanClusters(points, o.tolerance, o.min_points)) {
+  for (const auto& cluster : groups) {
+    if (cluster.size() < o.min_points) continue;
     std::vector<std::array<double, 2>> xy;
     xy.reserve(cluster.size());
-    for (std::size_t i : cluster) xy.push_back({points[i][0], points[i][1]});
+    for (std::size_t i : cluster) xy.push_back({points.at(i)[0], points.at(i)[1]});
     s.predicted_footprints.push_back(convexHull(std::move(xy)));
   }
   s.predicted = s.predicted_footprints.size();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "sadsplat/common/error.h"
@@ -120,6 +121,37 @@ ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted
     }
   }
   return out;
+}
+
+std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
+                                                      const OrthoGrid& grid,
+                                                      const ClassObjects& objects,
+                                                      double min_opacity) {
+  const std::size_t cells = static_cast<std::size_t>(grid.width) * grid.height;
+  if (objects.labels.size() != cells) {
+    throw Error("<map objects>", "labels", std::to_string(cells) + " cells (the grid's)",
+                std::to_string(objects.labels.size()));
+  }
+  // Opacity is stored as a logit; 0 keeps every Gaussian.
+  const double min_logit = min_opacity > 0 ? std::log(min_opacity / (1 - min_opacity))
+                                           : -std::numeric_limits<double>::infinity();
+  std::vector<std::vector<std::size_t>> groups(objects.objects.size());
+  for (std::size_t g = 0; g < cloud.size(); ++g) {
+    const GaussianPoint& p = cloud[g];
+    if (!(p.opacity >= min_logit)) continue;
+    const std::array<double, 3> m = grid.frame.toMap({p.x, p.y, p.z});
+    const double i = std::floor((m[0] - grid.x0) / grid.gsd);
+    const double j = std::floor((grid.y0 - m[1]) / grid.gsd);
+    if (!(i >= 0 && i < grid.width && j >= 0 && j < grid.height)) continue;
+    const int k =
+        objects.labels[static_cast<std::size_t>(j) * grid.width + static_cast<std::size_t>(i)];
+    if (k <= 0) continue;
+    if (objects.objects[static_cast<std::size_t>(k) - 1].class_id != static_cast<int>(p.label)) {
+      continue;
+    }
+    groups[static_cast<std::size_t>(k) - 1].push_back(g);
+  }
+  return groups;
 }
 
 }  // namespace pipeline

@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <pcl/point_cloud.h>
+
 #include "sadsplat/common/class_info.h"
+#include "sadsplat/common/gaussian_point.h"
 #include "sadsplat/geo/vector_files.h"
 #include "sadsplat/pipeline/map_products.h"
 #include "sadsplat/pipeline/ortho_render.h"
@@ -40,6 +43,17 @@ struct ClassObjects {
 };
 ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,
                           std::size_t min_cells);
+
+// The Gaussians of each map object, as `ortho --object-clouds` hands them out and `eval --ortho`
+// scores them: those of `cloud` (a labelledCloud) labelled with the object's class, of opacity
+// >= min_opacity, whose centre lies over one of the object's cells of `grid` (the objects'
+// labels are on that grid). Indices into `cloud`, ascending; [k - 1] for object k. Grouping the
+// cloud by the map's objects (cut where the DSM steps) instead of clustering it in 3D keeps
+// neighbouring buildings apart (docs/measurements/cloud_3d).
+std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
+                                                      const OrthoGrid& grid,
+                                                      const ClassObjects& objects,
+                                                      double min_opacity);
 
 }  // namespace pipeline
 }  // namespace sadsplat

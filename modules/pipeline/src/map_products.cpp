@@ -14,8 +14,10 @@
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/geo/vector_files.h"
 #include "sadsplat/io/atomic_file.h"
+#include "sadsplat/io/cloud_files.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/output_set.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/ortho_render.h"
 
@@ -50,6 +52,53 @@ double photoGsd(const OpenedRun& run) {
   return gsd[gsd.size() / 2];
 }
 
+struct ObjectCloudCounts {
+  std::size_t files = 0, gaussians = 0;
+};
+
+// OUT/objects/ (OrthoRunOptions::object_clouds): each map object's Gaussians as
+// object_<id>.pcd and objects.csv.
+ObjectCloudCounts writeObjectClouds(const std::string& dir, const gaussians::Trainer& trainer,
+                                    const io::Scene& scene, const OrthoGrid& grid,
+                                    const ClassObjects& objects, double min_opacity,
+                                    std::ostream* progress) {
+  const pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, progress);
+  const std::vector<std::vector<std::size_t>> groups =
+      objectGaussians(cloud, grid, objects, min_opacity);
+  io::makeDirectory(dir);
+  ObjectCloudCounts counts;
+  std::ostringstream csv;
+  csv << "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
+         "height_m,file\n"
+      << std::setprecision(10);
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    const geo::MapObjectAttributes& a = objects.objects[k];
+    csv << k + 1 << "," << a.class_id << "," << scene.classes[a.class_id].name << ","
+        << groups[k].size() << ",";
+    if (groups[k].empty()) {
+      csv << ",,,,," << a.height << ",\n";
+      continue;
+    }
+    pcl::PointCloud<GaussianPoint> part;
+    std::array<double, 3> sum{0, 0, 0};
+    for (const std::size_t g : groups[k]) {
+      part.push_back(cloud[g]);
+      sum[0] += cloud[g].x, sum[1] += cloud[g].y, sum[2] += cloud[g].z;
+    }
+    const double n = static_cast<double>(groups[k].size());
+    const std::array<double, 3> c{sum[0] / n, sum[1] / n, sum[2] / n};
+    const std::array<double, 3> m = grid.frame.toMap(c);
+    const std::string file = "object_" + std::to_string(k + 1) + ".pcd";
+    io::writeGaussians(dir + "/" + file, part);
+    csv << c[0] << "," << c[1] << "," << c[2] << "," << m[0] << "," << m[1] << "," << a.height
+        << "," << file << "\n";
+    ++counts.files;
+    counts.gaussians += groups[k].size();
+  }
+  io::writeTextFileAtomically(dir + "/objects.csv", csv.str());
+  return counts;
+}
+
 double roundToSignificant(double v, int digits) {
   const double p = std::pow(10.0, digits - 1 - std::floor(std::log10(v)));
   return std::round(v * p) / p;
@@ -71,7 +120,16 @@ std::string orthoRun(const OrthoRunOptions& o) {
   std::vector<std::string> outputs = {
       "orthophoto.tif", "orthophoto.png", "classes.tif", "classes.png", "confidence.tif",
       "confidence.png", "dsm.tif",        "dsm.png",     "classes.csv", "ortho.json"};
+  if (o.object_clouds && o.vectors.empty()) {
+    throw Error("<ortho>", "--object-clouds", "--vectors CLASSES (the objects' classes)",
+                "no --vectors");
+  }
+  if (!(o.object_min_opacity >= 0 && o.object_min_opacity < 1)) {
+    throw Error("<ortho>", "--object-min-opacity", "an opacity in [0, 1)",
+                std::to_string(o.object_min_opacity));
+  }
   if (!o.vectors.empty()) outputs.push_back("vectors.gpkg");
+  if (o.object_clouds) outputs.push_back("objects");
   io::OutputSet files(o.out, outputs);
   OpenedRun run = openRun(o.run);
   // The classes of --vectors, checked before the render.
@@ -119,6 +177,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     if (img.classes[i] < classes.size()) ++pixels[img.classes[i]];
   }
   std::size_t polygons = 0;
+  ObjectCloudCounts clouds;
   if (semantic) {
     geo::Raster ids = geo::Raster::bytesOf(img.width, img.height, 1);
     ids.bytes = img.classes;
@@ -133,6 +192,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
       const ClassObjects objects = classObjects(img, vector_classes, o.object_step, min_cells);
       polygons = geo::writeObjectPolygons(files.path("vectors.gpkg"), objects.labels, img.width,
                                           img.height, objects.objects, map, names, v);
+      if (o.object_clouds) {
+        clouds = writeObjectClouds(files.path("objects"), *run.trainer, run.scene, grid, objects,
+                                   o.object_min_opacity, o.progress);
+      }
     }
     geo::Raster preview = geo::Raster::bytesOf(img.width, img.height, 4);
     preview.last_band_is_alpha = true;
@@ -232,6 +295,14 @@ std::string orthoRun(const OrthoRunOptions& o) {
                     {"object_step_m", o.object_step},
                     {"merged_under_m2", kMinObjectM2}};
   }
+  if (o.object_clouds) {
+    j["object_clouds"] = {
+        {"folder", "objects"},
+        {"files", clouds.files},
+        {"gaussians", clouds.gaussians},
+        {"min_opacity", o.object_min_opacity},
+        {"labels", "the class the training views render where the Gaussian draws"}};
+  }
   j["files"] = semantic ? nlohmann::json{"orthophoto.tif", "classes.tif", "dsm.tif",
                                          "confidence.tif", "classes.csv"}
                         : nlohmann::json{"orthophoto.tif", "dsm.tif", "classes.csv"};
@@ -258,6 +329,10 @@ std::string orthoRun(const OrthoRunOptions& o) {
     } else {
       s << " (plain regions)\n";
     }
+  }
+  if (o.object_clouds) {
+    s << "  objects/: " << clouds.files << " object clouds (" << clouds.gaussians
+      << " Gaussians), objects.csv\n";
   }
   return s.str();
 }

@@ -17,6 +17,7 @@
 #include "sadsplat/eval/object_scores.h"
 #include "sadsplat/io/atomic_file.h"
 #include "sadsplat/io/filesystem.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 #include "sadsplat/pipeline/map_products.h"
 #include "sadsplat/pipeline/opened_run.h"
 #include "sadsplat/pipeline/ortho_render.h"
@@ -227,6 +228,24 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       }
     }
     const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area));
+    // The cloud's building objects as `ortho --object-clouds` hands them out: the Gaussians
+    // under each map object, their footprint the convex hull of their centres (as `eval --3d`
+    // scores the clustered cloud's), against the true footprints.
+    const pcl::PointCloud<GaussianPoint> cloud = labelledCloud(*run.trainer, run.scene);
+    std::vector<std::array<float, 3>> centres(cloud.size());
+    for (std::size_t g = 0; g < cloud.size(); ++g)
+      centres[g] = {cloud[g].x, cloud[g].y, cloud[g].z};
+    std::vector<eval::Footprint> true_footprints;
+    for (const synth::ObjectFootprint& b : footprints) {
+      true_footprints.push_back({{b.x0, b.y0}, {b.x1, b.y0}, {b.x1, b.y1}, {b.x0, b.y1}});
+    }
+    const eval::ObjectScoreOptions cloud_options;  // groups under 20 Gaussians are no objects
+    const double object_min_opacity = OrthoRunOptions().object_min_opacity;  // the opaque ones
+    const auto cloudObjects = [&](const ClassObjects& objects) {
+      return eval::scoreGroupedPoints(centres,
+                                      objectGaussians(cloud, grid, objects, object_min_opacity),
+                                      true_footprints, cloud_options);
+    };
     const auto objectScores = [&](double step) {
       const ClassObjects objects = classObjects(img, {building}, step, min_cells);
       const eval::ObjectScores o =
@@ -248,9 +267,17 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       }
       scored["height_m"] = heightErrorsJson(dsm_errors);
       scored["height_above_ground_m"] = heightErrorsJson(above_errors);
+      scored["cloud_f1"] = cloudObjects(objects).f1;
       return scored;
     };
     j["objects"] = objectScores(render.object_step);
+    j["cloud_objects"] = buildingObjectsJson(
+        cloudObjects(classObjects(img, {building}, render.object_step, min_cells)),
+        {{"object_step_m", render.object_step},
+         {"min_opacity", object_min_opacity},
+         {"min_points", cloud_options.min_points},
+         {"match_iou", cloud_options.match_iou},
+         {"footprint", "the convex hull of the Gaussians' centres"}});
     nlohmann::json by_step = nlohmann::json::array();
     for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) by_step.push_back(objectScores(step));
     j["objects_by_step"] = by_step;

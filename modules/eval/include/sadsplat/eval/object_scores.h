@@ -79,6 +79,16 @@ double footprintIou(const Footprint& a, const Footprint& b, double cell);
 ObjectScores scoreObjects(const std::vector<std::array<float, 3>>& points,
                           const std::vector<Footprint>& truth, const ObjectScoreOptions& options);
 
+/// \brief Scores objects grouped by other means than clustering (e.g. the Gaussians under each
+/// object of the class map): each group of `points` (indices; groups under
+/// options.min_points are not objects) gets the convex hull of its centres as its footprint,
+/// matched to `truth` as scoreObjects matches. options.tolerance is not used.
+/// \throws std::out_of_range for an index outside `points`
+ObjectScores scoreGroupedPoints(const std::vector<std::array<float, 3>>& points,
+                                const std::vector<std::vector<std::size_t>>& groups,
+                                const std::vector<Footprint>& truth,
+                                const ObjectScoreOptions& options);
+
 /// \brief Objects on a raster (e.g. geo::mapObjects'): `predicted` and `truth` label the cells of
 /// one grid (0 = no object, 1..n an object); predicted objects under `min_cells` are dropped;
 /// objects matched one to one at IoU >= match_iou, best first. ObjectScores::predicted_footprints

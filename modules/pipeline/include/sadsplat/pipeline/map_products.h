@@ -59,6 +59,15 @@ struct OrthoRunOptions {
   /// between neighbouring cells (geo/map_objects.h; 0: the plain regions); what --vectors writes
   /// and `eval --ortho` scores as building objects.
   double object_step = 1.5;
+  /// --object-clouds: with `vectors`, OUT/objects/ holds each object's Gaussians (those of its
+  /// class from the training views, opacity >= object_min_opacity, centre over one of its cells)
+  /// as object_<id>.pcd, every field, in the model's frame, ids as vectors.gpkg's object_id, and
+  /// objects.csv (object_id, class_id, class, gaussians, centroid, map x / y, height_m, file)
+  bool object_clouds = false;
+  /// --object-min-opacity: the opaque Gaussians (the surfaces a PCL user measures; what
+  /// `eval --ortho` scores); 0 keeps the translucent ones too (the object as a splat viewer shows
+  /// it)
+  double object_min_opacity = 0.5;
   std::ostream* progress = nullptr;
 };
 
@@ -66,7 +75,8 @@ struct OrthoRunOptions {
 /// nodata), dsm.tif (float32 height, -9999 = nodata), confidence.tif (float32, -1 = nodata),
 /// their PNG previews, classes.csv (pixels, area in m^2 and share per class) and ortho.json (the
 /// grid, CRS and fit); with `vectors`, vectors.gpkg (geo/vector_files.h: the classes' objects,
-/// geo/map_objects.h, as polygons simplified to one cell, those under four cells left out). Returns
+/// geo/map_objects.h, as polygons simplified to one cell, those under four cells left out); with
+/// `object_clouds` also OUT/objects/ (OrthoRunOptions::object_clouds). Returns
 /// a short summary for the terminal.
 std::string orthoRun(const OrthoRunOptions& options);
 
