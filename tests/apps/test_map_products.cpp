@@ -376,12 +376,111 @@ TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
       << info;
 }
 
+// Checks OUT/objects/ of `ortho --vectors WANTED --object-clouds --object-min-opacity 0.05` in
+// `dir` (see OrthoObjectClouds... below); `checked`: the object clouds whose polygon OGR read.
+void checkObjectClouds(const std::string& dir, const std::vector<ClassInfo>& classes,
+                       const std::set<std::string>& wanted, double gsd, int* checked_out) {
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
+  ASSERT_TRUE(j.contains("object_clouds")) << j.dump();
+  // The polygons' bounding boxes by object id, as OGR reads them.
+  std::string boxes;
+  ASSERT_EQ(test::runCommand("ogrinfo -q -dialect SQLite -sql \"SELECT object_id, class_id, "
+                             "ST_MinX(geom) AS x0, ST_MaxX(geom) AS x1, ST_MinY(geom) AS y0, "
+                             "ST_MaxY(geom) AS y1 FROM classes\" " +
+                                 dir + "/vectors.gpkg",
+                             &boxes),
+            0)
+      << boxes;
+  std::map<int, std::array<double, 5>> polygons;  // class, x0, x1, y0, y1
+  {
+    std::istringstream in(boxes);
+    std::string line;
+    int id = -1;
+    std::array<double, 5> box{};
+    int filled = 0;
+    while (std::getline(in, line)) {
+      const std::size_t eq = line.find(" = ");
+      if (eq == std::string::npos) continue;
+      const double v = std::stod(line.substr(eq + 3));
+      const std::string key = line.substr(0, line.find(" ("));
+      const std::size_t at = key.find_first_not_of(' ');
+      const std::string name = key.substr(at);
+      if (name == "object_id") id = static_cast<int>(v), filled = 0;
+      const std::vector<std::string> keys = {"class_id", "x0", "x1", "y0", "y1"};
+      const auto k = std::find(keys.begin(), keys.end(), name);
+      if (k != keys.end()) box[k - keys.begin()] = v, ++filled;
+      if (filled == 5) polygons[id] = box, filled = 0;
+    }
+  }
+  ASSERT_GT(polygons.size(), 0u) << boxes;
+  std::ifstream csv(dir + "/objects/objects.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line,
+            "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
+            "height_m,file");
+  std::size_t files = 0, gaussians = 0;
+  std::set<int> ids;
+  int checked = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    std::string cell;
+    while (std::getline(row, cell, ',')) f.push_back(cell);
+    if (!line.empty() && line.back() == ',') f.push_back("");
+    ASSERT_EQ(f.size(), 11u) << line;
+    const int id = std::stoi(f[0]), cls = std::stoi(f[1]);
+    ids.insert(id);
+    EXPECT_EQ(f[2], classes[cls].name) << line;
+    EXPECT_EQ(wanted.count(f[2]), 1u) << line;
+    const std::size_t n = std::stoul(f[3]);
+    if (n == 0) {
+      EXPECT_TRUE(f[10].empty()) << line;
+      continue;
+    }
+    ASSERT_EQ(f[10], "object_" + f[0] + ".pcd") << line;
+    const auto cloud = io::readGaussians(dir + "/objects/" + f[10]);
+    ASSERT_EQ(cloud.size(), n) << line;
+    double sx = 0, sy = 0, sz = 0;
+    for (const GaussianPoint& p : cloud) {
+      EXPECT_EQ(p.label, static_cast<std::uint32_t>(cls)) << line;
+      EXPECT_GE(p.opacity, std::log(0.05f / 0.95f)) << line;  // opacity >= 0.05 (a logit)
+      sx += p.x, sy += p.y, sz += p.z;
+    }
+    EXPECT_NEAR(std::stod(f[4]), sx / n, 1e-3) << line;
+    EXPECT_NEAR(std::stod(f[5]), sy / n, 1e-3) << line;
+    EXPECT_NEAR(std::stod(f[6]), sz / n, 1e-3) << line;
+    ++files, gaussians += n;
+    const auto polygon = polygons.find(id);
+    if (polygon == polygons.end()) continue;  // under four cells: no polygon
+    const auto& b = polygon->second;
+    EXPECT_EQ(b[0], cls) << line;
+    const double x = std::stod(f[7]), y = std::stod(f[8]);
+    EXPECT_GE(x, b[1] - gsd) << line;  // within a cell (the polygons are simplified to one)
+    EXPECT_LE(x, b[2] + gsd) << line;
+    EXPECT_GE(y, b[3] - gsd) << line;
+    EXPECT_LE(y, b[4] + gsd) << line;
+    ++checked;
+  }
+  for (const auto& [id, box] : polygons) EXPECT_EQ(ids.count(id), 1u) << id;
+  EXPECT_EQ(j["object_clouds"]["files"].get<std::size_t>(), files);
+  EXPECT_EQ(j["object_clouds"]["gaussians"].get<std::size_t>(), gaussians);
+  EXPECT_EQ(
+      io::filesIn(dir + "/objects", [](const std::string& f) { return io::endsWith(f, ".pcd"); })
+          .size(),
+      files);
+  *checked_out = checked;
+}
+
 TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
   std::string out;
   const std::string dir = dir_->file("geo_ortho");
   ASSERT_EQ(
       test::runCommand(
-          kCli + " ortho " + geoRun() + " --gsd 2 --vectors building,road --out " + dir, &out),
+          kCli + " ortho " + geoRun() +
+              " --gsd 2 --vectors building,road --object-clouds --object-min-opacity 0.05 --out " +
+              dir,
+          &out),
       0)
       << out;
   const std::string info = gdalinfo(dir + "/classes.tif");
@@ -419,6 +518,10 @@ TEST_F(MapProducts, AGeoreferencedRunMapsOntoItsUtmZone) {
       << validity;
   EXPECT_NE(validity.find("invalid (Integer) = 0"), std::string::npos) << validity;
   EXPECT_EQ(sums.find("class (String) = tree"), std::string::npos) << sums;
+  // The objects' Gaussians (in the model's frame) lie over their polygons (in UTM).
+  int checked = 0;
+  checkObjectClouds(dir, classesOf(geoRun()), {"building", "road"}, 2.0, &checked);
+  EXPECT_GT(checked, 0);
   // The grid holds the origin's UTM position (the scene's frame is centred near its origin).
   const auto origin_utm = geo::enuToUtm(
       io::georeferenceFromJson(test::readFile(geoRun() + "/georeference.json"), "g"), {{0, 0, 0}});
@@ -472,97 +575,9 @@ TEST_F(MapProducts, OrthoObjectCloudsHoldTheGaussiansOverEachObject) {
   // (The test's briefly trained model has few opaque Gaussians: the translucent ones too.)
   const std::string dir =
       ortho("--vectors building,tree --object-clouds --object-min-opacity 0.05", "object_clouds");
-  const nlohmann::json j = nlohmann::json::parse(test::readFile(dir + "/ortho.json"));
-  ASSERT_TRUE(j.contains("object_clouds")) << j.dump();
-  // The polygons' bounding boxes by object id, as OGR reads them.
-  std::string boxes;
-  ASSERT_EQ(test::runCommand("ogrinfo -q -dialect SQLite -sql \"SELECT object_id, class_id, "
-                             "ST_MinX(geom) AS x0, ST_MaxX(geom) AS x1, ST_MinY(geom) AS y0, "
-                             "ST_MaxY(geom) AS y1 FROM classes\" " +
-                                 dir + "/vectors.gpkg",
-                             &boxes),
-            0)
-      << boxes;
-  std::map<int, std::array<double, 5>> polygons;  // class, x0, x1, y0, y1
-  {
-    std::istringstream in(boxes);
-    std::string line;
-    int id = -1;
-    std::array<double, 5> box{};
-    int filled = 0;
-    while (std::getline(in, line)) {
-      const std::size_t eq = line.find(" = ");
-      if (eq == std::string::npos) continue;
-      const double v = std::stod(line.substr(eq + 3));
-      const std::string key = line.substr(0, line.find(" ("));
-      const std::size_t at = key.find_first_not_of(' ');
-      const std::string name = key.substr(at);
-      if (name == "object_id") id = static_cast<int>(v), filled = 0;
-      const std::vector<std::string> keys = {"class_id", "x0", "x1", "y0", "y1"};
-      const auto k = std::find(keys.begin(), keys.end(), name);
-      if (k != keys.end()) box[k - keys.begin()] = v, ++filled;
-      if (filled == 5) polygons[id] = box, filled = 0;
-    }
-  }
-  ASSERT_GT(polygons.size(), 0u) << boxes;
-  const auto classes = classesOf(run());
-  std::ifstream csv(dir + "/objects/objects.csv");
-  std::string line;
-  std::getline(csv, line);
-  EXPECT_EQ(line,
-            "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
-            "height_m,file");
-  std::size_t files = 0, gaussians = 0;
-  std::set<int> ids;
   int checked = 0;
-  while (std::getline(csv, line)) {
-    std::vector<std::string> f;
-    std::stringstream row(line);
-    std::string cell;
-    while (std::getline(row, cell, ',')) f.push_back(cell);
-    if (!line.empty() && line.back() == ',') f.push_back("");
-    ASSERT_EQ(f.size(), 11u) << line;
-    const int id = std::stoi(f[0]), cls = std::stoi(f[1]);
-    ids.insert(id);
-    EXPECT_EQ(f[2], classes[cls].name) << line;
-    EXPECT_TRUE(f[2] == "building" || f[2] == "tree") << line;
-    const std::size_t n = std::stoul(f[3]);
-    if (n == 0) {
-      EXPECT_TRUE(f[10].empty()) << line;
-      continue;
-    }
-    ASSERT_EQ(f[10], "object_" + f[0] + ".pcd") << line;
-    const auto cloud = io::readGaussians(dir + "/objects/" + f[10]);
-    ASSERT_EQ(cloud.size(), n) << line;
-    double sx = 0, sy = 0, sz = 0;
-    for (const GaussianPoint& p : cloud) {
-      EXPECT_EQ(p.label, static_cast<std::uint32_t>(cls)) << line;
-      EXPECT_GE(p.opacity, std::log(0.05f / 0.95f)) << line;  // opacity >= 0.05 (a logit)
-      sx += p.x, sy += p.y, sz += p.z;
-    }
-    EXPECT_NEAR(std::stod(f[4]), sx / n, 1e-3) << line;
-    EXPECT_NEAR(std::stod(f[5]), sy / n, 1e-3) << line;
-    EXPECT_NEAR(std::stod(f[6]), sz / n, 1e-3) << line;
-    ++files, gaussians += n;
-    const auto polygon = polygons.find(id);
-    if (polygon == polygons.end()) continue;  // under four cells: no polygon
-    const auto& b = polygon->second;
-    EXPECT_EQ(b[0], cls) << line;
-    const double x = std::stod(f[7]), y = std::stod(f[8]);
-    EXPECT_GE(x, b[1] - 0.5) << line;  // within a cell (the polygons are simplified to one)
-    EXPECT_LE(x, b[2] + 0.5) << line;
-    EXPECT_GE(y, b[3] - 0.5) << line;
-    EXPECT_LE(y, b[4] + 0.5) << line;
-    ++checked;
-  }
+  checkObjectClouds(dir, classesOf(run()), {"building", "tree"}, 0.5, &checked);
   EXPECT_GT(checked, 0);
-  for (const auto& [id, box] : polygons) EXPECT_EQ(ids.count(id), 1u) << id;
-  EXPECT_EQ(j["object_clouds"]["files"].get<std::size_t>(), files);
-  EXPECT_EQ(j["object_clouds"]["gaussians"].get<std::size_t>(), gaussians);
-  EXPECT_EQ(
-      io::filesIn(dir + "/objects", [](const std::string& f) { return io::endsWith(f, ".pcd"); })
-          .size(),
-      files);
 }
 
 TEST_F(MapProducts, ExtractWritesOneClassAsLasWithAMapOverride) {
