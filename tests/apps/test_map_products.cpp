@@ -673,6 +673,13 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   }
   EXPECT_EQ(j["height"], "first");
   EXPECT_EQ(j["class_from"], "blend");
+  // The trim (default auto: the model's building class) and what it changed.
+  EXPECT_EQ(j["trim"], nlohmann::json::array({"building"}));
+  EXPECT_GE(j["trimmed_share"].get<double>(), 0.0);
+  EXPECT_LT(j["trimmed_share"].get<double>(), 0.5);
+  EXPECT_NE(test::runCommand(kCli + " eval " + run() + " --ortho --trim roofs", &out), 0);
+  EXPECT_NE(out.find("--trim"), std::string::npos) << out;
+  EXPECT_NE(out.find("roofs"), std::string::npos) << out;
   EXPECT_EQ(j["min_views"], 0);
   // Building objects of the map, cut at the default DSM step and at six steps (0: the plain
   // regions); cutting never makes fewer objects than the plain regions, and every count is

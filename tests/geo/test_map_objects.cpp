@@ -2,6 +2,7 @@
 // merged into their neighbours; and their polygons in a GeoPackage read back by OGR's ogrinfo.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -151,6 +152,64 @@ TEST(MapObjects, BadInputIsAnError) {
       geo::mapObjects(std::vector<std::uint8_t>(4, 1), std::vector<float>(4, 0.f), 2, 2, o), Error);
   o.max_step = 0;  // no heights needed
   EXPECT_NO_THROW(geo::mapObjects(std::vector<std::uint8_t>(4, 1), {}, 2, 2, o));
+}
+
+// The trim (ortho --trim): a roof object of 6 x 4 cells whose Gaussians' hull covers only its
+// left 4 x 4 cells: the right two columns lie outside; an object with a degenerate hull (two
+// corners) keeps its cells; an object without a polygon is an error.
+TEST(MapObjects, CellsOutsideTheirObjectsHullAreFound) {
+  const int w = 8, h = 6;
+  std::vector<int> labels(w * h, 0);
+  for (int y = 1; y < 5; ++y) {
+    for (int x = 1; x < 7; ++x) labels[y * w + x] = 1;
+  }
+  labels[0] = 2;  // object 2: one cell in the corner
+  const std::vector<std::vector<std::array<double, 2>>> hulls = {
+      {{1, 1}, {5, 1}, {5, 5}, {1, 5}},  // cells x 1..4 (centres 1.5 .. 4.5) inside
+      {{0, 0}, {1, 1}}};                 // a line: no area, every cell kept
+  const std::vector<std::size_t> outside = geo::cellsOutsideHulls(labels, w, hulls);
+  std::vector<std::size_t> expected;
+  for (int y = 1; y < 5; ++y) {
+    for (int x = 5; x < 7; ++x) expected.push_back(static_cast<std::size_t>(y * w + x));
+  }
+  EXPECT_EQ(outside, expected);
+  // The other orientation of the same polygon gives the same cells.
+  const std::vector<std::vector<std::array<double, 2>>> reversed = {
+      {{1, 5}, {5, 5}, {5, 1}, {1, 1}}, {}};
+  EXPECT_EQ(geo::cellsOutsideHulls(labels, w, reversed), expected);
+  EXPECT_THROW(geo::cellsOutsideHulls(labels, w, {hulls[0]}), Error);
+}
+
+// Trimmed cells take the class most of the allowed, covered, untrimmed cells around them have;
+// a cell with none around it is returned unchanged.
+TEST(MapObjects, TrimmedCellsTakeTheClassAroundThem) {
+  const int w = 7, h = 3;
+  // Row-major: class 0 (building) in x 0..2, road (1) x 3..4 on rows 0-1, grass (2) x 3..6 on
+  // row 2 and x 5..6 above; a car (3) at (6, 0) that may not be chosen.
+  std::vector<std::uint8_t> classes = {0, 0, 0, 1, 1, 2, 3,  //
+                                       0, 0, 0, 1, 1, 2, 2,  //
+                                       0, 0, 0, 2, 2, 2, 2};
+  std::vector<std::uint8_t> covered(w * h, 1);
+  covered[7 + 4] = 0;  // an uncovered road cell does not vote
+  const std::vector<std::uint8_t> allowed = {0, 1, 1, 0};
+  // (2, 0) and (2, 1): radius 1 sees roads (3, 0), (3, 1) and grass (3, 2): road wins 2 to 1;
+  // (0, 0): only building cells (not allowed) around it: left unchanged.
+  const std::vector<std::size_t> cells = {2, 7 + 2, 0};
+  const std::vector<std::size_t> alone =
+      geo::takeClassAround(classes, covered, w, h, cells, allowed, 1);
+  EXPECT_EQ(alone, std::vector<std::size_t>{0});
+  EXPECT_EQ(classes[2], 1);
+  EXPECT_EQ(classes[7 + 2], 1);
+  EXPECT_EQ(classes[0], 0);
+  // A wider window reaches the grass: (2, 1) at radius 3 sees road (3, 0), (3, 1), (4, 0) and
+  // grass (3, 2), (4, 2), (5, 0..2): grass 5 to 3 (the uncovered road cell not counted).
+  std::vector<std::uint8_t> wide = {0, 0, 0, 1, 1, 2, 3,  //
+                                    0, 0, 0, 1, 1, 2, 2,  //
+                                    0, 0, 0, 2, 2, 2, 2};
+  geo::takeClassAround(wide, covered, w, h, {7 + 2}, allowed, 3);
+  EXPECT_EQ(wide[7 + 2], 2);
+  EXPECT_THROW(geo::takeClassAround(wide, std::vector<std::uint8_t>(3, 1), w, h, {}, allowed, 1),
+               Error);
 }
 
 // The objects' polygons as OGR reads them: one feature per object with its class, height and

@@ -42,6 +42,9 @@ class EvalCommand : public Command {
     c->add_option("--object-step", ortho_options_.object_step,
                   "--ortho: the building objects as `ortho --object-step` cuts them")
         ->default_val(1.5);
+    c->add_option("--trim", ortho_options_.trim, "--ortho: as `ortho --trim`")
+        ->delimiter(',')
+        ->default_val("auto");
     c->add_option("--ground-window", ortho_options_.ground_window,
                   "--ortho: as `ortho --ground-window`")
         ->default_val(20);

@@ -79,6 +79,13 @@ class OrthoCommand : public Command {
                   "than this between neighbouring cells (neighbouring buildings of different "
                   "heights; map units; 0: the plain regions)")
         ->default_val(1.5);
+    c->add_option("--trim", o_.trim,
+                  "classes (names, comma-separated) whose objects on the map are trimmed to the "
+                  "hull of their opaque Gaussians' centres: cells outside take the next most "
+                  "likely class around them (a roof's spill over its walls); auto: building "
+                  "where the model has it; none: off")
+        ->delimiter(',')
+        ->default_val("auto");
     c->add_flag("--object-clouds", o_.object_clouds,
                 "--vectors: also OUT/objects/: each object's Gaussians (its class, centre over the "
                 "object) as object_<id>.pcd, ids as in vectors.gpkg, and objects.csv");

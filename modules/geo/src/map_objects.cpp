@@ -149,5 +149,73 @@ std::vector<int> mapObjects(const std::vector<std::uint8_t>& mask,
   return label;
 }
 
+std::vector<std::size_t> cellsOutsideHulls(
+    const std::vector<int>& labels, int width,
+    const std::vector<std::vector<std::array<double, 2>>>& hulls) {
+  std::vector<std::size_t> outside;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const int label = labels[i];
+    if (label <= 0) continue;
+    if (static_cast<std::size_t>(label) > hulls.size()) {
+      throw Error("<map objects>", "hulls", "a polygon for every object",
+                  "none for object " + std::to_string(label));
+    }
+    const std::vector<std::array<double, 2>>& hull = hulls[static_cast<std::size_t>(label) - 1];
+    if (hull.size() < 3) continue;
+    const double x = static_cast<double>(i % width) + 0.5;
+    const double y = static_cast<double>(i / width) + 0.5;
+    // Inside a convex polygon: on one side of every edge (or on it).
+    bool left = true, right = true;
+    for (std::size_t e = 0; e < hull.size(); ++e) {
+      const auto& a = hull[e];
+      const auto& b = hull[(e + 1) % hull.size()];
+      const double cross = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+      left = left && cross >= -1e-9;
+      right = right && cross <= 1e-9;
+    }
+    if (!left && !right) outside.push_back(i);
+  }
+  return outside;
+}
+
+std::vector<std::size_t> takeClassAround(std::vector<std::uint8_t>& classes,
+                                         const std::vector<std::uint8_t>& covered, int width,
+                                         int height, const std::vector<std::size_t>& cells,
+                                         const std::vector<std::uint8_t>& allowed, int radius) {
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  if (classes.size() != n || covered.size() != n) {
+    throw Error("<map objects>", "classes", std::to_string(n) + " cells",
+                std::to_string(classes.size()) + " classes, " + std::to_string(covered.size()) +
+                    " covered");
+  }
+  std::vector<std::uint8_t> taken(n, 0);
+  for (const std::size_t c : cells) taken.at(c) = 1;
+  std::vector<std::uint8_t> result(cells.size(), 255);
+  std::vector<std::int64_t> votes(256);
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const int x = static_cast<int>(cells[k] % width), y = static_cast<int>(cells[k] / width);
+    std::fill(votes.begin(), votes.end(), 0);
+    for (int yy = std::max(0, y - radius); yy <= std::min(height - 1, y + radius); ++yy) {
+      for (int xx = std::max(0, x - radius); xx <= std::min(width - 1, x + radius); ++xx) {
+        const std::size_t d = static_cast<std::size_t>(yy) * width + xx;
+        const std::uint8_t c = classes[d];
+        if (covered[d] && !taken[d] && c < allowed.size() && allowed[c]) ++votes[c];
+      }
+    }
+    const auto best = std::max_element(votes.begin(), votes.end());
+    if (*best > 0) result[k] = static_cast<std::uint8_t>(best - votes.begin());
+  }
+  // Set after the votes: a cell's new class does not vote for its neighbours.
+  std::vector<std::size_t> alone;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (result[k] == 255) {
+      alone.push_back(cells[k]);
+    } else {
+      classes[cells[k]] = result[k];
+    }
+  }
+  return alone;
+}
+
 }  // namespace geo
 }  // namespace sadsplat

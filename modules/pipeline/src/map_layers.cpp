@@ -7,8 +7,10 @@
 
 #include "sadsplat/common/error.h"
 #include "sadsplat/common/order_statistics.h"
+#include "sadsplat/eval/object_scores.h"
 #include "sadsplat/geo/ground_model.h"
 #include "sadsplat/geo/map_objects.h"
+#include "sadsplat/pipeline/labelled_cloud.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -57,6 +59,53 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   return r;
 }
 
+std::vector<int> classIdsOf(const std::vector<std::string>& names,
+                            const std::vector<ClassInfo>& classes, const char* what,
+                            const char* flag) {
+  std::vector<int> ids;
+  for (const std::string& name : names) {
+    const auto it = std::find_if(classes.begin(), classes.end(),
+                                 [&](const ClassInfo& c) { return c.name == name; });
+    if (it == classes.end()) {
+      std::string known;
+      for (const ClassInfo& c : classes) known += (known.empty() ? "" : ", ") + c.name;
+      throw Error(what, flag, "class names of the model (" + known + ")", name);
+    }
+    ids.push_back(static_cast<int>(it - classes.begin()));
+  }
+  return ids;
+}
+
+std::vector<std::string> trimClasses(const OrthoRunOptions& o,
+                                     const std::vector<ClassInfo>& classes) {
+  if (o.trim.empty() || o.trim == std::vector<std::string>{"none"}) return {};
+  if (o.trim == std::vector<std::string>{"auto"}) {
+    for (const ClassInfo& c : classes) {
+      if (c.name == "building") return {"building"};
+    }
+    return {};
+  }
+  return o.trim;
+}
+
+pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRunOptions& o,
+                                       const gaussians::Trainer& trainer, const io::Scene& scene,
+                                       const char* what) {
+  const std::vector<std::string> names = trimClasses(o, scene.classes);
+  for (const std::string& n : o.trim) {
+    if ((n == "auto" || n == "none") && o.trim.size() > 1) {
+      throw Error(what, "--trim", "class names, or auto / none alone", n + " among others");
+    }
+  }
+  if (names.empty() || trainer.numClasses() == 0) return {};
+  render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");
+  render.trim_step = o.object_step;
+  pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, o.progress);
+  render.gaussian_classes.resize(cloud.size());
+  for (std::size_t g = 0; g < cloud.size(); ++g) render.gaussian_classes[g] = cloud[g].label;
+  return cloud;
+}
+
 void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
                       const std::vector<ClassInfo>& classes) {
   j["height"] = o.height;
@@ -67,6 +116,11 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["on_surface_m"] = o.on_surface;
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
+  j["trim"] = trimClasses(o, classes);
+  if (!j["trim"].empty()) {
+    j["trim_step_m"] = o.object_step;
+    j["trimmed_share"] = img.classes.empty() ? 0.0 : double(img.trimmed_cells) / img.classes.size();
+  }
   if (o.raised_check <= 0 && o.pit_depth <= 0) return;
   j["ground_window"] = o.ground_window;
   nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
@@ -152,6 +206,27 @@ std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<Gaus
     groups[static_cast<std::size_t>(k) - 1].push_back(g);
   }
   return groups;
+}
+
+std::vector<std::size_t> cellsOutsideObjectHulls(const pcl::PointCloud<GaussianPoint>& cloud,
+                                                 const OrthoGrid& grid, const OrthoImages& img,
+                                                 const std::vector<int>& classes, double step,
+                                                 std::size_t min_cells) {
+  const ClassObjects objects = classObjects(img, classes, step, min_cells);
+  const std::vector<std::vector<std::size_t>> groups =
+      objectGaussians(cloud, grid, objects, kObjectMinOpacity);
+  // Each object's hull in grid cells (x right, y down), as geo::cellsOutsideHulls takes them.
+  std::vector<std::vector<std::array<double, 2>>> hulls(groups.size());
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    if (groups[k].size() < kMinHullGaussians) continue;
+    std::vector<std::array<double, 2>> xy;
+    for (const std::size_t g : groups[k]) {
+      const std::array<double, 3> m = grid.frame.toMap({cloud[g].x, cloud[g].y, cloud[g].z});
+      xy.push_back({(m[0] - grid.x0) / grid.gsd, (grid.y0 - m[1]) / grid.gsd});
+    }
+    hulls[k] = eval::convexHull(std::move(xy));
+  }
+  return geo::cellsOutsideHulls(objects.labels, grid.width, hulls);
 }
 
 }  // namespace pipeline

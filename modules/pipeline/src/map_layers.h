@@ -23,6 +23,23 @@ namespace pipeline {
 // name `what`, the command, and the flag); the cameras come with the scene.
 OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what);
 
+// The ids of class `names` among `classes`; an unknown name is an error naming `what` and
+// `flag` and the model's classes.
+std::vector<int> classIdsOf(const std::vector<std::string>& names,
+                            const std::vector<ClassInfo>& classes, const char* what,
+                            const char* flag);
+
+// The classes OrthoRunOptions::trim names for a model with `classes` ("auto": building where
+// there is one; "none" or empty: none).
+std::vector<std::string> trimClasses(const OrthoRunOptions& o,
+                                     const std::vector<ClassInfo>& classes);
+
+// OrthoRunOptions::trim set on `render` for the run's model (the Gaussians' classes from its
+// training views: labelledCloud, returned for reuse; an empty cloud when nothing is trimmed).
+pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRunOptions& o,
+                                       const gaussians::Trainer& trainer, const io::Scene& scene,
+                                       const char* what);
+
 // How the map was rendered (the surface, the class, the view checks) and what the raised-class
 // check and the pit fill did (OrthoRenderOptions::raised_share, pit_depth), for ortho.json and
 // ortho_metrics.json.
@@ -50,6 +67,20 @@ ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted
 // labels are on that grid). Indices into `cloud`, ascending; [k - 1] for object k. Grouping the
 // cloud by the map's objects (cut where the DSM steps) instead of clustering it in 3D keeps
 // neighbouring buildings apart (docs/measurements/cloud_3d).
+// Opaque: the Gaussians whose centres make an object's footprint (eval --ortho's cloud_objects,
+// the trim; `ortho --object-clouds` by default).
+constexpr double kObjectMinOpacity = 0.5;
+
+// OrthoRenderOptions::trim_classes: the cells of the objects of `classes` on the map (cut at
+// `step`, slivers under `min_cells` merged) outside the convex hull of the centres of their
+// Gaussians (objectGaussians at opacity 0.5, objects of at least kMinHullGaussians; a cell is
+// outside when its centre is). Ascending.
+constexpr std::size_t kMinHullGaussians = 20;
+std::vector<std::size_t> cellsOutsideObjectHulls(const pcl::PointCloud<GaussianPoint>& cloud,
+                                                 const OrthoGrid& grid, const OrthoImages& img,
+                                                 const std::vector<int>& classes, double step,
+                                                 std::size_t min_cells);
+
 std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
                                                       const OrthoGrid& grid,
                                                       const ClassObjects& objects,

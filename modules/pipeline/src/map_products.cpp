@@ -58,11 +58,10 @@ struct ObjectCloudCounts {
 
 // OUT/objects/ (OrthoRunOptions::object_clouds): each map object's Gaussians as
 // object_<id>.pcd and objects.csv.
-ObjectCloudCounts writeObjectClouds(const std::string& dir, const gaussians::Trainer& trainer,
+ObjectCloudCounts writeObjectClouds(const std::string& dir,
+                                    const pcl::PointCloud<GaussianPoint>& cloud,
                                     const io::Scene& scene, const OrthoGrid& grid,
-                                    const ClassObjects& objects, double min_opacity,
-                                    std::ostream* progress) {
-  const pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, progress);
+                                    const ClassObjects& objects, double min_opacity) {
   const std::vector<std::vector<std::size_t>> groups =
       objectGaussians(cloud, grid, objects, min_opacity);
   io::makeDirectory(dir);
@@ -139,15 +138,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   if (!o.vectors.empty() && run.trainer->numClasses() == 0) {
     throw Error("<ortho>", "--vectors", "a semantic model (classes)", "no classes");
   }
-  for (const std::string& name : o.vectors) {
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      std::string known;
-      for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-      throw Error("<ortho>", "--vectors", "class names of the model (" + known + ")", name);
-    }
-    vector_classes.push_back(static_cast<int>(it - names.begin()));
-  }
+  vector_classes = classIdsOf(o.vectors, run.scene.classes, "<ortho>", "--vectors");
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
   if (o.progress) {
@@ -155,6 +146,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
                 << grid.frame.crs_name << "\n";
   }
   render_options.cameras = trainingCameras(run.scene);
+  pcl::PointCloud<GaussianPoint> labelled =
+      setTrim(render_options, o, *run.trainer, run.scene, "<ortho>");
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options, o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};
@@ -193,8 +186,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
       polygons = geo::writeObjectPolygons(files.path("vectors.gpkg"), objects.labels, img.width,
                                           img.height, objects.objects, map, names, v);
       if (o.object_clouds) {
-        clouds = writeObjectClouds(files.path("objects"), *run.trainer, run.scene, grid, objects,
-                                   o.object_min_opacity, o.progress);
+        if (labelled.empty()) labelled = labelledCloud(*run.trainer, run.scene, o.progress);
+        clouds = writeObjectClouds(files.path("objects"), labelled, run.scene, grid, objects,
+                                   o.object_min_opacity);
       }
     }
     geo::Raster preview = geo::Raster::bytesOf(img.width, img.height, 4);

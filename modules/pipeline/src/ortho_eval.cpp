@@ -112,6 +112,8 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   }
   grid.top = orthoTop(*run.trainer, grid.frame);
   render_options.cameras = trainingCameras(run.scene);
+  pcl::PointCloud<GaussianPoint> cloud =
+      setTrim(render_options, render, *run.trainer, run.scene, "<eval>");
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options);
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);
@@ -231,7 +233,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
     // The cloud's building objects as `ortho --object-clouds` hands them out: the Gaussians
     // under each map object, their footprint the convex hull of their centres (as `eval --3d`
     // scores the clustered cloud's), against the true footprints.
-    const pcl::PointCloud<GaussianPoint> cloud = labelledCloud(*run.trainer, run.scene);
+    if (cloud.empty()) cloud = labelledCloud(*run.trainer, run.scene);
     std::vector<std::array<float, 3>> centres(cloud.size());
     for (std::size_t g = 0; g < cloud.size(); ++g)
       centres[g] = {cloud[g].x, cloud[g].y, cloud[g].z};
@@ -240,7 +242,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       true_footprints.push_back({{b.x0, b.y0}, {b.x1, b.y0}, {b.x1, b.y1}, {b.x0, b.y1}});
     }
     const eval::ObjectScoreOptions cloud_options;  // groups under 20 Gaussians are no objects
-    const double object_min_opacity = OrthoRunOptions().object_min_opacity;  // the opaque ones
+    const double object_min_opacity = kObjectMinOpacity;
     const auto cloudObjects = [&](const ClassObjects& objects) {
       return eval::scoreGroupedPoints(centres,
                                       objectGaussians(cloud, grid, objects, object_min_opacity),

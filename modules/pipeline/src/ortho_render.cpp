@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
+#include "map_layers.h"
 #include "sadsplat/common/error.h"
 #include "sadsplat/gaussians/raster_math.h"
 #include "sadsplat/gaussians/view_coverage.h"
 #include "sadsplat/geo/ground_model.h"
+#include "sadsplat/geo/map_objects.h"
 
 namespace sadsplat {
 namespace pipeline {
@@ -235,14 +238,13 @@ std::vector<std::size_t> placeClassesOnGround(const OrthoGrid& grid,
   return std::move(low.cells);
 }
 
-// OrthoRenderOptions::raised_share: the `cells` of a raised class at ground height given the most
-// likely ground class (out.ground_classes; the tiles that hold one are rendered again for their
-// features).
-void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                      const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
-                      const std::vector<std::size_t>& cells, OrthoImages& out) {
+// The `cells` given the most likely class of `allowed` (the tiles that hold one are rendered
+// again for their features).
+void relabelCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                  const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
+                  const std::vector<std::size_t>& cells, const std::vector<int>& allowed,
+                  OrthoImages& out) {
   const int k = static_cast<int>(trainer.numClasses());
-  out.lowered_cells = static_cast<std::int64_t>(cells.size());
   if (cells.empty()) return;
   std::vector<std::uint8_t> lower(out.classes.size(), 0);
   for (std::size_t c : cells) lower[c] = 1;
@@ -256,7 +258,7 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
     at::Tensor cosines = trainer.classCosines(
         classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
     at::Tensor others = at::ones({k}, at::kBool);
-    for (int c : out.ground_classes) others[c] = false;
+    for (int c : allowed) others[c] = false;
     cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
     const auto best = cosines.max(2);
     const at::Tensor conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
@@ -271,6 +273,62 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
       }
     }
   }
+}
+
+// OrthoRenderOptions::raised_share: the `cells` of a raised class at ground height given the most
+// likely ground class (out.ground_classes).
+void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                      const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
+                      const std::vector<std::size_t>& cells, OrthoImages& out) {
+  out.lowered_cells = static_cast<std::int64_t>(cells.size());
+  relabelCells(trainer, grid, options, keep, tile, cells, out.ground_classes, out);
+}
+
+// OrthoRenderOptions::trim_classes: the objects' cells outside their Gaussians' hull given the
+// class around them (map units: the window's half side).
+constexpr double kTrimWindow = 1.0;
+void trimObjects(const gaussians::Trainer& trainer, const OrthoGrid& grid,
+                 const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
+                 OrthoImages& out) {
+  const int k = static_cast<int>(trainer.numClasses());
+  pcl::PointCloud<GaussianPoint> cloud = trainer.toCloud();
+  if (options.gaussian_classes.size() != cloud.size()) {
+    throw Error("<ortho>", "gaussian_classes",
+                std::to_string(cloud.size()) + " classes (one per Gaussian, for the trim)",
+                std::to_string(options.gaussian_classes.size()));
+  }
+  for (std::size_t g = 0; g < cloud.size(); ++g) cloud[g].label = options.gaussian_classes[g];
+  if (keep.defined()) {  // --on-surface: the Gaussians the map is made of
+    const at::Tensor kept = keep.to(at::kCPU, at::kBool).contiguous();
+    const bool* pk = kept.data_ptr<bool>();
+    for (std::size_t g = 0; g < cloud.size(); ++g) {
+      if (!pk[g]) cloud[g].label = std::numeric_limits<std::uint32_t>::max();
+    }
+  }
+  const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / (grid.gsd * grid.gsd)));
+  const std::vector<std::size_t> cells =
+      cellsOutsideObjectHulls(cloud, grid, out, options.trim_classes, options.trim_step, min_cells);
+  // The spill lies over the ground beside the walls: the ground classes where the raised check
+  // found them, else every other class.
+  std::vector<int> others;
+  for (int c = 0; c < k; ++c) {
+    const bool trimmed = std::find(options.trim_classes.begin(), options.trim_classes.end(), c) !=
+                         options.trim_classes.end();
+    const bool ground = out.ground_classes.empty() ||
+                        std::find(out.ground_classes.begin(), out.ground_classes.end(), c) !=
+                            out.ground_classes.end();
+    if (!trimmed && ground) others.push_back(c);
+  }
+  out.trimmed_cells = static_cast<std::int64_t>(cells.size());
+  // Each trimmed cell takes the class most of the allowed cells within kTrimWindow around it
+  // have (the surface beside a wall goes on under the spill); one with none around it, the most
+  // likely allowed class of its own features.
+  std::vector<std::uint8_t> allowed(static_cast<std::size_t>(k), 0);
+  for (int c : others) allowed[static_cast<std::size_t>(c)] = 1;
+  const int r = std::max(1, static_cast<int>(std::lround(kTrimWindow / grid.gsd)));
+  const std::vector<std::size_t> alone =
+      geo::takeClassAround(out.classes, out.covered, grid.width, grid.height, cells, allowed, r);
+  if (!others.empty()) relabelCells(trainer, grid, options, keep, tile, alone, others, out);
 }
 
 // OrthoRenderOptions::pit_depth: the ground-class cells in a pit take the level of the ground
@@ -448,6 +506,13 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
         *progress << "  ortho: " << out.filled_pits << " cells of a ground class more than "
                   << options.pit_depth << " below the ground classes around them raised to them\n";
       }
+    }
+  }
+  if (!options.trim_classes.empty() && trainer.numClasses() > 0) {
+    trimObjects(trainer, grid, options, keep, tile, out);
+    if (progress) {
+      *progress << "  ortho: " << out.trimmed_cells
+                << " cells of objects outside their Gaussians' hull given another class\n";
     }
   }
   return out;

@@ -8,6 +8,7 @@
 /// The slivers a cut leaves along walls (cells between a roof's height and the ground's) are then
 /// merged into the object they border most, as GDAL's sieve filter merges small regions.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -33,6 +34,25 @@ struct MapObjectOptions {
 std::vector<int> mapObjects(const std::vector<std::uint8_t>& mask,
                             const std::vector<float>& heights, int width, int height,
                             const MapObjectOptions& options);
+
+/// \brief The cells of labelled objects whose centre lies outside their object's convex
+/// polygon: `labels` as mapObjects gives them (`width` cells a row), `hulls[k - 1]` object k's
+/// convex polygon in cell units (x right from the grid's left edge, y down from its top: cell
+/// (i, j)'s centre is (i + 0.5, j + 0.5); either orientation); an object whose polygon has fewer
+/// than three corners keeps every cell. Ascending.
+/// \throws sadsplat::Error when a label has no polygon
+std::vector<std::size_t> cellsOutsideHulls(
+    const std::vector<int>& labels, int width,
+    const std::vector<std::vector<std::array<double, 2>>>& hulls);
+
+/// \brief Gives each of `cells` the class most of the cells within `radius` cells around it
+/// have (a square window), counting only covered cells of an `allowed` class (allowed[class] !=
+/// 0) that are not among `cells`; ties go to the lower class id. Returns the cells with no such
+/// cell around them, unchanged. `classes`, `covered`: row-major, `width` x `height`.
+std::vector<std::size_t> takeClassAround(std::vector<std::uint8_t>& classes,
+                                         const std::vector<std::uint8_t>& covered, int width,
+                                         int height, const std::vector<std::size_t>& cells,
+                                         const std::vector<std::uint8_t>& allowed, int radius);
 
 }  // namespace geo
 }  // namespace sadsplat

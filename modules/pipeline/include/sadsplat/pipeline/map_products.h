@@ -59,6 +59,12 @@ struct OrthoRunOptions {
   /// between neighbouring cells (geo/map_objects.h; 0: the plain regions); what --vectors writes
   /// and `eval --ortho` scores as building objects.
   double object_step = 1.5;
+  /// --trim: classes (names) whose objects on the map are trimmed to the hull of their
+  /// Gaussians (OrthoRenderOptions::trim_classes; cut at object_step); "auto": the class named
+  /// building where the model has one; "none" (or empty): off. On ten synth city runs (orbit and
+  /// mission) the trim raised every class map (+0.3 to +1.0 points) and halved the mean building
+  /// area error (15 -> 7.6 %; docs/measurements/cloud_3d).
+  std::vector<std::string> trim = {"auto"};
   /// --object-clouds: with `vectors`, OUT/objects/ holds each object's Gaussians (those of its
   /// class from the training views, opacity >= object_min_opacity, centre over one of its cells)
   /// as object_<id>.pcd, every field, in the model's frame, ids as vectors.gpkg's object_id, and

@@ -105,6 +105,17 @@ struct OrthoRenderOptions {
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
+  /// The objects of these classes on the class map (geo::mapObjects cut at trim_step, slivers
+  /// merged as `ortho --vectors` merges them) are trimmed to their Gaussians: the cells of an
+  /// object outside the convex hull of the centres of its opaque Gaussians (those of its class,
+  /// gaussian_classes, over the object: the Gaussians `ortho --object-clouds` hands out; objects
+  /// of at least 20) take the most likely class of the others. A roof's translucent tails spill
+  /// one to three cells over its walls onto the map; its Gaussians' centres do not. Empty: off.
+  std::vector<int> trim_classes;
+  double trim_step = 1.5;  ///< map units
+  /// Per Gaussian of the model (Trainer::toCloud's order): its class as the training views
+  /// render it (labelledCloud); needed by trim_classes.
+  std::vector<std::uint32_t> gaussian_classes;
 };
 
 /// \brief What an orthographic render gives per pixel (row-major; `covered` says which pixels
@@ -129,6 +140,7 @@ struct OrthoImages {
   std::vector<int> ground_classes;  ///< geo::LowRaisedCells::ground
   std::int64_t filled_pits = 0;     ///< cells OrthoRenderOptions::pit_depth raised
   double near_ground = 0;           ///< geo::LowRaisedCells::near_ground (the check's precondition)
+  std::int64_t trimmed_cells = 0;   ///< cells OrthoRenderOptions::trim_classes gave another class
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.
