@@ -188,6 +188,11 @@ TEST_F(MapProducts, OrthoWritesGeoTiffsGdalReadsWithTheGridAndLocalCrs) {
   // classes.csv: areas are pixels x gsd^2, shares sum to 1, and the pixel counts are those of
   // classes.tif.
   const geo::Raster ids = geo::readByteRaster(dir + "/classes.tif");
+  // ortho.json's grid is the rasters' (its height once lost to the surface mode's key).
+  const nlohmann::json grid = nlohmann::json::parse(j);
+  EXPECT_EQ(grid["width"], ids.width);
+  EXPECT_EQ(grid["height"], ids.height);
+  EXPECT_EQ(grid["height_from"], "first");
   std::map<int, long> counted;
   for (std::uint8_t v : ids.bytes) ++counted[v];
   std::ifstream csv(dir + "/classes.csv");
@@ -671,7 +676,7 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
     EXPECT_GT(w["miou"].get<double>(), 0.0);
     EXPECT_LE(w["miou"].get<double>(), 1.0);
   }
-  EXPECT_EQ(j["height"], "first");
+  EXPECT_EQ(j["height_from"], "first");
   EXPECT_EQ(j["class_from"], "blend");
   // The trim (default auto: the model's building class) and what it changed.
   EXPECT_EQ(j["trim"], nlohmann::json::array({"building"}));

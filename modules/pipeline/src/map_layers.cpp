@@ -108,7 +108,7 @@ pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRu
 
 void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoImages& img,
                       const std::vector<ClassInfo>& classes) {
-  j["height"] = o.height;
+  j["height_from"] = o.height;  // --height (the surface the DSM takes)
   j["class_from"] = o.class_from;
   j["min_views"] = o.min_views;
   j["min_spread_degrees"] = o.min_spread;

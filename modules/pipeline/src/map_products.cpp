@@ -262,7 +262,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   j["height"] = grid.height;
   j["covered_share"] = n ? double(covered) / n : 0.0;
   j["few_views_share"] = n ? double(img.few_views) / n : 0.0;
-  addRenderOptions(j, o, img, run.scene.classes);  // its "height" (the surface) replaces the grid's
+  addRenderOptions(j, o, img, run.scene.classes);
   j["map_scale_factor"] = grid.frame.k;
   j["grid_convergence_degrees"] = std::atan2(grid.frame.s, grid.frame.c) * 180 / M_PI;
   j["similarity_fit_residual_m"] = grid.frame.fit_residual;
