@@ -682,6 +682,20 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_EQ(j["trim"], nlohmann::json::array({"building"}));
   EXPECT_GE(j["trimmed_share"].get<double>(), 0.0);
   EXPECT_LT(j["trimmed_share"].get<double>(), 0.5);
+  EXPECT_EQ(j["trim_whole_under"], 0);
+  // Objects with too few Gaussians trimmed whole: never fewer cells trimmed (this briefly trained
+  // model's objects have few opaque Gaussians: every one of them goes).
+  ASSERT_EQ(test::runCommand(kCli + " eval " + run() + " --ortho --trim-whole-under 20 > /dev/null",
+                             &out),
+            0)
+      << out;
+  const nlohmann::json whole = nlohmann::json::parse(test::readFile(run() + "/ortho_metrics.json"));
+  EXPECT_EQ(whole["trim_whole_under"], 20);
+  EXPECT_GE(whole["trimmed_share"].get<double>(), j["trimmed_share"].get<double>());
+  EXPECT_LE(whole["area"]["building"]["predicted_m2"].get<double>(),
+            j["area"]["building"]["predicted_m2"].get<double>());
+  EXPECT_NE(test::runCommand(kCli + " eval " + run() + " --ortho --trim-whole-under -1", &out), 0);
+  EXPECT_NE(out.find("--trim-whole-under"), std::string::npos) << out;
   EXPECT_NE(test::runCommand(kCli + " eval " + run() + " --ortho --trim roofs", &out), 0);
   EXPECT_NE(out.find("--trim"), std::string::npos) << out;
   EXPECT_NE(out.find("roofs"), std::string::npos) << out;

@@ -45,6 +45,9 @@ class EvalCommand : public Command {
     c->add_option("--trim", ortho_options_.trim, "--ortho: as `ortho --trim`")
         ->delimiter(',')
         ->default_val("auto");
+    c->add_option("--trim-whole-under", ortho_options_.trim_whole_under,
+                  "--ortho: as `ortho --trim-whole-under`")
+        ->default_val(0);
     c->add_option("--ground-window", ortho_options_.ground_window,
                   "--ortho: as `ortho --ground-window`")
         ->default_val(20);

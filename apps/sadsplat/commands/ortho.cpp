@@ -86,6 +86,10 @@ class OrthoCommand : public Command {
                   "where the model has it; none: off")
         ->delimiter(',')
         ->default_val("auto");
+    c->add_option(
+         "--trim-whole-under", o_.trim_whole_under,
+         "--trim: objects with fewer opaque Gaussians of their class over them go whole (0: kept)")
+        ->default_val(0);
     c->add_flag("--object-clouds", o_.object_clouds,
                 "--vectors: also OUT/objects/: each object's Gaussians (its class, centre over the "
                 "object) as object_<id>.pcd, ids as in vectors.gpkg, and objects.csv");

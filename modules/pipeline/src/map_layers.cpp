@@ -100,6 +100,11 @@ pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRu
   if (names.empty() || trainer.numClasses() == 0) return {};
   render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");
   render.trim_step = o.object_step;
+  if (o.trim_whole_under < 0) {
+    throw Error(what, "--trim-whole-under", "a number of Gaussians >= 0",
+                std::to_string(o.trim_whole_under));
+  }
+  render.trim_whole_under = static_cast<std::size_t>(o.trim_whole_under);
   pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, o.progress);
   render.gaussian_classes.resize(cloud.size());
   for (std::size_t g = 0; g < cloud.size(); ++g) render.gaussian_classes[g] = cloud[g].label;
@@ -119,6 +124,7 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["trim"] = trimClasses(o, classes);
   if (!j["trim"].empty()) {
     j["trim_step_m"] = o.object_step;
+    j["trim_whole_under"] = o.trim_whole_under;
     j["trimmed_share"] = img.classes.empty() ? 0.0 : double(img.trimmed_cells) / img.classes.size();
   }
   if (o.raised_check <= 0 && o.pit_depth <= 0) return;
@@ -211,7 +217,7 @@ std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<Gaus
 std::vector<std::size_t> cellsOutsideObjectHulls(const pcl::PointCloud<GaussianPoint>& cloud,
                                                  const OrthoGrid& grid, const OrthoImages& img,
                                                  const std::vector<int>& classes, double step,
-                                                 std::size_t min_cells) {
+                                                 std::size_t min_cells, std::size_t whole_under) {
   const ClassObjects objects = classObjects(img, classes, step, min_cells);
   const std::vector<std::vector<std::size_t>> groups =
       objectGaussians(cloud, grid, objects, kObjectMinOpacity);
@@ -226,7 +232,17 @@ std::vector<std::size_t> cellsOutsideObjectHulls(const pcl::PointCloud<GaussianP
     }
     hulls[k] = eval::convexHull(std::move(xy));
   }
-  return geo::cellsOutsideHulls(objects.labels, grid.width, hulls);
+  std::vector<std::size_t> outside = geo::cellsOutsideHulls(objects.labels, grid.width, hulls);
+  // Objects with fewer than whole_under Gaussians over them go whole.
+  for (std::size_t i = 0; i < objects.labels.size(); ++i) {
+    const int label = objects.labels[i];
+    if (label > 0 && groups[static_cast<std::size_t>(label) - 1].size() < whole_under) {
+      outside.push_back(i);
+    }
+  }
+  std::sort(outside.begin(), outside.end());
+  outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
+  return outside;
 }
 
 }  // namespace pipeline

@@ -74,12 +74,13 @@ constexpr double kObjectMinOpacity = 0.5;
 // OrthoRenderOptions::trim_classes: the cells of the objects of `classes` on the map (cut at
 // `step`, slivers under `min_cells` merged) outside the convex hull of the centres of their
 // Gaussians (objectGaussians at opacity 0.5, objects of at least kMinHullGaussians; a cell is
-// outside when its centre is). Ascending.
+// outside when its centre is), and every cell of the objects with fewer than `whole_under`
+// Gaussians over them. Ascending.
 constexpr std::size_t kMinHullGaussians = 20;
 std::vector<std::size_t> cellsOutsideObjectHulls(const pcl::PointCloud<GaussianPoint>& cloud,
                                                  const OrthoGrid& grid, const OrthoImages& img,
                                                  const std::vector<int>& classes, double step,
-                                                 std::size_t min_cells);
+                                                 std::size_t min_cells, std::size_t whole_under);
 
 std::vector<std::vector<std::size_t>> objectGaussians(const pcl::PointCloud<GaussianPoint>& cloud,
                                                       const OrthoGrid& grid,

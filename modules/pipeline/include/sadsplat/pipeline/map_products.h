@@ -65,6 +65,9 @@ struct OrthoRunOptions {
   /// mission) the trim raised every class map (+0.3 to +1.0 points) and halved the mean building
   /// area error (15 -> 7.6 %; docs/measurements/cloud_3d).
   std::vector<std::string> trim = {"auto"};
+  /// --trim-whole-under N: objects of the trimmed classes with fewer than N opaque Gaussians of
+  /// their class over them take the classes around them whole (0: kept)
+  int trim_whole_under = 0;
   /// --object-clouds: with `vectors`, OUT/objects/ holds each object's Gaussians (those of its
   /// class from the training views, opacity >= object_min_opacity, centre over one of its cells)
   /// as object_<id>.pcd, every field, in the model's frame, ids as vectors.gpkg's object_id, and

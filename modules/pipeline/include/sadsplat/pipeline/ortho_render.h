@@ -113,6 +113,10 @@ struct OrthoRenderOptions {
   /// one to three cells over its walls onto the map; its Gaussians' centres do not. Empty: off.
   std::vector<int> trim_classes;
   double trim_step = 1.5;  ///< map units
+  /// Objects of trim_classes with fewer than this many opaque Gaussians of their class over
+  /// them are trimmed whole (a strip of spill between two roofs, cut off by the height steps, has
+  /// a few); 0: such objects are kept (those under 20 have no hull and keep every cell).
+  std::size_t trim_whole_under = 0;
   /// Per Gaussian of the model (Trainer::toCloud's order): its class as the training views
   /// render it (labelledCloud); needed by trim_classes.
   std::vector<std::uint32_t> gaussian_classes;
