@@ -37,8 +37,8 @@ nlohmann::json heightErrorsJson(std::vector<double> e) {
   std::vector<double> a(e.size());
   std::transform(e.begin(), e.end(), a.begin(), [](double v) { return std::abs(v); });
   j["rmse"] = std::sqrt(sq / e.size());
-  j["median_error"] = quantileInPlace(e, 0.5);
-  j["median_abs_error"] = quantileInPlace(a, 0.5);
+  j["median_error"] = medianInPlace(e);  // the mean of the middle two, as eval::scoreDsm's
+  j["median_abs_error"] = medianInPlace(a);
   return j;
 }
 
@@ -272,7 +272,13 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       scored["cloud_f1"] = cloudObjects(objects).f1;
       return scored;
     };
-    j["objects"] = objectScores(render.object_step);
+    nlohmann::json by_step = nlohmann::json::array();
+    for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) by_step.push_back(objectScores(step));
+    j["objects"] = nlohmann::json();
+    for (const nlohmann::json& o : by_step) {
+      if (o["object_step_m"].get<double>() == render.object_step) j["objects"] = o;
+    }
+    if (j["objects"].is_null()) j["objects"] = objectScores(render.object_step);
     j["cloud_objects"] = buildingObjectsJson(
         cloudObjects(classObjects(img, {building}, render.object_step, min_cells)),
         {{"object_step_m", render.object_step},
@@ -280,8 +286,6 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
          {"min_points", cloud_options.min_points},
          {"match_iou", cloud_options.match_iou},
          {"footprint", "the convex hull of the Gaussians' centres"}});
-    nlohmann::json by_step = nlohmann::json::array();
-    for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) by_step.push_back(objectScores(step));
     j["objects_by_step"] = by_step;
   }
   const std::string text = j.dump(2) + "\n";
