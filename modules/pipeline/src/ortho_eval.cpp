@@ -242,11 +242,10 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       true_footprints.push_back({{b.x0, b.y0}, {b.x1, b.y0}, {b.x1, b.y1}, {b.x0, b.y1}});
     }
     const eval::ObjectScoreOptions cloud_options;  // groups under 20 Gaussians are no objects
-    const double object_min_opacity = kObjectMinOpacity;
-    const auto cloudObjects = [&](const ClassObjects& objects) {
-      return eval::scoreGroupedPoints(centres,
-                                      objectGaussians(cloud, grid, objects, object_min_opacity),
-                                      true_footprints, cloud_options);
+    // The map's objects at one step (JSON) and the cloud's grouped by them.
+    struct StepScores {
+      nlohmann::json map;
+      eval::ObjectScores cloud;
     };
     const auto objectScores = [&](double step) {
       const ClassObjects objects = classObjects(img, {building}, step, min_cells);
@@ -269,23 +268,27 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
       }
       scored["height_m"] = heightErrorsJson(dsm_errors);
       scored["height_above_ground_m"] = heightErrorsJson(above_errors);
-      scored["cloud_f1"] = cloudObjects(objects).f1;
-      return scored;
+      const eval::ObjectScores in_cloud = eval::scoreGroupedPoints(
+          centres, objectGaussians(cloud, grid, objects, kObjectMinOpacity), true_footprints,
+          cloud_options);
+      scored["cloud_f1"] = in_cloud.f1;
+      return StepScores{scored, in_cloud};
     };
     nlohmann::json by_step = nlohmann::json::array();
-    for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) by_step.push_back(objectScores(step));
-    j["objects"] = nlohmann::json();
-    for (const nlohmann::json& o : by_step) {
-      if (o["object_step_m"].get<double>() == render.object_step) j["objects"] = o;
+    std::optional<StepScores> at_step;  // render.object_step's
+    for (const double step : {0.0, 3.0, 2.0, 1.5, 1.0, 0.5}) {
+      StepScores scores = objectScores(step);
+      by_step.push_back(scores.map);
+      if (step == render.object_step) at_step = std::move(scores);
     }
-    if (j["objects"].is_null()) j["objects"] = objectScores(render.object_step);
+    if (!at_step) at_step = objectScores(render.object_step);
+    j["objects"] = at_step->map;
     j["cloud_objects"] = buildingObjectsJson(
-        cloudObjects(classObjects(img, {building}, render.object_step, min_cells)),
-        {{"object_step_m", render.object_step},
-         {"min_opacity", object_min_opacity},
-         {"min_points", cloud_options.min_points},
-         {"match_iou", cloud_options.match_iou},
-         {"footprint", "the convex hull of the Gaussians' centres"}});
+        at_step->cloud, {{"object_step_m", render.object_step},
+                         {"min_opacity", kObjectMinOpacity},
+                         {"min_points", cloud_options.min_points},
+                         {"match_iou", cloud_options.match_iou},
+                         {"footprint", "the convex hull of the Gaussians' centres"}});
     j["objects_by_step"] = by_step;
   }
   const std::string text = j.dump(2) + "\n";
