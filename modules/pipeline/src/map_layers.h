@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -49,6 +50,10 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
 // Map objects smaller than this merge into the neighbour of their class they border most (the
 // slivers the height cut leaves along walls); also the smallest building the map scores.
 constexpr double kMinObjectM2 = 20;
+// kMinObjectM2 in cells of `gsd` map units (rounded up).
+inline std::size_t minObjectCells(double gsd) {
+  return static_cast<std::size_t>(std::ceil(kMinObjectM2 / (gsd * gsd)));
+}
 
 // The objects of each class in `wanted` on the map: its covered cells split where the surface
 // model steps by more than `step` (geo::mapObjects), numbered across the classes, each with its

@@ -132,13 +132,13 @@ std::string orthoRun(const OrthoRunOptions& o) {
   io::OutputSet files(o.out, outputs);
   OpenedRun run = openRun(o.run);
   // The classes of --vectors, checked before the render.
-  std::vector<int> vector_classes;
   std::vector<std::string> names;
   for (const ClassInfo& c : run.scene.classes) names.push_back(c.name);
   if (!o.vectors.empty() && run.trainer->numClasses() == 0) {
     throw Error("<ortho>", "--vectors", "a semantic model (classes)", "no classes");
   }
-  vector_classes = classIdsOf(o.vectors, run.scene.classes, "<ortho>", "--vectors");
+  const std::vector<int> vector_classes =
+      classIdsOf(o.vectors, run.scene.classes, "<ortho>", "--vectors");
   const double gsd = o.gsd ? *o.gsd : roundToSignificant(photoGsd(run), 2);
   const OrthoGrid grid = footprintGrid(*run.trainer, run.scene, gsd, o.bounds);
   if (o.progress) {
@@ -181,8 +181,8 @@ std::string orthoRun(const OrthoRunOptions& o) {
       geo::ObjectPolygonOptions v;
       v.simplify = grid.gsd;
       v.min_area = 4 * grid.gsd * grid.gsd;
-      const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / (gsd * gsd)));
-      const ClassObjects objects = classObjects(img, vector_classes, o.object_step, min_cells);
+      const ClassObjects objects =
+          classObjects(img, vector_classes, o.object_step, minObjectCells(gsd));
       polygons = geo::writeObjectPolygons(files.path("vectors.gpkg"), objects.labels, img.width,
                                           img.height, objects.objects, map, names, v);
       if (o.object_clouds) {

@@ -229,7 +229,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
         }
       }
     }
-    const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / cell_area));
+    const std::size_t min_cells = minObjectCells(grid.gsd);
     // The cloud's building objects as `ortho --object-clouds` hands them out: the Gaussians
     // under each map object, their footprint the convex hull of their centres (as `eval --3d`
     // scores the clustered cloud's), against the true footprints.

@@ -305,10 +305,9 @@ void trimObjects(const gaussians::Trainer& trainer, const OrthoGrid& grid,
       if (!pk[g]) cloud[g].label = std::numeric_limits<std::uint32_t>::max();
     }
   }
-  const auto min_cells = static_cast<std::size_t>(std::ceil(kMinObjectM2 / (grid.gsd * grid.gsd)));
   const std::vector<std::size_t> cells =
-      cellsOutsideObjectHulls(cloud, grid, out, options.trim_classes, options.trim_step, min_cells,
-                              options.trim_whole_under);
+      cellsOutsideObjectHulls(cloud, grid, out, options.trim_classes, options.trim_step,
+                              minObjectCells(grid.gsd), options.trim_whole_under);
   // The spill lies over the ground beside the walls: the ground classes where the raised check
   // found them, else every other class.
   std::vector<int> others;
