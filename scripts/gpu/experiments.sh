@@ -19,7 +19,8 @@
 #       of the Gaussians on the surface (eval --ortho --on-surface M: ortho_sM_*.json);
 #       LABELLED=auto synth scenes with synth --labelled auto (the views pick-views advises);
 #       ORTHO_RAISED="0.33" the class map with the raised-class check (eval --ortho --raised-check
-#       F: ortho_rF_*.json); KEEP_RUNS=1
+#       F: ortho_rF_*.json); ORTHO_VARIANTS="TAG:eval flags;TAG:eval flags" the class map
+#       with any other `eval --ortho` flags (ortho_vTAG_*.json); KEEP_RUNS=1
 #       packs the run directories (no .ply / .pcd) into $OUT/runs_<scene>.tar.* (15 MiB parts);
 #       $OUT gets
 #       scene_<name>.txt and scene_<name>.tgz (metrics, logs); a training
@@ -295,6 +296,12 @@ mode_scene() {
         for r in ${ORTHO_RAISED:-}; do
           "$bin" eval "$work/run_$name" --ortho --raised-check "$r" \
             > "$work/results/ortho_r${r}_$name.json" 2>> "$work/results/eval_$name.log" || exit 1
+        done &&
+        IFS=';' read -ra variants <<< "${ORTHO_VARIANTS:-}" &&
+        for v in "${variants[@]}"; do
+          # shellcheck disable=SC2086
+          "$bin" eval "$work/run_$name" --ortho ${v#*:} \
+            > "$work/results/ortho_v${v%%:*}_$name.json" 2>> "$work/results/eval_$name.log" || exit 1
         done || {
         echo "$name: stopped (rc $?)"
         # A training stopped at the deadline leaves its checkpoint: evaluate the model as it was

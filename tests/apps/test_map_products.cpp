@@ -368,6 +368,60 @@ TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
   EXPECT_NE(out.find("--pit-depth"), std::string::npos) << out;
 }
 
+// `ortho --spike-height`: the DSM cells it changes are of a ground class and lowered by more than
+// the height; the class map does not change; ortho.json counts them. The clearance spares the
+// cells near a raised class: never more cells changed with it.
+TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
+  const std::string plain = ortho("--ground-window 8", "ortho_spikes_off"),
+                    lowered = ortho("--spike-height 0.5 --spike-clearance 0 --ground-window 8",
+                                    "ortho_spikes"),
+                    spared = ortho("--spike-height 0.5 --ground-window 8", "ortho_spikes_spared");
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(lowered + "/ortho.json"));
+  const nlohmann::json off = nlohmann::json::parse(test::readFile(plain + "/ortho.json"));
+  EXPECT_EQ(off["spike_height"], 0.0);
+  EXPECT_FALSE(off.contains("spike_clearance"));
+  ASSERT_EQ(j["spike_height"].get<double>(), 0.5);
+  ASSERT_EQ(j["spike_clearance"].get<double>(), 0.0);
+  const std::vector<ClassInfo> classes = classesOf(run());
+  std::set<std::size_t> ground;
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    const nlohmann::json& h = j["class_height_above_ground"][classes[c].name];
+    if (!h.is_null() && h.get<double>() < 1.25) ground.insert(c);
+  }
+  const std::vector<double> a = gdalFloats(plain + "/dsm.tif", dir_->file("sa.xyz"));
+  const std::vector<double> b = gdalFloats(lowered + "/dsm.tif", dir_->file("sb.xyz"));
+  const std::vector<double> c = gdalFloats(spared + "/dsm.tif", dir_->file("sc.xyz"));
+  const geo::Raster cls = geo::readByteRaster(lowered + "/classes.tif");
+  EXPECT_EQ(cls.bytes, geo::readByteRaster(plain + "/classes.tif").bytes);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), c.size());
+  ASSERT_EQ(a.size(), cls.bytes.size());
+  std::size_t changed = 0, changed_spared = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (c[i] != a[i]) {
+      ++changed_spared;
+      EXPECT_EQ(c[i], b[i]) << i;  // a spared run lowers a cell as the unspared one does
+    }
+    if (a[i] == b[i]) continue;
+    ++changed;
+    EXPECT_LT(b[i], a[i] - 0.5) << i;
+    EXPECT_TRUE(ground.count(cls.bytes[i])) << int(cls.bytes[i]);
+  }
+  EXPECT_NEAR(j["spike_lowered_share"].get<double>(), double(changed) / a.size(), 1e-12);
+  EXPECT_LE(changed_spared, changed);
+  if (!j["spike_height_applied"].get<bool>()) EXPECT_EQ(changed, 0u);
+  for (const char* bad : {"--spike-height -1", "--spike-clearance -1"}) {
+    std::string out;
+    EXPECT_EQ(
+        test::runCommand(
+            kCli + " ortho " + run() + " " + bad + " --out " + dir_->file("bad_spikes"), &out),
+        1)
+        << bad;
+    EXPECT_NE(out.find(std::string(bad).substr(0, std::string(bad).find(' '))), std::string::npos)
+        << out;
+  }
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");

@@ -166,7 +166,8 @@ TEST(GroundModel, GroundClassPitsAreListedWithTheLevelAround) {
     if (!m.covered[c]) surface[c] = NAN;
     if (m.covered[c] && m.classes[c] == 0 && c % 17 == 5) surface[c] -= 0.5f;
   }
-  const geo::GroundPits pits = geo::findGroundPits(m.classes, surface, {0}, kSide, kSide, 40, 1.0);
+  const geo::GroundOutliers pits =
+      geo::findGroundPits(m.classes, surface, {0}, kSide, kSide, 40, 1.0);
   std::size_t expected = 0;
   for (std::size_t c = 0; c < surface.size(); ++c) {
     expected += m.covered[c] && m.classes[c] == 0 && c % 17 == 0;
@@ -197,6 +198,70 @@ TEST(GroundModel, GroundClassPitsAreListedWithTheLevelAround) {
   EXPECT_TRUE(geo::findGroundPits(m.classes, surface, {}, kSide, kSide, 40, 1.0).cells.empty());
 }
 
+TEST(GroundModel, GroundClassSpikesAreListedWithTheLevelAround) {
+  // The sample without its pits; a one-cell halo of road at roof height (+12) along the right
+  // wall of every small building (as a roof's spill beside its wall, trimmed to road); road
+  // cells 0.5 above the ground elsewhere (a bump lower than the rise).
+  Map m = sampleMap();
+  std::vector<float> surface = m.surface;
+  std::vector<std::uint8_t> halo(surface.size(), 0);
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      const std::size_t c = m.at(x, y);
+      if (!m.covered[c]) {
+        surface[c] = NAN;
+        continue;
+      }
+      if (m.classes[c] != 0) continue;
+      surface[c] = trueGround(x, y) + (c % 17 == 5 ? 0.5f : 0.f);
+      const bool wall = x % 50 == 30 && m.classes[m.at(x - 1, y)] == 1;
+      if (wall) surface[c] += 12.f, halo[c] = 1;
+    }
+  }
+  const geo::GroundOutliers spikes =
+      geo::findGroundSpikes(m.classes, surface, {0}, kSide, kSide, 40, 1.0);
+  std::vector<std::uint8_t> listed(surface.size(), 0);
+  for (std::size_t c : spikes.cells) listed[c] = 1;
+  std::size_t halo_cells = 0, halo_listed = 0;
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      const std::size_t c = m.at(x, y);
+      const bool inner = x >= 40 && y >= 40 && x < kSide - 40 && y < kSide - 40;
+      if (halo[c]) {
+        ++halo_cells;
+        halo_listed += listed[c];
+        EXPECT_NEAR(spikes.level[c], trueGround(x, y), inner ? 0.5 : 1.2) << x << "," << y;
+      } else if (listed[c]) {
+        // Nothing else but, within a window of the grid's edges where the level is extrapolated
+        // from one side (ground_model.h) and runs below this slope, a bump; never a building or
+        // a car (not a ground class here).
+        EXPECT_FALSE(inner) << x << "," << y;
+        EXPECT_EQ(m.classes[c], 0) << x << "," << y;
+        EXPECT_EQ(c % 17, 5u) << x << "," << y;
+      }
+    }
+  }
+  EXPECT_GT(halo_cells, 40u);
+  EXPECT_EQ(halo_listed, halo_cells);
+  // A clearance around the buildings (class 1) spares the halo beside their walls, not a
+  // floater over open road: (45, 150) 10 up, 15 cells from the nearest building.
+  const std::size_t floater = m.at(45, 150);
+  ASSERT_EQ(m.classes[floater], 0);
+  surface[floater] += 10.f;
+  const geo::GroundOutliers cleared =
+      geo::findGroundSpikes(m.classes, surface, {0}, kSide, kSide, 40, 1.0, {1}, 2);
+  std::size_t floater_listed = 0;
+  for (std::size_t c : cleared.cells) {
+    EXPECT_FALSE(halo[c]) << c;
+    floater_listed += c == floater;
+  }
+  EXPECT_EQ(floater_listed, 1u);
+  // Cars and buildings as ground classes: the cars (1.5 up) and buildings (12 up) are listed.
+  const geo::GroundOutliers all =
+      geo::findGroundSpikes(m.classes, surface, {0, 1, 2}, kSide, kSide, 40, 1.0);
+  EXPECT_GT(all.cells.size(), spikes.cells.size());
+}
+
 TEST(GroundModel, BadInputsAreErrors) {
   const std::vector<float> s(6, 0.f), g(6, 0.f);
   const std::vector<std::uint8_t> cov(6, 1), cls(6, 0);
@@ -211,6 +276,10 @@ TEST(GroundModel, BadInputsAreErrors) {
   EXPECT_THROW(geo::findGroundPits(cls, s, {0}, 3, 2, 1, 0.0), Error);  // depth 0
   EXPECT_THROW(geo::findGroundPits(cls, std::vector<float>(5, 0.f), {0}, 3, 2, 1, 1.0), Error);
   EXPECT_NO_THROW(geo::findGroundPits(cls, s, {0}, 3, 2, 1, 1.0));
+  EXPECT_THROW(geo::findGroundSpikes(cls, s, {0}, 3, 2, 1, 0.0), Error);  // rise 0
+  EXPECT_THROW(geo::findGroundSpikes(cls, std::vector<float>(5, 0.f), {0}, 3, 2, 1, 1.0), Error);
+  EXPECT_NO_THROW(geo::findGroundSpikes(cls, s, {0}, 3, 2, 1, 1.0));
+  EXPECT_THROW(geo::findGroundSpikes(cls, s, {0}, 3, 2, 1, 1.0, {1}, -1), Error);
 }
 
 }  // namespace

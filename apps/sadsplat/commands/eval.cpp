@@ -39,6 +39,12 @@ class EvalCommand : public Command {
         ->default_val(0.33);
     c->add_option("--pit-depth", ortho_options_.pit_depth, "--ortho: as `ortho --pit-depth`")
         ->default_val(1.0);
+    c->add_option("--spike-height", ortho_options_.spike_height,
+                  "--ortho: as `ortho --spike-height`")
+        ->default_val(0.0);
+    c->add_option("--spike-clearance", ortho_options_.spike_clearance,
+                  "--ortho: as `ortho --spike-clearance`")
+        ->default_val(4.0);
     c->add_option("--object-step", ortho_options_.object_step,
                   "--ortho: the building objects as `ortho --object-step` cuts them")
         ->default_val(1.5);

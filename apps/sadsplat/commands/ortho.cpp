@@ -65,9 +65,20 @@ class OrthoCommand : public Command {
                   "through thin ground Gaussians (map units; 0: off; skipped with --raised-check's "
                   "warning)")
         ->default_val(1.0);
+    c->add_option("--spike-height", o_.spike_height,
+                  "a DSM cell of a ground class more than this above the median height of the "
+                  "ground classes around it takes that height, after --trim: a road shows the "
+                  "ground, not a floater over it (map units; 0: off; skipped with "
+                  "--raised-check's warning)")
+        ->default_val(0.0);
+    c->add_option("--spike-clearance", o_.spike_clearance,
+                  "--spike-height spares the cells within this of a raised class's cell (a roof "
+                  "cell the class map calls road or paved stands at the roof's height; map "
+                  "units)")
+        ->default_val(4.0);
     c->add_option("--ground-window", o_.ground_window,
-                  "--raised-check, --pit-depth: the ground is a low percentile of the DSM in "
-                  "windows of this side (map units)")
+                  "--raised-check, --pit-depth, --spike-height: the ground is a low percentile of "
+                  "the DSM in windows of this side (map units)")
         ->default_val(20);
     c->add_option("--vectors", o_.vectors,
                   "classes (names, comma-separated) whose objects are also written as polygons "

@@ -254,27 +254,93 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
   return out;
 }
 
-GroundPits findGroundPits(const std::vector<std::uint8_t>& classes,
-                          const std::vector<float>& surface, const std::vector<int>& ground_classes,
-                          int width, int height, int window_cells, double depth) {
+namespace {
+
+// The ground-class cells with a surface and their level (GroundOutliers::level).
+GroundOutliers groundLevel(const std::vector<std::uint8_t>& classes,
+                           const std::vector<float>& surface,
+                           const std::vector<int>& ground_classes, int width, int height,
+                           int window_cells, std::vector<std::uint8_t>& ground_cell) {
   checkSize(surface.size(), classes.size(), "surface");
-  if (!(depth > 0))
-    throw Error("<ground model>", "pit depth", "a depth > 0", std::to_string(depth));
   std::vector<std::uint8_t> is_ground(256, 0);
   for (int c : ground_classes) is_ground.at(static_cast<std::size_t>(c)) = 1;
-  std::vector<std::uint8_t> ground_cell(classes.size(), 0);
+  ground_cell.assign(classes.size(), 0);
   for (std::size_t c = 0; c < classes.size(); ++c) {
     ground_cell[c] = is_ground[classes[c]] && std::isfinite(surface[c]);
   }
   GroundModelOptions options;
   options.window_cells = window_cells;
   options.percentile = 0.5;
-  GroundPits pits;
-  pits.level = groundHeights(surface, ground_cell, width, height, options);
+  GroundOutliers out;
+  out.level = groundHeights(surface, ground_cell, width, height, options);
+  return out;
+}
+
+}  // namespace
+
+GroundOutliers findGroundPits(const std::vector<std::uint8_t>& classes,
+                              const std::vector<float>& surface,
+                              const std::vector<int>& ground_classes, int width, int height,
+                              int window_cells, double depth) {
+  checkSize(surface.size(), classes.size(), "surface");
+  if (!(depth > 0))
+    throw Error("<ground model>", "pit depth", "a depth > 0", std::to_string(depth));
+  std::vector<std::uint8_t> ground_cell;
+  GroundOutliers pits =
+      groundLevel(classes, surface, ground_classes, width, height, window_cells, ground_cell);
   for (std::size_t c = 0; c < classes.size(); ++c) {
     if (ground_cell[c] && surface[c] < pits.level[c] - depth) pits.cells.push_back(c);
   }
   return pits;
+}
+
+GroundOutliers findGroundSpikes(const std::vector<std::uint8_t>& classes,
+                                const std::vector<float>& surface,
+                                const std::vector<int>& ground_classes, int width, int height,
+                                int window_cells, double rise,
+                                const std::vector<int>& raised_classes, int clearance_cells) {
+  checkSize(surface.size(), classes.size(), "surface");
+  if (!(rise > 0))
+    throw Error("<ground model>", "spike height", "a height > 0", std::to_string(rise));
+  if (clearance_cells < 0) {
+    throw Error("<ground model>", "spike clearance", "cells >= 0", std::to_string(clearance_cells));
+  }
+  std::vector<std::uint8_t> ground_cell;
+  GroundOutliers spikes =
+      groundLevel(classes, surface, ground_classes, width, height, window_cells, ground_cell);
+  // Cells within the clearance of a raised cell: the raised cells dilated by a square (rows,
+  // then columns).
+  std::vector<std::uint8_t> near(classes.size(), 0);
+  if (clearance_cells > 0 && !raised_classes.empty()) {
+    std::vector<std::uint8_t> is_raised(256, 0);
+    for (int c : raised_classes) is_raised.at(static_cast<std::size_t>(c)) = 1;
+    std::vector<std::uint8_t> rows(classes.size(), 0);
+    const auto at = [width](int x, int y) { return static_cast<std::size_t>(y) * width + x; };
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (!is_raised[classes[at(x, y)]]) continue;
+        for (int d = std::max(0, x - clearance_cells);
+             d <= std::min(width - 1, x + clearance_cells); ++d) {
+          rows[at(d, y)] = 1;
+        }
+      }
+    }
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (!rows[at(x, y)]) continue;
+        for (int d = std::max(0, y - clearance_cells);
+             d <= std::min(height - 1, y + clearance_cells); ++d) {
+          near[at(x, d)] = 1;
+        }
+      }
+    }
+  }
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    if (ground_cell[c] && !near[c] && surface[c] > spikes.level[c] + rise) {
+      spikes.cells.push_back(c);
+    }
+  }
+  return spikes;
 }
 
 }  // namespace geo

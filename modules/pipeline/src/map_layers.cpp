@@ -41,6 +41,14 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--pit-depth", "a depth >= 0 in map units (0: off)",
                 std::to_string(o.pit_depth));
   }
+  if (!(o.spike_height >= 0 && std::isfinite(o.spike_height))) {
+    throw Error(what, "--spike-height", "a height >= 0 in map units (0: off)",
+                std::to_string(o.spike_height));
+  }
+  if (!(o.spike_clearance >= 0 && std::isfinite(o.spike_clearance))) {
+    throw Error(what, "--spike-clearance", "a distance >= 0 in map units",
+                std::to_string(o.spike_clearance));
+  }
   if (!(o.object_step >= 0 && std::isfinite(o.object_step))) {
     throw Error(what, "--object-step", "a height step >= 0 in map units (0: plain regions)",
                 std::to_string(o.object_step));
@@ -51,6 +59,8 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   }
   r.raised_share = o.raised_check;
   r.pit_depth = o.pit_depth;
+  r.spike_height = o.spike_height;
+  r.spike_clearance = o.spike_clearance;
   r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
@@ -121,13 +131,15 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["on_surface_m"] = o.on_surface;
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
+  j["spike_height"] = o.spike_height;
+  if (o.spike_height > 0) j["spike_clearance"] = o.spike_clearance;
   j["trim"] = trimClasses(o, classes);
   if (!j["trim"].empty()) {
     j["trim_step_m"] = o.object_step;
     j["trim_whole_under"] = o.trim_whole_under;
     j["trimmed_share"] = img.classes.empty() ? 0.0 : double(img.trimmed_cells) / img.classes.size();
   }
-  if (o.raised_check <= 0 && o.pit_depth <= 0) return;
+  if (o.raised_check <= 0 && o.pit_depth <= 0 && o.spike_height <= 0) return;
   j["ground_window"] = o.ground_window;
   nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
   for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
@@ -143,6 +155,8 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["near_ground_share"] = img.near_ground;
   j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
+  j["spike_lowered_share"] = n ? double(img.lowered_spikes) / n : 0.0;
+  j["spike_height_applied"] = o.spike_height > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
 ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,

@@ -5,6 +5,8 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "map_layers.h"
 #include "sadsplat/common/error.h"
@@ -336,11 +338,23 @@ void trimObjects(const gaussians::Trainer& trainer, const OrthoGrid& grid,
 // elevation is never read).
 void fillGroundPits(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
   const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
-  const geo::GroundPits pits =
+  const geo::GroundOutliers pits =
       geo::findGroundPits(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
                           window, options.pit_depth);
   for (std::size_t c : pits.cells) out.elevation[c] = pits.level[c];
   out.filled_pits = static_cast<std::int64_t>(pits.cells.size());
+}
+
+// OrthoRenderOptions::spike_height: the ground-class cells standing above the ground classes
+// around them take their level (geo::findGroundSpikes).
+void lowerGroundSpikes(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
+  const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
+  const geo::GroundOutliers spikes =
+      geo::findGroundSpikes(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
+                            window, options.spike_height, out.raised_classes,
+                            static_cast<int>(std::lround(options.spike_clearance / grid.gsd)));
+  for (std::size_t c : spikes.cells) out.elevation[c] = spikes.level[c];
+  out.lowered_spikes = static_cast<std::int64_t>(spikes.cells.size());
 }
 
 }  // namespace
@@ -481,14 +495,18 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     }
     out.few_views = few.numel();
   }
-  if ((options.raised_share > 0 || options.pit_depth > 0) && trainer.numClasses() > 0) {
+  const bool ground_checks =
+      options.raised_share > 0 || options.pit_depth > 0 || options.spike_height > 0;
+  if (ground_checks && trainer.numClasses() > 0) {
     const std::vector<std::size_t> low =
         placeClassesOnGround(grid, options, static_cast<int>(trainer.numClasses()), out);
     lowerRaisedCells(trainer, grid, options, keep, tile, low, out);
-    const char* checks = options.raised_share > 0 && options.pit_depth > 0
-                             ? "--raised-check and --pit-depth"
-                         : options.raised_share > 0 ? "--raised-check"
-                                                    : "--pit-depth";
+    std::string checks;
+    for (const auto& [on, flag] : {std::pair{options.raised_share > 0, "--raised-check"},
+                                   std::pair{options.pit_depth > 0, "--pit-depth"},
+                                   std::pair{options.spike_height > 0, "--spike-height"}}) {
+      if (on) checks += (checks.empty() ? "" : ", ") + std::string(flag);
+    }
     if (out.near_ground < geo::kMinNearGround) {
       if (progress) {
         *progress << "  ortho: warning: " << checks << " skipped: only "
@@ -513,6 +531,16 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     if (progress) {
       *progress << "  ortho: " << out.trimmed_cells
                 << " cells of objects outside their Gaussians' hull given another class\n";
+    }
+  }
+  // After the trim: the cells it gave a ground class keep the roof's height until here.
+  if (options.spike_height > 0 && trainer.numClasses() > 0 &&
+      out.near_ground >= geo::kMinNearGround) {
+    lowerGroundSpikes(grid, options, out);
+    if (progress) {
+      *progress << "  ortho: " << out.lowered_spikes << " cells of a ground class more than "
+                << options.spike_height
+                << " above the ground classes around them lowered to them\n";
     }
   }
   return out;

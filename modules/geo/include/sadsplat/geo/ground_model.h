@@ -78,24 +78,42 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
                                   double min_near_ground = kMinNearGround);
 
 /// \brief The cells of a ground class (roads, grass, water: LowRaisedCells::ground) that lie in
-/// a pit: a rendered DSM whose ground Gaussians are thin lets the first surface fall through to
-/// the Gaussians under the ground (on a synth city orbit 17 % of the ground cells lay more than
-/// 1 m below the true ground). A road is not a pit, so such a cell's height is the level of the
-/// ground classes around it. Within one window of the grid's edges the level is extrapolated
-/// from one side (groundHeights): on an 8 % slope it ran up to 1.1 above the ground there, so a
-/// dip shallower than `depth` may be raised too (tests/geo/test_ground_model.cpp).
-struct GroundPits {
+/// a pit (findGroundPits): a rendered DSM whose ground Gaussians are thin lets the first surface
+/// fall through to the Gaussians under the ground (on a synth city orbit 17 % of the ground cells
+/// lay more than 1 m below the true ground). A road is not a pit, so such a cell's height is the
+/// level of the ground classes around it. Within one window of the grid's edges the level is
+/// extrapolated from one side (groundHeights): on an 8 % slope it ran up to 1.1 above the ground
+/// there, so a dip shallower than `depth` may be raised too (tests/geo/test_ground_model.cpp).
+struct GroundOutliers {
   /// Per cell: the median height of the ground classes' cells in windows of `window_cells`, as
   /// groundHeights makes it (its 50th percentile over those cells only; NaN without any).
   std::vector<float> level;
-  std::vector<std::size_t> cells;  ///< ground-class cells more than `depth` below `level`
+  std::vector<std::size_t> cells;  ///< ground-class cells too far below (pits) or above `level`
 };
 
-/// \brief Finds them (`classes` holds class ids, 255: none; `surface` NaN: none).
+/// \brief The pits: ground-class cells more than `depth` below the level (`classes` holds class
+/// ids, 255: none; `surface` NaN: none).
 /// \throws sadsplat::Error for sizes that do not match, a window below 1 cell or depth <= 0
-GroundPits findGroundPits(const std::vector<std::uint8_t>& classes,
-                          const std::vector<float>& surface, const std::vector<int>& ground_classes,
-                          int width, int height, int window_cells, double depth);
+GroundOutliers findGroundPits(const std::vector<std::uint8_t>& classes,
+                              const std::vector<float>& surface,
+                              const std::vector<int>& ground_classes, int width, int height,
+                              int window_cells, double depth);
+
+/// \brief The spikes: ground-class cells more than `rise` above the level of the ground classes
+/// around them (the level findGroundPits takes). A cell the class map calls road or grass shows
+/// the ground, so its height is the ground's: floaters over a port's quays or an orbit's
+/// periphery stand metres above it, and on synth's cities the first surface keeps a roof's
+/// height one to three cells beyond its walls. A misclassified roof or crown cell would be
+/// lowered too: cells within `clearance_cells` (a square window) of a cell of one of
+/// `raised_classes` are not listed (0: none spared), which spares the walls' halo as well.
+/// \throws sadsplat::Error for sizes that do not match, a window below 1 cell, rise <= 0 or a
+/// negative clearance
+GroundOutliers findGroundSpikes(const std::vector<std::uint8_t>& classes,
+                                const std::vector<float>& surface,
+                                const std::vector<int>& ground_classes, int width, int height,
+                                int window_cells, double rise,
+                                const std::vector<int>& raised_classes = {},
+                                int clearance_cells = 0);
 
 }  // namespace geo
 }  // namespace sadsplat

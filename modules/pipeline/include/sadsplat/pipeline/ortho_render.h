@@ -102,6 +102,14 @@ struct OrthoRenderOptions {
   /// the ground model, so it is skipped where the raised check is (too few cells near the
   /// ground). 0: off (here; `ortho` and `eval --ortho` ask for 1, map_products.h).
   double pit_depth = 0;
+  /// DSM cells of a ground class more than this above the level of the ground classes around
+  /// them (windows of ground_window) take that level, after the trim: a road's height is the
+  /// ground's, not a floater's over it (geo::findGroundSpikes). Needs the ground model, so it
+  /// is skipped where the raised check is. 0: off.
+  double spike_height = 0;
+  /// spike_height spares the cells within this of a raised class's cell (map units): a roof
+  /// cell the class map calls road or paved stands at the roof's height.
+  double spike_clearance = 0;
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
@@ -143,6 +151,7 @@ struct OrthoImages {
   std::int64_t lowered_cells = 0;
   std::vector<int> ground_classes;  ///< geo::LowRaisedCells::ground
   std::int64_t filled_pits = 0;     ///< cells OrthoRenderOptions::pit_depth raised
+  std::int64_t lowered_spikes = 0;  ///< cells OrthoRenderOptions::spike_height lowered
   double near_ground = 0;           ///< geo::LowRaisedCells::near_ground (the check's precondition)
   std::int64_t trimmed_cells = 0;   ///< cells OrthoRenderOptions::trim_classes gave another class
 };
