@@ -477,9 +477,10 @@ void checkObjectClouds(const std::string& dir, const std::vector<ClassInfo>& cla
   std::getline(csv, line);
   EXPECT_EQ(line,
             "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
-            "height_m,file");
+            "height_m,file,las_file");
   std::size_t files = 0, gaussians = 0;
   std::set<int> ids;
+  std::string las_wkt;
   int checked = 0;
   while (std::getline(csv, line)) {
     std::vector<std::string> f;
@@ -487,7 +488,7 @@ void checkObjectClouds(const std::string& dir, const std::vector<ClassInfo>& cla
     std::string cell;
     while (std::getline(row, cell, ',')) f.push_back(cell);
     if (!line.empty() && line.back() == ',') f.push_back("");
-    ASSERT_EQ(f.size(), 11u) << line;
+    ASSERT_EQ(f.size(), 12u) << line;
     const int id = std::stoi(f[0]), cls = std::stoi(f[1]);
     ids.insert(id);
     EXPECT_EQ(f[2], classes[cls].name) << line;
@@ -495,9 +496,24 @@ void checkObjectClouds(const std::string& dir, const std::vector<ClassInfo>& cla
     const std::size_t n = std::stoul(f[3]);
     if (n == 0) {
       EXPECT_TRUE(f[10].empty()) << line;
+      EXPECT_TRUE(f[11].empty()) << line;
       continue;
     }
     ASSERT_EQ(f[10], "object_" + f[0] + ".pcd") << line;
+    ASSERT_EQ(f[11], "object_" + f[0] + ".las") << line;
+    // The LAS holds the same points on the map: their mean is the CSV's map position, in the
+    // map's CRS. Within 1 cm: the LAS is exact (PROJ, point by point), the map's similarity
+    // leaves out the Earth's curvature under a point h above the origin's plane, d from it
+    // (h d / R: 131 m x 150 m / 6371 km = 3 mm here), and the file stores millimetres.
+    io::LasHeader las_header;
+    const std::vector<io::LasPoint> las = io::readLas(dir + "/objects/" + f[11], &las_header);
+    ASSERT_EQ(las.size(), n) << line;
+    double mx = 0, my = 0;
+    for (const io::LasPoint& p : las) mx += p.x, my += p.y;
+    EXPECT_NEAR(mx / n, std::stod(f[7]), 0.01) << line;
+    EXPECT_NEAR(my / n, std::stod(f[8]), 0.01) << line;
+    EXPECT_EQ(las_header.wkt.empty(), false) << line;
+    las_wkt = las_header.wkt;
     const auto cloud = io::readGaussians(dir + "/objects/" + f[10]);
     ASSERT_EQ(cloud.size(), n) << line;
     double sx = 0, sy = 0, sz = 0;
@@ -524,10 +540,20 @@ void checkObjectClouds(const std::string& dir, const std::vector<ClassInfo>& cla
   for (const auto& [id, box] : polygons) EXPECT_EQ(ids.count(id), 1u) << id;
   EXPECT_EQ(j["object_clouds"]["files"].get<std::size_t>(), files);
   EXPECT_EQ(j["object_clouds"]["gaussians"].get<std::size_t>(), gaussians);
-  EXPECT_EQ(
-      io::filesIn(dir + "/objects", [](const std::string& f) { return io::endsWith(f, ".pcd"); })
-          .size(),
-      files);
+  for (const char* ext : {".pcd", ".las"}) {
+    EXPECT_EQ(
+        io::filesIn(dir + "/objects", [&](const std::string& f) { return io::endsWith(f, ext); })
+            .size(),
+        files)
+        << ext;
+  }
+  // The LAS files' CRS is the map's: UTM where the run is georeferenced, else local metres.
+  const std::string tif_crs = gdalinfo(dir + "/classes.tif");
+  if (tif_crs.find("UTM zone") != std::string::npos) {
+    EXPECT_NE(las_wkt.find("UTM zone"), std::string::npos) << las_wkt;
+  } else {
+    EXPECT_NE(las_wkt.find("LOCAL_CS"), std::string::npos) << las_wkt;
+  }
   *checked_out = checked;
 }
 

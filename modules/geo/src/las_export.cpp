@@ -45,6 +45,15 @@ std::string finish(const std::string& path, std::vector<io::LasPoint>& points,
     const Crs utm = crsOfEpsg(o.georeference->epsg_utm);
     header.wkt = utm.wkt;
     crs = utm.name;
+  } else if (o.local_frame) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec3 m = o.local_frame->toMap(scene_xyz[i]);
+      points[i].x = m[0];
+      points[i].y = m[1];
+      points[i].z = m[2];
+    }
+    header.wkt = o.local_frame->wkt;
+    crs = "local metres of the map (no georeference)";
   } else {
     for (std::size_t i = 0; i < points.size(); ++i) {
       points[i].x = scene_xyz[i][0];

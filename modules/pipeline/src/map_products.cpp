@@ -10,6 +10,7 @@
 
 #include "map_layers.h"
 #include "sadsplat/common/error.h"
+#include "sadsplat/geo/las_export.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/geo/raster_files.h"
 #include "sadsplat/geo/vector_files.h"
@@ -57,7 +58,8 @@ struct ObjectCloudCounts {
 };
 
 // OUT/objects/ (OrthoRunOptions::object_clouds): each map object's Gaussians as
-// object_<id>.pcd and objects.csv.
+// object_<id>.pcd (the model's frame, every field) and object_<id>.las (the map's CRS), and
+// objects.csv.
 ObjectCloudCounts writeObjectClouds(const std::string& dir,
                                     const pcl::PointCloud<GaussianPoint>& cloud,
                                     const io::Scene& scene, const OrthoGrid& grid,
@@ -66,16 +68,20 @@ ObjectCloudCounts writeObjectClouds(const std::string& dir,
       objectGaussians(cloud, grid, objects, min_opacity);
   io::makeDirectory(dir);
   ObjectCloudCounts counts;
+  geo::LasExportOptions las;
+  las.classes = scene.classes;
+  las.georeference = scene.georeference;
+  las.local_frame = grid.frame;
   std::ostringstream csv;
   csv << "object_id,class_id,class,gaussians,centroid_x,centroid_y,centroid_z,map_x,map_y,"
-         "height_m,file\n"
-      << std::setprecision(10);
+         "height_m,file,las_file\n"
+      << std::setprecision(12);  // UTM northings to 0.01 mm
   for (std::size_t k = 0; k < groups.size(); ++k) {
     const geo::MapObjectAttributes& a = objects.objects[k];
     csv << k + 1 << "," << a.class_id << "," << scene.classes[a.class_id].name << ","
         << groups[k].size() << ",";
     if (groups[k].empty()) {
-      csv << ",,,,," << a.height << ",\n";
+      csv << ",,,,," << a.height << ",,\n";
       continue;
     }
     pcl::PointCloud<GaussianPoint> part;
@@ -87,10 +93,11 @@ ObjectCloudCounts writeObjectClouds(const std::string& dir,
     const double n = static_cast<double>(groups[k].size());
     const std::array<double, 3> c{sum[0] / n, sum[1] / n, sum[2] / n};
     const std::array<double, 3> m = grid.frame.toMap(c);
-    const std::string file = "object_" + std::to_string(k + 1) + ".pcd";
-    io::writeGaussians(dir + "/" + file, part);
+    const std::string file = "object_" + std::to_string(k + 1);
+    io::writeGaussians(dir + "/" + file + ".pcd", part);
+    geo::writeGaussiansLas(dir + "/" + file + ".las", part, las);
     csv << c[0] << "," << c[1] << "," << c[2] << "," << m[0] << "," << m[1] << "," << a.height
-        << "," << file << "\n";
+        << "," << file << ".pcd," << file << ".las\n";
     ++counts.files;
     counts.gaussians += groups[k].size();
   }
@@ -293,6 +300,9 @@ std::string orthoRun(const OrthoRunOptions& o) {
     j["object_clouds"] = {
         {"folder", "objects"},
         {"files", clouds.files},
+        {"formats",
+         {{"pcd", "the model's frame, every Gaussian field"},
+          {"las", "the map's CRS, centres with base colour and ASPRS class"}}},
         {"gaussians", clouds.gaussians},
         {"min_opacity", o.object_min_opacity},
         {"labels", "the class the training views render where the Gaussian draws"}};
@@ -325,7 +335,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
     }
   }
   if (o.object_clouds) {
-    s << "  objects/: " << clouds.files << " object clouds (" << clouds.gaussians
+    s << "  objects/: " << clouds.files << " object clouds as .pcd and .las (" << clouds.gaussians
       << " Gaussians), objects.csv\n";
   }
   return s.str();

@@ -10,6 +10,7 @@
 
 #include "sadsplat/common/class_info.h"
 #include "sadsplat/common/gaussian_point.h"
+#include "sadsplat/geo/map_frame.h"
 #include "sadsplat/io/georeference.h"
 
 #include <pcl/point_cloud.h>
@@ -23,6 +24,9 @@ struct LasExportOptions {
   std::vector<ClassInfo> classes;                ///< names for the ASPRS mapping (may be empty)
   std::optional<io::Georeference> georeference;  ///< none: local metres
   std::string classification_map;                ///< JSON {"class": code} overriding defaults
+  /// Without a georeference: the points through this frame (the map's local metres, z up, as
+  /// `ortho` draws them) instead of the scene's own axes; none: the scene's axes.
+  std::optional<MapFrame> local_frame;
 };
 
 /// \brief Writes the Gaussians' centres; returns a one-line summary (points, CRS, codes used).
