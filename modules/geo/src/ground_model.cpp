@@ -51,6 +51,26 @@ Between between(int cells, int window, int windows) {
   return b;
 }
 
+// The ground-class cells with a surface and their level (GroundOutliers::level); the callers
+// check the sizes.
+GroundOutliers groundLevel(const std::vector<std::uint8_t>& classes,
+                           const std::vector<float>& surface,
+                           const std::vector<int>& ground_classes, int width, int height,
+                           int window_cells, std::vector<std::uint8_t>& ground_cell) {
+  std::vector<std::uint8_t> is_ground(256, 0);
+  for (int c : ground_classes) is_ground.at(static_cast<std::size_t>(c)) = 1;
+  ground_cell.assign(classes.size(), 0);
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    ground_cell[c] = is_ground[classes[c]] && std::isfinite(surface[c]);
+  }
+  GroundModelOptions options;
+  options.window_cells = window_cells;
+  options.percentile = 0.5;
+  GroundOutliers out;
+  out.level = groundHeights(surface, ground_cell, width, height, options);
+  return out;
+}
+
 }  // namespace
 
 std::vector<float> groundHeights(const std::vector<float>& surface,
@@ -253,30 +273,6 @@ LowRaisedCells findLowRaisedCells(const std::vector<std::uint8_t>& classes,
   }
   return out;
 }
-
-namespace {
-
-// The ground-class cells with a surface and their level (GroundOutliers::level).
-GroundOutliers groundLevel(const std::vector<std::uint8_t>& classes,
-                           const std::vector<float>& surface,
-                           const std::vector<int>& ground_classes, int width, int height,
-                           int window_cells, std::vector<std::uint8_t>& ground_cell) {
-  checkSize(surface.size(), classes.size(), "surface");
-  std::vector<std::uint8_t> is_ground(256, 0);
-  for (int c : ground_classes) is_ground.at(static_cast<std::size_t>(c)) = 1;
-  ground_cell.assign(classes.size(), 0);
-  for (std::size_t c = 0; c < classes.size(); ++c) {
-    ground_cell[c] = is_ground[classes[c]] && std::isfinite(surface[c]);
-  }
-  GroundModelOptions options;
-  options.window_cells = window_cells;
-  options.percentile = 0.5;
-  GroundOutliers out;
-  out.level = groundHeights(surface, ground_cell, width, height, options);
-  return out;
-}
-
-}  // namespace
 
 GroundOutliers findGroundPits(const std::vector<std::uint8_t>& classes,
                               const std::vector<float>& surface,
