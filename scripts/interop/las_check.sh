@@ -11,13 +11,7 @@ run=$(readlink -f "$1")
 out=$(mkdir -p "$2" && cd "$2" && pwd)
 cli=${SADSPLAT_CLI:-$root/build/bin/sadsplat}
 tools=$root/.deps/splat-tools
-# Pinned to one release line: @loaders.gl/las 4.5.1 asks for core ~4.4.0 (npm ERESOLVE with 4.5.1).
-if [ ! -d "$tools/node_modules/@loaders.gl/las" ]; then
-  mkdir -p "$tools"
-  (cd "$tools" && { [ -f package.json ] || npm init -y >/dev/null; } &&
-     npm install --no-audit --no-fund @loaders.gl/core@4.4.5 @loaders.gl/las@4.4.5 >/dev/null)
-fi
-cp "$root/scripts/interop/read_las_with_loadersgl.mjs" "$tools/"
+source "$root/scripts/interop/las_reader.sh"
 failed=0
 check() {  # input model, output las
   "$cli" convert "$1" "$2" >/dev/null

@@ -6,7 +6,7 @@
 #   bash scripts/interop/object_las_check.sh RUN OUT_DIR [CLASSES=building]
 # Runs `sadsplat ortho RUN --out OUT_DIR --vectors CLASSES --object-clouds`; prints one PASS / FAIL
 # line and exits 1 on FAIL. Needs node, npm and the npm registry (the reader goes to
-# .deps/splat-tools, git-ignored, as scripts/interop/las_check.sh installs it). Not part of CI.
+# .deps/splat-tools, git-ignored: scripts/interop/las_reader.sh). Not part of CI.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 run=$(readlink -f "$1")
@@ -14,12 +14,7 @@ out=$(mkdir -p "$2" && cd "$2" && pwd)
 classes=${3:-building}
 cli=${SADSPLAT_CLI:-$root/build/bin/sadsplat}
 tools=$root/.deps/splat-tools
-if [ ! -d "$tools/node_modules/@loaders.gl/las" ]; then
-  mkdir -p "$tools"
-  (cd "$tools" && { [ -f package.json ] || npm init -y >/dev/null; } &&
-     npm install --no-audit --no-fund @loaders.gl/core@4.4.5 @loaders.gl/las@4.4.5 >/dev/null)
-fi
-cp "$root/scripts/interop/read_las_with_loadersgl.mjs" "$tools/"
+source "$root/scripts/interop/las_reader.sh"
 "$cli" ortho "$run" --out "$out" --vectors "$classes" --object-clouds --object-min-opacity 0.05 \
   > "$out/ortho.log"
 : > "$out/loaders.jsonl"
