@@ -217,6 +217,11 @@ at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::Ras
   return trainer.renderCamera(camera, keep).features;
 }
 
+// OrthoRenderOptions::ground_window in cells of the grid (at least one).
+int groundWindowCells(const OrthoRenderOptions& options, const OrthoGrid& grid) {
+  return std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
+}
+
 // The ground under the DSM and each class against it (geo::groundHeights, findLowRaisedCells):
 // the raised and the ground classes, their heights above the ground, the share of cells near it,
 // all what the raised check and the pit fill need. Returns the cells of a raised class lower than
@@ -225,8 +230,7 @@ std::vector<std::size_t> placeClassesOnGround(const OrthoGrid& grid,
                                               const OrthoRenderOptions& options, int num_classes,
                                               OrthoImages& out) {
   geo::GroundModelOptions ground_options;
-  ground_options.window_cells =
-      std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
+  ground_options.window_cells = groundWindowCells(options, grid);
   out.ground =
       geo::groundHeights(out.elevation, out.covered, grid.width, grid.height, ground_options);
   geo::LowRaisedCells low = geo::findLowRaisedCells(
@@ -333,28 +337,31 @@ void trimObjects(const gaussians::Trainer& trainer, const OrthoGrid& grid,
   if (!others.empty()) relabelCells(trainer, grid, options, keep, tile, alone, others, out);
 }
 
-// OrthoRenderOptions::pit_depth: the ground-class cells in a pit take the level of the ground
-// classes around them (geo::findGroundPits; an uncovered cell has no class, 255, so its
-// elevation is never read).
+// The ground-class cells a check found (geo::findGroundPits / findGroundSpikes) take the level of
+// the ground classes around them (an uncovered cell has no class, 255, so its elevation is never
+// read). Returns how many.
+std::int64_t setToGroundLevel(const geo::GroundOutliers& found, OrthoImages& out) {
+  for (std::size_t c : found.cells) out.elevation[c] = found.level[c];
+  return static_cast<std::int64_t>(found.cells.size());
+}
+
+// OrthoRenderOptions::pit_depth: the ground-class cells in a pit.
 void fillGroundPits(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
-  const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
-  const geo::GroundOutliers pits =
+  out.filled_pits = setToGroundLevel(
       geo::findGroundPits(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
-                          window, options.pit_depth);
-  for (std::size_t c : pits.cells) out.elevation[c] = pits.level[c];
-  out.filled_pits = static_cast<std::int64_t>(pits.cells.size());
+                          groundWindowCells(options, grid), options.pit_depth),
+      out);
 }
 
 // OrthoRenderOptions::spike_height: the ground-class cells standing above the ground classes
-// around them take their level (geo::findGroundSpikes).
+// around them, except those within spike_clearance of a raised class's cell.
 void lowerGroundSpikes(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
-  const int window = std::max(1, static_cast<int>(std::lround(options.ground_window / grid.gsd)));
-  const geo::GroundOutliers spikes =
+  out.lowered_spikes = setToGroundLevel(
       geo::findGroundSpikes(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
-                            window, options.spike_height, out.raised_classes,
-                            static_cast<int>(std::lround(options.spike_clearance / grid.gsd)));
-  for (std::size_t c : spikes.cells) out.elevation[c] = spikes.level[c];
-  out.lowered_spikes = static_cast<std::int64_t>(spikes.cells.size());
+                            groundWindowCells(options, grid), options.spike_height,
+                            out.raised_classes,
+                            static_cast<int>(std::lround(options.spike_clearance / grid.gsd))),
+      out);
 }
 
 }  // namespace
