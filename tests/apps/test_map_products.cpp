@@ -333,6 +333,18 @@ std::vector<double> gdalFloats(const std::string& tif, const std::string& xyz) {
   return v;
 }
 
+// The ground classes' ids as ortho.json `j` reports them: a median height above the ground below
+// half the raised height (1.25 m).
+std::set<std::size_t> groundClassIds(const nlohmann::json& j,
+                                     const std::vector<ClassInfo>& classes) {
+  std::set<std::size_t> ground;
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    const nlohmann::json& h = j["class_height_above_ground"][classes[c].name];
+    if (!h.is_null() && h.get<double>() < 1.25) ground.insert(c);
+  }
+  return ground;
+}
+
 // `ortho --pit-depth`: the DSM cells it changes are of a ground class and raised by more than the
 // depth; nothing else changes, and ortho.json counts them.
 TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
@@ -341,12 +353,7 @@ TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
   const nlohmann::json j = nlohmann::json::parse(test::readFile(filled + "/ortho.json"));
   EXPECT_EQ(nlohmann::json::parse(test::readFile(plain + "/ortho.json"))["pit_depth"], 0.0);
   ASSERT_EQ(j["pit_depth"].get<double>(), 0.5);
-  const std::vector<ClassInfo> classes = classesOf(run());
-  std::set<std::size_t> ground;
-  for (std::size_t c = 0; c < classes.size(); ++c) {
-    const nlohmann::json& h = j["class_height_above_ground"][classes[c].name];
-    if (!h.is_null() && h.get<double>() < 1.25) ground.insert(c);
-  }
+  const std::set<std::size_t> ground = groundClassIds(j, classesOf(run()));
   const std::vector<double> a = gdalFloats(plain + "/dsm.tif", dir_->file("a.xyz"));
   const std::vector<double> b = gdalFloats(filled + "/dsm.tif", dir_->file("b.xyz"));
   const geo::Raster cls = geo::readByteRaster(filled + "/classes.tif");
@@ -382,12 +389,7 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
   EXPECT_FALSE(off.contains("spike_clearance"));
   ASSERT_EQ(j["spike_height"].get<double>(), 0.5);
   ASSERT_EQ(j["spike_clearance"].get<double>(), 0.0);
-  const std::vector<ClassInfo> classes = classesOf(run());
-  std::set<std::size_t> ground;
-  for (std::size_t c = 0; c < classes.size(); ++c) {
-    const nlohmann::json& h = j["class_height_above_ground"][classes[c].name];
-    if (!h.is_null() && h.get<double>() < 1.25) ground.insert(c);
-  }
+  const std::set<std::size_t> ground = groundClassIds(j, classesOf(run()));
   const std::vector<double> a = gdalFloats(plain + "/dsm.tif", dir_->file("sa.xyz"));
   const std::vector<double> b = gdalFloats(lowered + "/dsm.tif", dir_->file("sb.xyz"));
   const std::vector<double> c = gdalFloats(spared + "/dsm.tif", dir_->file("sc.xyz"));
