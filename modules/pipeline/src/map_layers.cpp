@@ -49,6 +49,18 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--spike-clearance", "a distance >= 0 in map units",
                 std::to_string(o.spike_clearance));
   }
+  if (!(o.spike_roof_width >= 0 && std::isfinite(o.spike_roof_width))) {
+    throw Error(what, "--spike-roof-width", "a width >= 0 in map units (0: off)",
+                std::to_string(o.spike_roof_width));
+  }
+  if (o.spike_roof_width > 0 && o.spike_height <= 0) {
+    throw Error(what, "--spike-roof-width", "--spike-height > 0 (it sorts that check's cells)",
+                "--spike-height " + std::to_string(o.spike_height));
+  }
+  if (o.trim_whole_under < 0) {
+    throw Error(what, "--trim-whole-under", "a number of Gaussians >= 0",
+                std::to_string(o.trim_whole_under));
+  }
   if (!(o.object_step >= 0 && std::isfinite(o.object_step))) {
     throw Error(what, "--object-step", "a height step >= 0 in map units (0: plain regions)",
                 std::to_string(o.object_step));
@@ -61,6 +73,7 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   r.pit_depth = o.pit_depth;
   r.spike_height = o.spike_height;
   r.spike_clearance = o.spike_clearance;
+  r.spike_roof_width = o.spike_roof_width;
   r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
@@ -110,10 +123,6 @@ pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRu
   if (names.empty() || trainer.numClasses() == 0) return {};
   render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");
   render.trim_step = o.object_step;
-  if (o.trim_whole_under < 0) {
-    throw Error(what, "--trim-whole-under", "a number of Gaussians >= 0",
-                std::to_string(o.trim_whole_under));
-  }
   render.trim_whole_under = static_cast<std::size_t>(o.trim_whole_under);
   pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, o.progress);
   render.gaussian_classes.resize(cloud.size());
@@ -132,7 +141,10 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
   j["spike_height"] = o.spike_height;
-  if (o.spike_height > 0) j["spike_clearance"] = o.spike_clearance;
+  if (o.spike_height > 0) {
+    j["spike_clearance"] = o.spike_clearance;
+    j["spike_roof_width"] = o.spike_roof_width;
+  }
   j["trim"] = trimClasses(o, classes);
   if (!j["trim"].empty()) {
     j["trim_step_m"] = o.object_step;
@@ -156,6 +168,7 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
   j["spike_lowered_share"] = n ? double(img.lowered_spikes) / n : 0.0;
+  if (o.spike_height > 0) j["spike_roof_share"] = n ? double(img.spike_roofs) / n : 0.0;
   j["spike_height_applied"] = o.spike_height > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
