@@ -412,71 +412,13 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
   EXPECT_NEAR(j["spike_lowered_share"].get<double>(), double(changed) / a.size(), 1e-12);
   EXPECT_LE(changed_spared, changed);
   if (!j["spike_height_applied"].get<bool>()) EXPECT_EQ(changed, 0u);
-  for (const char* bad : {"--spike-height -1", "--spike-clearance -1"}) {
+  for (const char* bad :
+       {"--spike-height -1", "--spike-clearance -1", "--trim none --trim-whole-under -1"}) {
     std::string out;
     EXPECT_EQ(
         test::runCommand(
             kCli + " ortho " + run() + " " + bad + " --out " + dir_->file("bad_spikes"), &out),
         1)
-        << bad;
-    EXPECT_NE(out.find(std::string(bad).substr(0, std::string(bad).find(' '))), std::string::npos)
-        << out;
-  }
-}
-
-// `ortho --spike-roof-width`: the spikes in patches at least that wide keep their height and take
-// a raised class, the rest are lowered as without it: the two sets split the spikes exactly.
-TEST_F(MapProducts, OrthoSpikeRoofWidthGivesWideSpikePatchesARaisedClass) {
-  const std::string flags = "--spike-height 0.5 --spike-clearance 0 --ground-window 8";
-  const std::string plain = ortho("--ground-window 8", "ortho_roofs_off"),
-                    lowered = ortho(flags, "ortho_roofs_lowered"),
-                    roofs = ortho(flags + " --spike-roof-width 1.5", "ortho_roofs");
-  const nlohmann::json j = nlohmann::json::parse(test::readFile(roofs + "/ortho.json"));
-  ASSERT_EQ(j["spike_roof_width"].get<double>(), 1.5);
-  const std::set<std::size_t> ground = groundClassIds(j, classesOf(run()));
-  std::set<std::size_t> raised;
-  const std::vector<ClassInfo> classes = classesOf(run());
-  for (const auto& r : j["raised_classes"]) {
-    for (std::size_t c = 0; c < classes.size(); ++c) {
-      if (classes[c].name == r.get<std::string>()) raised.insert(c);
-    }
-  }
-  const std::vector<double> a = gdalFloats(plain + "/dsm.tif", dir_->file("ra.xyz"));
-  const std::vector<double> b = gdalFloats(lowered + "/dsm.tif", dir_->file("rb.xyz"));
-  const std::vector<double> c = gdalFloats(roofs + "/dsm.tif", dir_->file("rc.xyz"));
-  const std::vector<std::uint8_t> cls_a = geo::readByteRaster(plain + "/classes.tif").bytes;
-  const std::vector<std::uint8_t> cls_c = geo::readByteRaster(roofs + "/classes.tif").bytes;
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_EQ(a.size(), c.size());
-  ASSERT_EQ(a.size(), cls_c.size());
-  std::size_t spikes = 0, relabelled = 0, dropped = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const bool spike = a[i] != b[i];
-    spikes += spike;
-    if (cls_c[i] != cls_a[i]) {
-      ++relabelled;
-      EXPECT_TRUE(spike) << i;  // only spikes change class
-      EXPECT_TRUE(ground.count(cls_a[i])) << int(cls_a[i]);
-      EXPECT_TRUE(raised.count(cls_c[i])) << int(cls_c[i]);
-      EXPECT_EQ(c[i], a[i]) << i;  // and keep their height
-    } else if (spike) {
-      ++dropped;
-      EXPECT_EQ(c[i], b[i]) << i;  // lowered as without the width
-    } else {
-      EXPECT_EQ(c[i], a[i]) << i;
-    }
-  }
-  EXPECT_GT(relabelled, 0u);  // the test model has wide patches: not vacuous
-  EXPECT_GT(dropped, 0u);
-  EXPECT_EQ(relabelled + dropped, spikes);
-  EXPECT_NEAR(j["spike_roof_share"].get<double>(), double(relabelled) / a.size(), 1e-12);
-  EXPECT_NEAR(j["spike_lowered_share"].get<double>(), double(dropped) / a.size(), 1e-12);
-  for (const char* bad : {"--spike-height 1 --spike-roof-width -1", "--spike-roof-width 2",
-                          "--trim none --trim-whole-under -1"}) {
-    std::string out;
-    EXPECT_EQ(test::runCommand(
-                  kCli + " ortho " + run() + " " + bad + " --out " + dir_->file("bad_roofs"), &out),
-              1)
         << bad;
     const std::string flag = std::string(bad).substr(std::string(bad).rfind("--"));
     EXPECT_NE(out.find(flag.substr(0, flag.find(' '))), std::string::npos) << out;

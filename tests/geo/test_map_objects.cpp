@@ -2,7 +2,6 @@
 // merged into their neighbours; and their polygons in a GeoPackage read back by OGR's ogrinfo.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -211,74 +210,6 @@ TEST(MapObjects, TrimmedCellsTakeTheClassAroundThem) {
   EXPECT_EQ(wide[7 + 2], 2);
   EXPECT_THROW(geo::takeClassAround(wide, std::vector<std::uint8_t>(3, 1), w, h, {}, allowed, 1),
                Error);
-}
-
-// The spike cells in wide patches (a roof the class map calls paved) against thin strips (a
-// roof's halo over its wall): a hand-drawn map, then random masks against the definition.
-TEST(MapObjects, WidePatchesKeepWholeSquaresAndDropStrips) {
-  const std::vector<std::string> map = {"##.......",  //
-                                        "##..###..",  //
-                                        "....####.",  //
-                                        "#...###..",  //
-                                        "#........",  //
-                                        "#########"};
-  const int w = 9, h = static_cast<int>(map.size());
-  std::vector<std::size_t> cells;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (map[y][x] == '#') cells.push_back(static_cast<std::size_t>(y) * w + x);
-    }
-  }
-  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
-  // Side 2: the 2 x 2 block and the 3 x 3 patch; the cell sticking out of the patch at (7, 2),
-  // the one-cell-wide column and the row stay out.
-  const std::vector<std::size_t> two = geo::cellsInWidePatches(cells, w, h, 2);
-  std::vector<std::size_t> expected = {at(0, 0), at(1, 0), at(0, 1), at(1, 1)};
-  for (int y = 1; y <= 3; ++y) {
-    for (int x = 4; x <= 6; ++x) expected.push_back(at(x, y));
-  }
-  std::sort(expected.begin(), expected.end());
-  EXPECT_EQ(two, expected);
-  // Side 3: only the 3 x 3 patch; side 1: every cell; side 4: none.
-  const std::vector<std::size_t> three = geo::cellsInWidePatches(cells, w, h, 3);
-  ASSERT_EQ(three.size(), 9u);
-  EXPECT_EQ(three.front(), at(4, 1));
-  EXPECT_EQ(three.back(), at(6, 3));
-  EXPECT_EQ(geo::cellsInWidePatches(cells, w, h, 1), cells);
-  EXPECT_TRUE(geo::cellsInWidePatches(cells, w, h, 4).empty());
-  EXPECT_THROW(geo::cellsInWidePatches(cells, w, h, 0), Error);
-  EXPECT_THROW(geo::cellsInWidePatches({at(8, 5) + 1}, w, h, 1), Error);
-
-  // Random masks: a cell is kept exactly when some side x side square of the mask holds it.
-  std::uint32_t state = 12345;
-  const auto next = [&state] { return state = state * 1664525u + 1013904223u; };
-  for (int trial = 0; trial < 20; ++trial) {
-    const int rw = 5 + trial % 7, rh = 4 + trial % 5, side = 1 + trial % 4;
-    std::vector<std::uint8_t> in(static_cast<std::size_t>(rw) * rh);
-    std::vector<std::size_t> set;
-    for (std::size_t c = 0; c < in.size(); ++c) {
-      in[c] = (next() >> 16) % 10 < 7;
-      if (in[c]) set.push_back(c);
-    }
-    std::vector<std::size_t> naive;
-    for (std::size_t c = 0; c < in.size(); ++c) {
-      if (!in[c]) continue;
-      const int x = static_cast<int>(c % rw), y = static_cast<int>(c / rw);
-      bool kept = false;
-      for (int y0 = y - side + 1; y0 <= y && !kept; ++y0) {
-        for (int x0 = x - side + 1; x0 <= x && !kept; ++x0) {
-          if (x0 < 0 || y0 < 0 || x0 + side > rw || y0 + side > rh) continue;
-          bool full = true;
-          for (int yy = y0; yy < y0 + side && full; ++yy) {
-            for (int xx = x0; xx < x0 + side && full; ++xx) full = in[yy * rw + xx] != 0;
-          }
-          kept = full;
-        }
-      }
-      if (kept) naive.push_back(c);
-    }
-    EXPECT_EQ(geo::cellsInWidePatches(set, rw, rh, side), naive) << "trial " << trial;
-  }
 }
 
 // The objects' polygons as OGR reads them: one feature per object with its class, height and

@@ -76,12 +76,6 @@ class OrthoCommand : public Command {
                   "cell the class map calls road or paved stands at the roof's height; map "
                   "units)")
         ->default_val(4.0);
-    c->add_option("--spike-roof-width", o_.spike_roof_width,
-                  "--spike-height's cells in a patch at least this wide (map units) keep their "
-                  "height and take the most likely raised class of their features: a roof the "
-                  "class map calls road or paved, not a roof's one-cell halo over its wall (0: "
-                  "every such cell is lowered)")
-        ->default_val(0.0);
     c->add_option("--ground-window", o_.ground_window,
                   "--raised-check, --pit-depth, --spike-height: the ground is a low percentile of "
                   "the DSM in windows of this side (map units)")

@@ -217,54 +217,5 @@ std::vector<std::size_t> takeClassAround(std::vector<std::uint8_t>& classes,
   return alone;
 }
 
-std::vector<std::size_t> cellsInWidePatches(const std::vector<std::size_t>& cells, int width,
-                                            int height, int side) {
-  if (side < 1) throw Error("<map objects>", "patch width", "cells >= 1", std::to_string(side));
-  const std::size_t n = static_cast<std::size_t>(width) * height;
-  std::vector<std::uint8_t> in(n, 0);
-  for (const std::size_t c : cells) {
-    if (c >= n) {
-      throw Error("<map objects>", "cells", "indices below " + std::to_string(n),
-                  std::to_string(c));
-    }
-    in[c] = 1;
-  }
-  // Summed-area tables, one row and column of zeros in front: sum over [x0, x1) x [y0, y1).
-  const auto integral = [width, height](const std::vector<std::uint8_t>& mask) {
-    const std::size_t w1 = static_cast<std::size_t>(width) + 1;
-    std::vector<std::int64_t> s(w1 * (static_cast<std::size_t>(height) + 1), 0);
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        s[(y + 1) * w1 + x + 1] = mask[static_cast<std::size_t>(y) * width + x] +
-                                  s[y * w1 + x + 1] + s[(y + 1) * w1 + x] - s[y * w1 + x];
-      }
-    }
-    return s;
-  };
-  const auto box = [width](const std::vector<std::int64_t>& s, int x0, int y0, int x1, int y1) {
-    const std::size_t w1 = static_cast<std::size_t>(width) + 1;
-    return s[y1 * w1 + x1] - s[y0 * w1 + x1] - s[y1 * w1 + x0] + s[y0 * w1 + x0];
-  };
-  // The squares made only of cells, by their top-left cell; then every cell one of them covers.
-  const std::vector<std::int64_t> sum_in = integral(in);
-  std::vector<std::uint8_t> full(n, 0);
-  const std::int64_t area = static_cast<std::int64_t>(side) * side;
-  for (int y = 0; y + side <= height; ++y) {
-    for (int x = 0; x + side <= width; ++x) {
-      full[static_cast<std::size_t>(y) * width + x] = box(sum_in, x, y, x + side, y + side) == area;
-    }
-  }
-  const std::vector<std::int64_t> sum_full = integral(full);
-  std::vector<std::size_t> wide;
-  for (std::size_t c = 0; c < n; ++c) {
-    if (!in[c]) continue;
-    const int x = static_cast<int>(c % width), y = static_cast<int>(c / width);
-    if (box(sum_full, std::max(0, x - side + 1), std::max(0, y - side + 1), x + 1, y + 1) > 0) {
-      wide.push_back(c);
-    }
-  }
-  return wide;
-}
-
 }  // namespace geo
 }  // namespace sadsplat

@@ -49,14 +49,6 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--spike-clearance", "a distance >= 0 in map units",
                 std::to_string(o.spike_clearance));
   }
-  if (!(o.spike_roof_width >= 0 && std::isfinite(o.spike_roof_width))) {
-    throw Error(what, "--spike-roof-width", "a width >= 0 in map units (0: off)",
-                std::to_string(o.spike_roof_width));
-  }
-  if (o.spike_roof_width > 0 && o.spike_height <= 0) {
-    throw Error(what, "--spike-roof-width", "--spike-height > 0 (it sorts that check's cells)",
-                "--spike-height " + std::to_string(o.spike_height));
-  }
   if (o.trim_whole_under < 0) {
     throw Error(what, "--trim-whole-under", "a number of Gaussians >= 0",
                 std::to_string(o.trim_whole_under));
@@ -73,7 +65,6 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   r.pit_depth = o.pit_depth;
   r.spike_height = o.spike_height;
   r.spike_clearance = o.spike_clearance;
-  r.spike_roof_width = o.spike_roof_width;
   r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
@@ -141,10 +132,7 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
   j["spike_height"] = o.spike_height;
-  if (o.spike_height > 0) {
-    j["spike_clearance"] = o.spike_clearance;
-    j["spike_roof_width"] = o.spike_roof_width;
-  }
+  if (o.spike_height > 0) j["spike_clearance"] = o.spike_clearance;
   j["trim"] = trimClasses(o, classes);
   if (!j["trim"].empty()) {
     j["trim_step_m"] = o.object_step;
@@ -168,7 +156,6 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["raised_check_applied"] = o.raised_check > 0 && img.near_ground >= geo::kMinNearGround;
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
   j["spike_lowered_share"] = n ? double(img.lowered_spikes) / n : 0.0;
-  if (o.spike_height > 0) j["spike_roof_share"] = n ? double(img.spike_roofs) / n : 0.0;
   j["spike_height_applied"] = o.spike_height > 0 && img.near_ground >= geo::kMinNearGround;
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -355,28 +354,14 @@ void fillGroundPits(const OrthoGrid& grid, const OrthoRenderOptions& options, Or
 }
 
 // OrthoRenderOptions::spike_height: the ground-class cells standing above the ground classes
-// around them, except those within spike_clearance of a raised class's cell, lowered; with
-// spike_roof_width, those in wide patches given the most likely raised class instead.
-void lowerGroundSpikes(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                       const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
-                       OrthoImages& out) {
-  geo::GroundOutliers spikes = geo::findGroundSpikes(
-      out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
-      groundWindowCells(options, grid), options.spike_height, out.raised_classes,
-      static_cast<int>(std::lround(options.spike_clearance / grid.gsd)));
-  if (options.spike_roof_width > 0 && !out.raised_classes.empty()) {
-    const int side =
-        std::max(1, static_cast<int>(std::lround(options.spike_roof_width / grid.gsd)));
-    const std::vector<std::size_t> roofs =
-        geo::cellsInWidePatches(spikes.cells, grid.width, grid.height, side);
-    relabelCells(trainer, grid, options, keep, tile, roofs, out.raised_classes, out);
-    out.spike_roofs = static_cast<std::int64_t>(roofs.size());
-    std::vector<std::size_t> rest;
-    std::set_difference(spikes.cells.begin(), spikes.cells.end(), roofs.begin(), roofs.end(),
-                        std::back_inserter(rest));
-    spikes.cells = std::move(rest);
-  }
-  out.lowered_spikes = setToGroundLevel(spikes, out);
+// around them, except those within spike_clearance of a raised class's cell.
+void lowerGroundSpikes(const OrthoGrid& grid, const OrthoRenderOptions& options, OrthoImages& out) {
+  out.lowered_spikes = setToGroundLevel(
+      geo::findGroundSpikes(out.classes, out.elevation, out.ground_classes, grid.width, grid.height,
+                            groundWindowCells(options, grid), options.spike_height,
+                            out.raised_classes,
+                            static_cast<int>(std::lround(options.spike_clearance / grid.gsd))),
+      out);
 }
 
 }  // namespace
@@ -558,15 +543,11 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   // After the trim: the cells it gave a ground class keep the roof's height until here.
   if (options.spike_height > 0 && trainer.numClasses() > 0 &&
       out.near_ground >= geo::kMinNearGround) {
-    lowerGroundSpikes(trainer, grid, options, keep, tile, out);
+    lowerGroundSpikes(grid, options, out);
     if (progress) {
       *progress << "  ortho: " << out.lowered_spikes << " cells of a ground class more than "
                 << options.spike_height
                 << " above the ground classes around them lowered to them\n";
-      if (options.spike_roof_width > 0) {
-        *progress << "  ortho: " << out.spike_roofs << " such cells in patches at least "
-                  << options.spike_roof_width << " wide given the most likely raised class\n";
-      }
     }
   }
   return out;

@@ -54,13 +54,5 @@ std::vector<std::size_t> takeClassAround(std::vector<std::uint8_t>& classes,
                                          int height, const std::vector<std::size_t>& cells,
                                          const std::vector<std::uint8_t>& allowed, int radius);
 
-/// \brief The `cells` (indices into a row-major `width` x `height` grid) that lie in some
-/// `side` x `side` square made only of `cells`: what a morphological opening by that square
-/// keeps (a strip or blob narrower than `side` goes, a patch at least that wide stays whole).
-/// Ascending; duplicates in `cells` count once.
-/// \throws sadsplat::Error for side < 1 or a cell outside the grid
-std::vector<std::size_t> cellsInWidePatches(const std::vector<std::size_t>& cells, int width,
-                                            int height, int side);
-
 }  // namespace geo
 }  // namespace sadsplat

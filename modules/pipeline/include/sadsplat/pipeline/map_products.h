@@ -61,9 +61,6 @@ struct OrthoRunOptions {
   /// --spike-clearance M (OrthoRenderOptions::spike_clearance): 4 of 0 / 1 / 2 / 4 m kept the
   /// roofs best on those runs.
   double spike_clearance = 4;
-  /// --spike-roof-width M (OrthoRenderOptions::spike_roof_width; 0: off): --spike-height's cells
-  /// in patches at least M wide keep their height and take the most likely raised class.
-  double spike_roof_width = 0;
   double ground_window = 20;  ///< --ground-window M (OrthoRenderOptions::ground_window)
   /// --vectors: classes (names) whose objects go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;

@@ -110,11 +110,6 @@ struct OrthoRenderOptions {
   /// spike_height spares the cells within this of a raised class's cell (map units): a roof
   /// cell the class map calls road or paved stands at the roof's height.
   double spike_clearance = 0;
-  /// spike_height's cells that lie in a patch at least this wide (map units; a square of that
-  /// side fits inside the patch: geo::cellsInWidePatches) keep their height and take the most
-  /// likely raised class of their features: a roof the class map calls road or paved, not the
-  /// one-cell halo of a roof over its wall or a small floater. 0: every spike is lowered.
-  double spike_roof_width = 0;
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
@@ -157,9 +152,8 @@ struct OrthoImages {
   std::vector<int> ground_classes;  ///< geo::LowRaisedCells::ground
   std::int64_t filled_pits = 0;     ///< cells OrthoRenderOptions::pit_depth raised
   std::int64_t lowered_spikes = 0;  ///< cells OrthoRenderOptions::spike_height lowered
-  std::int64_t spike_roofs = 0;  ///< cells OrthoRenderOptions::spike_roof_width gave a raised class
-  double near_ground = 0;        ///< geo::LowRaisedCells::near_ground (the check's precondition)
-  std::int64_t trimmed_cells = 0;  ///< cells OrthoRenderOptions::trim_classes gave another class
+  double near_ground = 0;           ///< geo::LowRaisedCells::near_ground (the check's precondition)
+  std::int64_t trimmed_cells = 0;   ///< cells OrthoRenderOptions::trim_classes gave another class
 };
 
 /// \brief Renders the grid in tiles of `tile` pixels; progress lines on `progress` if not null.
