@@ -425,6 +425,38 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
   }
 }
 
+// `ortho --class-from views`: the class map from the classes the training views give the
+// Gaussians (OrthoSurface::kViews); its confidence is the class's share of the blending weight,
+// at least 1 / classes wherever a class is given; the covered cells and the DSM are the blend's.
+TEST_F(MapProducts, OrthoClassFromViewsGivesEveryCoveredCellAClassAndAWeightShare) {
+  // Without the checks that move classes or heights after the render (each its own test).
+  const std::string plain = "--trim none --raised-check 0 --pit-depth 0";
+  const std::string blend = ortho(plain, "ortho_class_blend"),
+                    views = ortho(plain + " --class-from views", "ortho_class_views");
+  const nlohmann::json j = nlohmann::json::parse(test::readFile(views + "/ortho.json"));
+  EXPECT_EQ(j["class_from"], "views");
+  const std::size_t k = classesOf(run()).size();
+  const geo::Raster cls = geo::readByteRaster(views + "/classes.tif");
+  const geo::Raster cls_blend = geo::readByteRaster(blend + "/classes.tif");
+  const std::vector<double> conf = gdalFloats(views + "/confidence.tif", dir_->file("cv.xyz"));
+  EXPECT_EQ(gdalFloats(views + "/dsm.tif", dir_->file("dv.xyz")),
+            gdalFloats(blend + "/dsm.tif", dir_->file("db.xyz")));
+  ASSERT_EQ(cls.bytes.size(), conf.size());
+  ASSERT_EQ(cls.bytes.size(), cls_blend.bytes.size());
+  std::size_t classed = 0, differ = 0;
+  for (std::size_t i = 0; i < conf.size(); ++i) {
+    EXPECT_EQ(cls.bytes[i] == 255, cls_blend.bytes[i] == 255) << i;  // the same covered cells
+    if (cls.bytes[i] == 255) continue;
+    ++classed;
+    differ += cls.bytes[i] != cls_blend.bytes[i];
+    EXPECT_LT(cls.bytes[i], k);
+    EXPECT_GE(conf[i], 1.0 / k - 1e-5) << i;
+    EXPECT_LE(conf[i], 1.0 + 1e-5) << i;
+  }
+  EXPECT_GT(classed, conf.size() / 4);
+  EXPECT_GT(differ, 0u);  // another rule, not the blend's map under another name
+}
+
 TEST_F(MapProducts, OrthoBoundsSetTheGrid) {
   std::string out;
   const std::string dir = dir_->file("ortho_bounds");
@@ -937,6 +969,7 @@ TEST_F(MapProducts, BadOptionsAreOneLineErrors) {
   expectError("ortho " + run() + " --bounds 10,10,0,20 --out " + dir_->file("x"), "--bounds");
   expectError("ortho " + run() + " --height top --out " + dir_->file("x"), "--height");
   expectError("ortho " + run() + " --class-from top --out " + dir_->file("x"), "--class-from");
+  expectError("ortho " + run() + " --height views --out " + dir_->file("x"), "--height");
   expectError("ortho " + run() + " --min-views -1 --out " + dir_->file("x"), "--min-views");
   expectError("ortho " + run() + " --min-spread 400 --out " + dir_->file("x"), "--min-spread");
   expectError("ortho " + run() + " --vectors roof --out " + dir_->file("x"), "roof");

@@ -262,6 +262,47 @@ TEST(LabelledCloud, EachGaussianTakesTheClassTheViewsRenderWhereItDraws) {
   EXPECT_GT(seen, static_cast<int>(labelled.size()) / 2);
 }
 
+// Trainer::renderCameraWith composites any per-Gaussian rows as the features are composited: the
+// model's own features give its render's features; one-hot classes give per pixel weights that
+// sum to the alpha. `ortho --class-from views` (OrthoSurface::kViews) takes the class with the
+// most of that weight: every Gaussian of one class gives that class everywhere, at confidence 1.
+TEST(LabelledCloud, OneHotClassesRenderAsBlendingWeightsAndMakeTheViewsClassMap) {
+  test::TempDir dir;
+  trainTinyRun(dir.file("run"));
+  const pipeline::OpenedRun run = pipeline::openRun(dir.file("run"));
+  const gaussians::Trainer& trainer = *run.trainer;
+  const gaussians::RasterCamera cam =
+      gaussians::RasterCamera::fromPinhole(run.scene.views.front().camera);
+  const gaussians::RenderResult own = trainer.renderCamera(cam);
+  const at::Tensor features = trainer.parameters().features;
+  EXPECT_TRUE(
+      at::allclose(trainer.renderCameraWith(cam, features).features, own.features, 1e-5, 1e-6));
+  const int k = trainer.numClasses();
+  const std::int64_t n = trainer.numGaussians();
+  const at::Tensor labels = at::arange(n, at::kLong).remainder(k);
+  const at::Tensor weights =
+      trainer.renderCameraWith(cam, at::one_hot(labels, k).to(at::kFloat)).features;
+  ASSERT_EQ(weights.size(2), k);
+  EXPECT_TRUE(at::allclose(weights.sum(2), own.alpha, 1e-4, 1e-5));
+  EXPECT_GT(own.alpha.max().item<double>(), 0.5);  // not an empty picture
+  EXPECT_THROW(trainer.renderCameraWith(cam, at::zeros({n - 1, k})), Error);
+
+  pipeline::OrthoRenderOptions options;
+  options.classes = pipeline::OrthoSurface::kViews;
+  const pipeline::OrthoGrid grid = pipeline::footprintGrid(trainer, run.scene, 0.05);
+  EXPECT_THROW(pipeline::renderOrtho(trainer, grid, options), Error);  // no classes given
+  options.gaussian_classes.assign(static_cast<std::size_t>(n), static_cast<std::uint32_t>(k - 1));
+  const pipeline::OrthoImages img = pipeline::renderOrtho(trainer, grid, options, nullptr, 16);
+  std::size_t covered = 0;
+  for (std::size_t c = 0; c < img.covered.size(); ++c) {
+    if (!img.covered[c]) continue;
+    ++covered;
+    EXPECT_EQ(img.classes[c], k - 1) << c;
+    EXPECT_NEAR(img.confidence[c], 1.0, 1e-5) << c;
+  }
+  EXPECT_GT(covered, 50u);  // the tiny model covers a few hundred cells
+}
+
 // `extract RUN --on-surface M` starts from gaussiansOnSurface: the run's model.ply without the
 // Gaussians farther than M from the surface their views render (surfaceGaps, one per Gaussian);
 // a large M keeps every Gaussian some view draws, a smaller one fewer.

@@ -33,7 +33,9 @@ class OrthoCommand : public Command {
         ->default_val("first");
     c->add_option("--class-from", o_.class_from,
                   "the class map's class: blend = of the feature composited along the ray; "
-                  "first = of the Gaussians in front of the first surface")
+                  "first = of the Gaussians in front of the first surface; views = the class "
+                  "with the most blending weight along the ray, each Gaussian counted as the "
+                  "class the training views give it (as model.ply's labels)")
         ->default_val("blend");
     c->add_option("--min-views", o_.min_views,
                   "cells whose surface fewer training photos see unoccluded are nodata (default 0: "

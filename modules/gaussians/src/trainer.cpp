@@ -491,6 +491,20 @@ RenderResult Trainer::renderCamera(const RasterCamera& camera, const at::Tensor&
   return render(s.evaluationGaussians(keep), camera, s.evaluationSettings());
 }
 
+RenderResult Trainer::renderCameraWith(const RasterCamera& camera, const at::Tensor& features,
+                                       const at::Tensor& keep) const {
+  c10::AutoGradMode no_grad(false);
+  const State& s = *state_;
+  GaussianParams g = s.evaluationGaussians(keep);
+  if (!features.defined() || features.dim() != 2 || features.size(0) != g.means.size(0)) {
+    throw Error("<render>", "features",
+                "one row per Gaussian (" + std::to_string(g.means.size(0)) + ")",
+                features.defined() ? std::to_string(features.size(0)) + " rows" : "none");
+  }
+  g.features = features.to(g.means.device(), g.means.scalar_type()).contiguous();
+  return render(g, camera, s.evaluationSettings());
+}
+
 RenderResult Trainer::renderDepth(const RasterCamera& camera, const at::Tensor& keep) const {
   c10::AutoGradMode no_grad(false);
   const State& s = *state_;

@@ -18,7 +18,7 @@ namespace pipeline {
 OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what) {
   OrthoRenderOptions r;
   r.height = parseOrthoSurface(o.height, "--height");
-  r.classes = parseOrthoSurface(o.class_from, "--class-from");
+  r.classes = parseOrthoSurface(o.class_from, "--class-from", true);
   if (o.min_views < 0) {
     throw Error(what, "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
   }
@@ -102,19 +102,23 @@ std::vector<std::string> trimClasses(const OrthoRunOptions& o,
   return o.trim;
 }
 
-pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRunOptions& o,
-                                       const gaussians::Trainer& trainer, const io::Scene& scene,
-                                       const char* what) {
+pcl::PointCloud<GaussianPoint> setGaussianClasses(OrthoRenderOptions& render,
+                                                  const OrthoRunOptions& o,
+                                                  const gaussians::Trainer& trainer,
+                                                  const io::Scene& scene, const char* what) {
   const std::vector<std::string> names = trimClasses(o, scene.classes);
   for (const std::string& n : o.trim) {
     if ((n == "auto" || n == "none") && o.trim.size() > 1) {
       throw Error(what, "--trim", "class names, or auto / none alone", n + " among others");
     }
   }
-  if (names.empty() || trainer.numClasses() == 0) return {};
-  render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");
-  render.trim_step = o.object_step;
-  render.trim_whole_under = static_cast<std::size_t>(o.trim_whole_under);
+  const bool views = render.classes == OrthoSurface::kViews;
+  if ((names.empty() && !views) || trainer.numClasses() == 0) return {};
+  if (!names.empty()) {
+    render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");
+    render.trim_step = o.object_step;
+    render.trim_whole_under = static_cast<std::size_t>(o.trim_whole_under);
+  }
   pcl::PointCloud<GaussianPoint> cloud = labelledCloud(trainer, scene, o.progress);
   render.gaussian_classes.resize(cloud.size());
   for (std::size_t g = 0; g < cloud.size(); ++g) render.gaussian_classes[g] = cloud[g].label;

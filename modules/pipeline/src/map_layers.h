@@ -35,11 +35,13 @@ std::vector<int> classIdsOf(const std::vector<std::string>& names,
 std::vector<std::string> trimClasses(const OrthoRunOptions& o,
                                      const std::vector<ClassInfo>& classes);
 
-// OrthoRunOptions::trim set on `render` for the run's model (the Gaussians' classes from its
-// training views: labelledCloud, returned for reuse; an empty cloud when nothing is trimmed).
-pcl::PointCloud<GaussianPoint> setTrim(OrthoRenderOptions& render, const OrthoRunOptions& o,
-                                       const gaussians::Trainer& trainer, const io::Scene& scene,
-                                       const char* what);
+// OrthoRunOptions::trim set on `render` for the run's model, and the Gaussians' classes from its
+// training views (labelledCloud, returned for reuse) where the trim or `--class-from views` needs
+// them; an empty cloud when neither does.
+pcl::PointCloud<GaussianPoint> setGaussianClasses(OrthoRenderOptions& render,
+                                                  const OrthoRunOptions& o,
+                                                  const gaussians::Trainer& trainer,
+                                                  const io::Scene& scene, const char* what);
 
 // How the map was rendered (the surface, the class, the view checks) and what the raised-class
 // check and the pit fill did (OrthoRenderOptions::raised_share, pit_depth), for ortho.json and

@@ -154,7 +154,7 @@ std::string orthoRun(const OrthoRunOptions& o) {
   }
   render_options.cameras = trainingCameras(run.scene);
   pcl::PointCloud<GaussianPoint> labelled =
-      setTrim(render_options, o, *run.trainer, run.scene, "<ortho>");
+      setGaussianClasses(render_options, o, *run.trainer, run.scene, "<ortho>");
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options, o.progress);
   const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
   geo::MapGrid map{grid.x0, grid.y0, grid.gsd, grid.frame.wkt};

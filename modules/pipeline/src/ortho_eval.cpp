@@ -113,7 +113,7 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   grid.top = orthoTop(*run.trainer, grid.frame);
   render_options.cameras = trainingCameras(run.scene);
   pcl::PointCloud<GaussianPoint> cloud =
-      setTrim(render_options, render, *run.trainer, run.scene, "<eval>");
+      setGaussianClasses(render_options, render, *run.trainer, run.scene, "<eval>");
   const OrthoImages img = renderOrtho(*run.trainer, grid, render_options);
   const int C = run.trainer->numClasses();
   eval::ConfusionMatrix confusion(C);

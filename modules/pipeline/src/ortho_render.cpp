@@ -163,10 +163,12 @@ std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene) {
   return cameras;
 }
 
-OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field) {
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field,
+                               bool views_allowed) {
   if (text == "first") return OrthoSurface::kFirst;
   if (text == "blend") return OrthoSurface::kBlend;
-  throw Error("<ortho>", field, "first or blend", text);
+  if (text == "views" && views_allowed) return OrthoSurface::kViews;
+  throw Error("<ortho>", field, views_allowed ? "first, blend or views" : "first or blend", text);
 }
 
 namespace {
@@ -210,11 +212,39 @@ std::vector<OrthoTile> orthoTiles(const OrthoGrid& grid, int tile) {
   return tiles;
 }
 
-// The features the class map is decoded from, for one tile (OrthoRenderOptions::classes).
-at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
-                         bool first_class, const at::Tensor& keep) {
-  if (first_class) return trainer.renderSurface(camera, 0.5, true, keep).features;
-  return trainer.renderCamera(camera, keep).features;
+// OrthoRenderOptions::gaussian_classes one-hot ([N, classes]) for OrthoSurface::kViews.
+at::Tensor oneHotClasses(const gaussians::Trainer& trainer, const OrthoRenderOptions& options) {
+  const int k = trainer.numClasses();
+  if (options.gaussian_classes.size() != static_cast<std::size_t>(trainer.numGaussians())) {
+    throw Error("<ortho>", "gaussian_classes",
+                std::to_string(trainer.numGaussians()) + " classes (one per Gaussian)",
+                std::to_string(options.gaussian_classes.size()));
+  }
+  std::vector<std::int64_t> ids(options.gaussian_classes.begin(), options.gaussian_classes.end());
+  const at::Tensor labels = at::tensor(ids, at::kLong).clamp(0, k - 1);
+  return at::one_hot(labels, k).to(at::kFloat);
+}
+
+// Per cell and class [h, w, classes] (on the model's device), a score whose maximum is the
+// cell's class and its confidence: the cosines of the decoded feature (the blend's or the first
+// surface's), or with OrthoSurface::kViews each class's share of the blending weight. `blend`:
+// the tile's plain render, when the caller has it.
+at::Tensor classScores(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
+                       const OrthoRenderOptions& options, const at::Tensor& keep,
+                       const gaussians::RenderResult* blend = nullptr) {
+  switch (options.classes) {
+    case OrthoSurface::kFirst:
+      return trainer.classCosines(trainer.renderSurface(camera, 0.5, true, keep).features);
+    case OrthoSurface::kViews: {
+      const at::Tensor weights =
+          trainer.renderCameraWith(camera, oneHotClasses(trainer, options), keep).features;
+      return weights / weights.sum(2, true).clamp_min(1e-12);
+    }
+    case OrthoSurface::kBlend:
+      break;
+  }
+  return trainer.classCosines(blend ? blend->features
+                                    : trainer.renderCamera(camera, keep).features);
 }
 
 // OrthoRenderOptions::ground_window in cells of the grid (at least one).
@@ -261,8 +291,7 @@ void relabelCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
     }
     if (!any) continue;
     const gaussians::RasterCamera camera = orthoCamera(grid, t.x_off, t.y_off, t.w, t.h);
-    at::Tensor cosines = trainer.classCosines(
-        classFeatures(trainer, camera, options.classes == OrthoSurface::kFirst, keep));
+    at::Tensor cosines = classScores(trainer, camera, options, keep);
     at::Tensor others = at::ones({k}, at::kBool);
     for (int c : allowed) others[c] = false;
     cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
@@ -423,7 +452,10 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     covered = covered.to(at::kByte).contiguous();
     depth = depth.contiguous();
     if (trainer.numClasses() > 0) {
-      const auto best = trainer.classCosines(features).max(2);
+      const at::Tensor scores = options.classes == OrthoSurface::kViews
+                                    ? classScores(trainer, camera, options, keep)
+                                    : trainer.classCosines(features);
+      const auto best = scores.max(2);
       conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
       cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
     }

@@ -117,6 +117,12 @@ class Trainer {
   /// \brief As renderCamera, drawing only the Gaussians where `keep` ([N] bool, on any device) is
   /// true (a viewer's class selection); an undefined `keep` draws them all.
   RenderResult renderCamera(const RasterCamera& camera, const at::Tensor& keep) const;
+  /// \brief As renderCamera, each Gaussian carrying its row of `features` ([N, C], any device)
+  /// in place of its semantic feature: RenderResult::features composites them (one-hot classes
+  /// give each class's blending weight over each pixel). `keep` as renderCamera's.
+  /// \throws sadsplat::Error when `features` is not one row per Gaussian
+  RenderResult renderCameraWith(const RasterCamera& camera, const at::Tensor& features,
+                                const at::Tensor& keep = at::Tensor()) const;
   /// \brief As renderCamera, without the features: colour, alpha and expected depth; `keep` as
   /// there.
   RenderResult renderDepth(const RasterCamera& camera, const at::Tensor& keep = at::Tensor()) const;

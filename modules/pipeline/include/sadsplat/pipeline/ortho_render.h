@@ -54,6 +54,11 @@ enum class OrthoSurface {
   /// The blend through every Gaussian on the ray: the expected depth (a floater or an
   /// overhanging edge pulls it towards itself); the class of the composited feature.
   kBlend,
+  /// Classes only: the class with the most blending weight along the ray, each Gaussian counted
+  /// as the class the training views give it (OrthoRenderOptions::gaussian_classes,
+  /// labelled_cloud.h), not as its feature decodes top-down. Confidence: that class's share of
+  /// the weight.
+  kViews,
 };
 
 /// \brief How the map is rendered.
@@ -126,7 +131,7 @@ struct OrthoRenderOptions {
   /// a few); 0: such objects are kept (those under 20 have no hull and keep every cell).
   std::size_t trim_whole_under = 0;
   /// Per Gaussian of the model (Trainer::toCloud's order): its class as the training views
-  /// render it (labelledCloud); needed by trim_classes.
+  /// render it (labelledCloud); needed by trim_classes and classes = kViews.
   std::vector<std::uint32_t> gaussian_classes;
 };
 
@@ -138,10 +143,12 @@ struct OrthoImages {
   std::vector<std::uint8_t> rgb;      ///< 3 per pixel
   std::vector<std::uint8_t> covered;  ///< 1 = covered
   std::vector<std::uint8_t>
-      classes;                    ///< class id, 255 = none (uncovered, or a model without classes)
-  std::vector<float> elevation;   ///< map height of the rendered surface (OrthoSurface)
-  std::vector<float> confidence;  ///< Trainer::classCosines of the class (0 without classes)
-  std::int64_t few_views = 0;     ///< cells with a surface made nodata by min_views
+      classes;                   ///< class id, 255 = none (uncovered, or a model without classes)
+  std::vector<float> elevation;  ///< map height of the rendered surface (OrthoSurface)
+  /// Trainer::classCosines of the class (0 without classes); with OrthoSurface::kViews the
+  /// class's share of the blending weight.
+  std::vector<float> confidence;
+  std::int64_t few_views = 0;  ///< cells with a surface made nodata by min_views
   /// With OrthoRenderOptions::raised_share or pit_depth: the ground height per cell (NaN: no
   /// surface at all), each class's median height above it, the raised classes and how many cells
   /// they lost.
@@ -166,9 +173,11 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
 /// \brief The scene's training cameras (OrthoRenderOptions::cameras).
 std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene);
 
-/// \brief "first" or "blend" as an OrthoSurface.
+/// \brief "first" or "blend" (and "views" where `views_allowed`: the class map's) as an
+/// OrthoSurface.
 /// \throws sadsplat::Error naming `field` for any other text
-OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field);
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field,
+                               bool views_allowed = false);
 
 }  // namespace pipeline
 }  // namespace sadsplat
