@@ -24,7 +24,7 @@ class EvalCommand : public Command {
     c->add_option("--height", ortho_options_.height, "--ortho: as `ortho --height`")
         ->default_val("first");
     c->add_option("--class-from", ortho_options_.class_from, "--ortho: as `ortho --class-from`")
-        ->default_val("blend");
+        ->default_val("views");
     c->add_option("--depth-tolerance", ortho_options_.depth_tolerance,
                   "--ortho: as `ortho --depth-tolerance`")
         ->default_val(0.02);

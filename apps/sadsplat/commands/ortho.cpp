@@ -36,7 +36,7 @@ class OrthoCommand : public Command {
                   "first = of the Gaussians in front of the first surface; views = the class "
                   "with the most blending weight along the ray, each Gaussian counted as the "
                   "class the training views give it (as model.ply's labels)")
-        ->default_val("blend");
+        ->default_val("views");
     c->add_option("--min-views", o_.min_views,
                   "cells whose surface fewer training photos see unoccluded are nodata (default 0: "
                   "keep all)")

@@ -67,7 +67,8 @@ struct OrthoRenderOptions {
   /// synth scenes, docs/measurements/cloud_3d).
   OrthoSurface height = OrthoSurface::kFirst;
   /// The class map: the blend's class scores 1.5-5 points mIoU above the first surface's on the
-  /// same runs (the features are trained as blends), so it stays the default.
+  /// same runs (the features are trained as blends). kViews scores higher still but needs
+  /// gaussian_classes (the CLI's default, map_products.h); here the blend needs nothing.
   OrthoSurface classes = OrthoSurface::kBlend;
   /// A covered cell whose surface point fewer than this many of `cameras` see unoccluded is
   /// nodata (gaussians::seenUnoccluded against each camera's depth render): a surface only one
