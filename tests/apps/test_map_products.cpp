@@ -431,8 +431,8 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
 TEST_F(MapProducts, OrthoClassFromViewsGivesEveryCoveredCellAClassAndAWeightShare) {
   // Without the checks that move classes or heights after the render (each its own test).
   const std::string plain = "--trim none --raised-check 0 --pit-depth 0";
-  const std::string blend = ortho(plain, "ortho_class_blend"),
-                    views = ortho(plain + " --class-from views", "ortho_class_views");
+  const std::string blend = ortho(plain + " --class-from blend", "ortho_class_blend"),
+                    views = ortho(plain, "ortho_class_views");  // the default
   const nlohmann::json j = nlohmann::json::parse(test::readFile(views + "/ortho.json"));
   EXPECT_EQ(j["class_from"], "views");
   const std::size_t k = classesOf(run()).size();
@@ -792,7 +792,7 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
     EXPECT_LE(w["miou"].get<double>(), 1.0);
   }
   EXPECT_EQ(j["height_from"], "first");
-  EXPECT_EQ(j["class_from"], "blend");
+  EXPECT_EQ(j["class_from"], "views");  // the default since 2026-12-01
   // The trim (default auto: the model's building class) and what it changed.
   EXPECT_EQ(j["trim"], nlohmann::json::array({"building"}));
   EXPECT_GE(j["trimmed_share"].get<double>(), 0.0);
