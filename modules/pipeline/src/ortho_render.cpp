@@ -225,26 +225,31 @@ at::Tensor oneHotClasses(const gaussians::Trainer& trainer, const OrthoRenderOpt
   return at::one_hot(labels, k).to(at::kFloat);
 }
 
-// Per cell and class [h, w, classes] (on the model's device), a score whose maximum is the
-// cell's class and its confidence: the cosines of the decoded feature (the blend's or the first
-// surface's), or with OrthoSurface::kViews each class's share of the blending weight. `blend`:
-// the tile's plain render, when the caller has it.
-at::Tensor classScores(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
-                       const OrthoRenderOptions& options, const at::Tensor& keep,
-                       const gaussians::RenderResult* blend = nullptr) {
+// What one tile composites for the class map (OrthoRenderOptions::classes): the trained features
+// along the whole ray (kBlend) or in front of the first surface (kFirst), or each class's
+// blending weight (kViews: the Gaussians carrying oneHotClasses).
+at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
+                         const OrthoRenderOptions& options, const at::Tensor& keep) {
   switch (options.classes) {
     case OrthoSurface::kFirst:
-      return trainer.classCosines(trainer.renderSurface(camera, 0.5, true, keep).features);
-    case OrthoSurface::kViews: {
-      const at::Tensor weights =
-          trainer.renderCameraWith(camera, oneHotClasses(trainer, options), keep).features;
-      return weights / weights.sum(2, true).clamp_min(1e-12);
-    }
+      return trainer.renderSurface(camera, 0.5, true, keep).features;
+    case OrthoSurface::kViews:
+      return trainer.renderCameraWith(camera, oneHotClasses(trainer, options), keep).features;
     case OrthoSurface::kBlend:
       break;
   }
-  return trainer.classCosines(blend ? blend->features
-                                    : trainer.renderCamera(camera, keep).features);
+  return trainer.renderCamera(camera, keep).features;
+}
+
+// Per cell and class [h, w, classes], a score whose maximum is the cell's class and its
+// confidence, from classFeatures' image (`features`): the cosines of the decoded feature, or with
+// OrthoSurface::kViews each class's share of the blending weight.
+at::Tensor classScores(const gaussians::Trainer& trainer, const OrthoRenderOptions& options,
+                       const at::Tensor& features) {
+  if (options.classes == OrthoSurface::kViews) {
+    return features / features.sum(2, true).clamp_min(1e-12);
+  }
+  return trainer.classCosines(features);
 }
 
 // OrthoRenderOptions::ground_window in cells of the grid (at least one).
@@ -291,7 +296,8 @@ void relabelCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
     }
     if (!any) continue;
     const gaussians::RasterCamera camera = orthoCamera(grid, t.x_off, t.y_off, t.w, t.h);
-    at::Tensor cosines = classScores(trainer, camera, options, keep);
+    at::Tensor cosines =
+        classScores(trainer, options, classFeatures(trainer, camera, options, keep));
     at::Tensor others = at::ones({k}, at::kBool);
     for (int c : allowed) others[c] = false;
     cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
@@ -425,13 +431,20 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   out.confidence.assign(pixels, 0.f);
   const bool first_height = options.height == OrthoSurface::kFirst;
   const bool first_class = options.classes == OrthoSurface::kFirst;
+  // kViews: the Gaussians carry their classes one-hot in the tiles' render (its colour, alpha
+  // and depth do not depend on the features), so one render gives the map and the class weights.
+  const at::Tensor one_hot = options.classes == OrthoSurface::kViews && trainer.numClasses() > 0
+                                 ? oneHotClasses(trainer, options)
+                                 : at::Tensor();
   const std::vector<OrthoTile> tiles = orthoTiles(grid, tile);
   int done = 0;
   std::vector<at::Tensor> surface_points, surface_cells;
   for (const OrthoTile& t : tiles) {
     const int x_off = t.x_off, y_off = t.y_off, w = t.w, h = t.h;
     const gaussians::RasterCamera camera = orthoCamera(grid, x_off, y_off, w, h);
-    const gaussians::RenderResult r = trainer.renderCamera(camera, keep);
+    const gaussians::RenderResult r = one_hot.defined()
+                                          ? trainer.renderCameraWith(camera, one_hot, keep)
+                                          : trainer.renderCamera(camera, keep);
     const at::Tensor rgb = r.rgb.clamp(0, 1).mul(255).round().to(at::kCPU, at::kByte).contiguous();
     at::Tensor covered = r.alpha.to(at::kCPU, at::kFloat) >= 0.5f;
     at::Tensor depth = r.depth.to(at::kCPU, at::kFloat), features = r.features, cls, conf;
@@ -452,10 +465,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     covered = covered.to(at::kByte).contiguous();
     depth = depth.contiguous();
     if (trainer.numClasses() > 0) {
-      const at::Tensor scores = options.classes == OrthoSurface::kViews
-                                    ? classScores(trainer, camera, options, keep)
-                                    : trainer.classCosines(features);
-      const auto best = scores.max(2);
+      const auto best = classScores(trainer, options, features).max(2);
       conf = std::get<0>(best).to(at::kCPU, at::kFloat).contiguous();
       cls = std::get<1>(best).to(at::kCPU, at::kLong).contiguous();
     }
