@@ -798,6 +798,96 @@ TEST(Rasterizer, RenderWithoutFeaturesOrDepthGivesTheSameColourAndGradients) {
   EXPECT_FALSE(b[3].defined()) << "features were not rendered";
 }
 
+// The depth spread (RenderSettings::depth_spread): two discs on the camera's axis at depths z1
+// < z2 give each pixel 1/2 sum_ij w_i w_j (z_i - z_j)^2 = w1 w2 (z2 - z1)^2 with the weights the
+// compositing gives them (w1 = a1, w2 = (1 - a1) a2); one disc alone spreads nothing; the other
+// outputs are those of a render without it; its gradient pulls the discs together and
+// matches central finite differences in every input.
+TEST(Rasterizer, DepthSpreadIsTheWeightsSpreadAlongTheRayAndDifferentiable) {
+  const RasterCamera cam = frontCamera(16, 16, 22.0);
+  const auto opts = at::TensorOptions().dtype(at::kDouble);
+  const double z1 = 3.0, z2 = 4.5, o1 = 0.5, o2 = 0.8, sigma = 0.6;
+  GaussianParams g;
+  g.means = at::tensor({0.0, 0.0, z1, 0.0, 0.0, z2}, opts).reshape({2, 3});
+  g.quats = at::tensor({1.0, 0.0, 0.0, 0.0}, opts).reshape({1, 4}).repeat({2, 1});
+  g.log_scales = at::full({2, 3}, std::log(sigma), opts);
+  g.opacity_logits = at::tensor({std::log(o1 / (1 - o1)), std::log(o2 / (1 - o2))}, opts);
+  g.sh = at::zeros({2, 16, 3}, opts);
+  g.features = at::zeros({2, 2}, opts);
+  RenderSettings with;
+  with.depth_spread = true;
+  const auto r = gaussians::render(g, cam, with);
+  const auto plain = gaussians::render(g, cam);
+  ASSERT_TRUE(r.depth_spread.defined());
+  EXPECT_FALSE(plain.depth_spread.defined());
+  EXPECT_TRUE(at::equal(r.rgb, plain.rgb));
+  EXPECT_TRUE(at::equal(r.alpha, plain.alpha));
+  EXPECT_TRUE(at::allclose(r.depth, plain.depth, 1e-12, 1e-12));
+  EXPECT_EQ(r.features.size(2), 2);
+  // Both discs are wide against the pixel (sigma x f / z > 2 px): at the centre pixel each
+  // Gaussian's alpha is its opacity x its falloff at the pixel centre.
+  const auto alphaAt = [&](double o, double z) {
+    const double s2 = std::pow(22.0 * sigma / z, 2) + 0.3, d = 0.5;
+    return o * std::exp(-0.5 * (2 * d * d) / s2);
+  };
+  const double a1 = alphaAt(o1, z1), a2 = alphaAt(o2, z2);
+  const double w1 = a1, w2 = (1 - a1) * a2;
+  EXPECT_NEAR(r.alpha[8][8].item<double>(), w1 + w2, 1e-12);
+  EXPECT_NEAR(r.depth_spread[8][8].item<double>(), w1 * w2 * (z2 - z1) * (z2 - z1), 1e-9);
+  EXPECT_GT(r.depth_spread.sum().item<double>(), 0);
+
+  GaussianParams one = g;
+  one.means = g.means.slice(0, 0, 1);
+  one.quats = g.quats.slice(0, 0, 1);
+  one.log_scales = g.log_scales.slice(0, 0, 1);
+  one.opacity_logits = g.opacity_logits.slice(0, 0, 1);
+  one.sh = g.sh.slice(0, 0, 1);
+  one.features = g.features.slice(0, 0, 1);
+  EXPECT_NEAR(gaussians::render(one, cam, with).depth_spread.abs().max().item<double>(), 0, 1e-12);
+
+  // Its gradient in the discs' depths: the front one pushed back, the back one forward.
+  GaussianParams d = g;
+  d.means = g.means.clone().requires_grad_(true);
+  const auto grad =
+      torch::autograd::grad({gaussians::render(d, cam, with).depth_spread.sum()}, {d.means})[0];
+  EXPECT_LT(grad[0][2].item<double>(), 0);
+  EXPECT_GT(grad[1][2].item<double>(), 0);
+
+  // Every input against finite differences, the spread weighted into the test's loss.
+  const RasterCamera small = frontCamera(16, 16, 22.0);
+  GaussianParams s = randomScene(5, 3, 5);
+  at::manual_seed(7);
+  const at::Tensor w = at::randn({16, 16}, opts);
+  at::Tensor GaussianParams::*const members[] = {&GaussianParams::means, &GaussianParams::quats,
+                                                 &GaussianParams::log_scales,
+                                                 &GaussianParams::opacity_logits};
+  std::vector<at::Tensor> tensors;
+  for (auto member : members) {
+    s.*member = (s.*member).detach().clone().requires_grad_(true);
+    tensors.push_back(s.*member);
+  }
+  const auto loss = [&](const GaussianParams& p) {
+    return (gaussians::render(p, small, with).depth_spread * w).sum();
+  };
+  const auto grads = torch::autograd::grad({loss(s)}, tensors);
+  c10::AutoGradMode no_grad(false);
+  for (std::size_t k = 0; k < tensors.size(); ++k) {
+    const at::Tensor base = tensors[k].detach();
+    for (int64_t i = 0; i < base.numel(); ++i) {
+      const auto eval = [&](double delta) {
+        GaussianParams p = s;
+        at::Tensor changed = base.clone();
+        changed.view({-1})[i] += delta;
+        p.*members[k] = changed;
+        return loss(p).item<double>();
+      };
+      const double numeric = (eval(1e-6) - eval(-1e-6)) / 2e-6;
+      EXPECT_NEAR(grads[k].reshape({-1})[i].item<double>(), numeric, 1e-5 * (1 + std::abs(numeric)))
+          << k << "[" << i << "]";
+    }
+  }
+}
+
 // The SH coefficients in two parts (the trainer's sh_dc and sh_rest, read in place) render the
 // same colours as one [N, K, 3] tensor, bit for bit, and each part's gradient is its slice of
 // the whole's; a part whose rows lie apart (a narrow view) reads the same; coefficients above
