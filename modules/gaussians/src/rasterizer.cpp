@@ -472,21 +472,9 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   auto [means2d, conics, depths, radii] = projectGaussians(g.means, g.quats, g.log_scales, camera);
   const at::Tensor colors =
       evaluateSh(g.sh, g.sh_rest, g.means, camera.shViewpoint(), settings.sh_degree);
-  std::vector<at::Tensor> channels{colors};
-  if (features.size(1) > 0) channels.push_back(features);
-  if (settings.depth) channels.push_back(depths.unsqueeze(1));
-  // The spread from the first two moments of u = (z - z0) / s, centred and scaled by the
-  // Gaussians' own depths (constants: the spread does not depend on them) so that the moments
-  // stay of order one in float32 however far the camera is.
-  at::Tensor spread_scale;
-  if (settings.depth_spread) {
-    const at::Tensor z = depths.detach();
-    spread_scale = n > 1 ? z.std().clamp_min(1e-6) : at::ones({}, z.options());
-    const at::Tensor u = ((depths - z.mean()) / spread_scale).unsqueeze(1);
-    channels.push_back(u);
-    channels.push_back(u * u);
-  }
-  const at::Tensor values = channels.size() == 1 ? colors : at::cat(channels, 1);
+  const at::Tensor values = settings.depth ? at::cat({colors, features, depths.unsqueeze(1)}, 1)
+                            : features.size(1) > 0 ? at::cat({colors, features}, 1)
+                                                   : colors;
   at::Tensor opacities = at::sigmoid(g.opacity_logits);
   if (g.opacity_gate.defined()) {
     expectTensor(g.opacity_gate, "opacity_gate", n, {}, g.means);
@@ -507,17 +495,10 @@ RenderResult render(const GaussianParams& g, const RasterCamera& camera,
   const int64_t C = features.size(1);
   RenderResult result;
   result.rgb = composeBackground(rgb, alpha, settings.background);
-  result.features = rest.size(2) > C ? rest.slice(2, 0, C) : rest;
-  int64_t next = C;
+  result.features = settings.depth ? rest.slice(2, 0, C) : rest;
   if (settings.depth) {
-    const at::Tensor depth_sum = rest.select(2, next++);
+    const at::Tensor depth_sum = rest.select(2, C);
     result.depth = at::where(alpha > 0, depth_sum / alpha.clamp_min(1e-10), at::zeros_like(alpha));
-  }
-  if (settings.depth_spread) {
-    // sum_i w_i sum_j w_j (u_i^2 - 2 u_i u_j + u_j^2) / 2 = alpha M2 - M1^2.
-    const at::Tensor m1 = rest.select(2, next);
-    const at::Tensor m2 = rest.select(2, next + 1);
-    result.depth_spread = (alpha * m2 - m1 * m1).clamp_min(0) * spread_scale.square();
   }
   result.alpha = alpha;
   result.means2d = means2d;

@@ -97,12 +97,6 @@ const std::vector<TrainOption> kOptions = {
      "weight of the sparse-depth loss: mean |rendered depth - sparse point depth| / depth over "
      "the points each training view sees (0: off)",
      nullptr, 0, kInf},
-    {"lambda_distortion", &C::lambda_distortion,
-     "weight of the depth-distortion loss: mean over pixels of the weights' spread along the ray "
-     "1/2 sum w_i w_j (z_i - z_j)^2 / extent^2 (0: off)",
-     nullptr, 0, kInf},
-    {"distortion_from", &C::distortion_from,
-     "iteration from which the distortion loss counts (-1: densify_until)", nullptr, -1, kInf},
     {"semantic_interval", &C::semantic_interval,
      "every this many iterations a labelled view is rendered as well (0: never)", nullptr, 0, kInf},
     {"views_per_step", &C::views_per_step,

@@ -54,10 +54,9 @@ struct StepPass {
   int ranks = 1;
   int batch = 1;
   bool read_losses = false;
-  bool distortion = false;  // the depth-distortion loss counts in this step
   RenderSettings settings;
   GaussianParams g;
-  at::Tensor total, rgb_sum, sem_sum, dist_sum;
+  at::Tensor total, rgb_sum, sem_sum;
   std::vector<RenderResult> renders;
   std::vector<RasterCamera> cameras;
 };
@@ -175,11 +174,10 @@ struct Trainer::State {
 // a render's tile list was short.
 void Trainer::State::renderLossesBackward(StepPass& pass, int it, TileListCapacity* tile_capacity) {
   const TrainConfig& c = config;
-  pass.total = pass.rgb_sum = pass.sem_sum = pass.dist_sum = at::Tensor();
+  pass.total = pass.rgb_sum = pass.sem_sum = at::Tensor();
   pass.renders.clear();
   pass.cameras.clear();
   pass.settings.tile_capacity = tile_capacity;
-  pass.distortion = c.lambda_distortion > 0 && it >= c.distortion_from;
   // Counter-based noise: a second pass samples the same gates (the first one's graph is gone).
   pass.g.opacity_gate = drop.trainingGate(params, it);  // undefined when not gated
   for (int v : pass.views) {
@@ -218,7 +216,6 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
                             views.sparse_depths[v].size() > 0;
   pass.settings.features = role.semantic;
   pass.settings.depth = sparse_depth;
-  pass.settings.depth_spread = pass.distortion;
   RenderResult r = render(pass.g, views.cameras[v], pass.settings);
   r.means2d.retain_grad();
   enterPhase(p, "losses forward");
@@ -255,11 +252,6 @@ at::Tensor Trainer::State::viewLoss(StepPass& pass, int v) {
   }
   if (sparse_depth) {
     loss = loss + c.lambda_sparse_depth * sparseDepthLoss(r.depth, views.sparse_depths[v]);
-  }
-  if (pass.distortion) {
-    const at::Tensor distortion = r.depth_spread.mean() * (1.0 / (extent * extent));
-    loss = loss + c.lambda_distortion * distortion;
-    accumulate(pass.dist_sum, distortion);
   }
   pass.renders.push_back(r);
   pass.cameras.push_back(views.cameras[v]);
@@ -325,14 +317,12 @@ void Trainer::State::readLossValues(const StepPass& pass, StepStats& stats) cons
   const at::Tensor zero = at::zeros({}, pass.total.options());
   at::Tensor values =
       at::stack({pass.total.detach(), pass.rgb_sum, pass.sem_sum.defined() ? pass.sem_sum : zero,
-                 at::full({}, static_cast<double>(pass.views.size()), pass.total.options()),
-                 pass.dist_sum.defined() ? pass.dist_sum : zero});
+                 at::full({}, static_cast<double>(pass.views.size()), pass.total.options())});
   if (collective) collective->sum(values);
   values = values.to(at::kDouble).cpu();
   const double* value = values.data_ptr<double>();
   stats.rgb_loss = value[1] / value[3];
   stats.semantic_loss = value[2] / pass.batch;
-  stats.distortion_loss = value[4] / value[3];
   stats.loss = value[0];
 }
 

@@ -51,7 +51,6 @@ void TrainLogWriter::append(const TrainLogRecord& r) {
     j["loss"] = r.loss;
     j["rgb_loss"] = r.rgb_loss;
     j["semantic_loss"] = r.semantic_loss;
-    if (r.distortion_loss != 0) j["distortion_loss"] = r.distortion_loss;
     j["seconds"] = r.seconds;
   } else if (r.type != "max_gaussians_reached") {
     j["removed"] = r.removed;
@@ -99,7 +98,6 @@ std::vector<TrainLogRecord> readTrainLog(const std::string& path) {
     r.loss = number("loss");
     r.rgb_loss = number("rgb_loss");
     r.semantic_loss = number("semantic_loss");
-    r.distortion_loss = number("distortion_loss");
     r.seconds = number("seconds");
     r.gaussians = count("gaussians");
     r.removed = count("removed");

@@ -122,7 +122,6 @@ void TrainingReport::log(const gaussians::StepStats& s, double seconds, bool las
     r.loss = s.loss;
     r.rgb_loss = s.rgb_loss;
     r.semantic_loss = s.semantic_loss;
-    r.distortion_loss = s.distortion_loss;
     r.gaussians = s.num_gaussians;
     r.seconds = seconds;
     log_->append(r);

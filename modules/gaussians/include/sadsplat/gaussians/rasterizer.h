@@ -51,8 +51,6 @@ struct RenderSettings {
   bool features = true;
   /// Render the expected depth (false: RenderResult::depth is undefined; one channel fewer).
   bool depth = true;
-  /// Render the spread of depth along each ray (RenderResult::depth_spread; two channels more).
-  bool depth_spread = false;
   /// CUDA: size the (Gaussian, tile) list from earlier renders instead of waiting for the GPU
   /// to count it; the caller checks with tile_capacity->renderedAll() before using the render's
   /// gradients (tile_list_capacity.h). Null: exact lists. Kept alive by the caller. CPU: unused.
@@ -85,12 +83,6 @@ struct RenderResult {
   at::Tensor alpha;     ///< [H, W] accumulated opacity
   at::Tensor depth;     ///< [H, W] expected depth (alpha-weighted mean camera z), 0 where alpha = 0
                         ///< (undefined when RenderSettings::depth is false)
-  /// [H, W] the spread of the blending weights w_i along each ray in camera depth z_i:
-  /// 1/2 sum_ij w_i w_j (z_i - z_j)^2 = alpha^2 x the weighted variance of z (depth^2 units; the
-  /// squared form of Mip-NeRF 360's distortion). 0 where one surface takes the whole weight;
-  /// large where a floater and the surface behind it share it. Differentiable in every input.
-  /// Undefined unless RenderSettings::depth_spread.
-  at::Tensor depth_spread;
   at::Tensor means2d;   ///< [N, 2] projected centres (pixels); call retain_grad() before backward
                         ///< to read the screen-space gradient
   at::Tensor radii;     ///< [N] int32 screen radius, 0 = culled

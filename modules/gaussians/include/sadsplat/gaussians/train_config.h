@@ -70,16 +70,6 @@ struct LossOptions {
   /// the surfaces to what the photos triangulated where the photometric loss alone leaves the
   /// depth free (a capture that sees the ground from one side). 0: off; nothing without points.
   double lambda_sparse_depth = 0.0;
-  /// Not the paper: weight of the depth-distortion loss (Mip-NeRF 360, 2DGS; here its squared
-  /// form): the mean over each training view's pixels of RenderResult::depth_spread, the spread
-  /// of the blending weights along the ray, / extent^2. Pulls each pixel's weight onto one
-  /// surface: a floater in front of the ground either covers it or goes, a thick band of
-  /// Gaussians becomes a thin one. 0: off.
-  double lambda_distortion = 0.0;
-  /// The iteration from which the distortion loss counts. -1: from the end of the
-  /// densification (densify_until), so that it does not hold back the Gaussians the
-  /// densification grows.
-  int distortion_from = -1;
   /// Every this many iterations a labelled view is rendered as well, for the semantic loss
   /// (only 3 of ~63 training views carry labels). 1 = every iteration.
   int semantic_interval = 2;

@@ -32,9 +32,6 @@ struct StepStats {
   /// Whether the loss values below were read (step(true)); after step(false) they are NaN.
   bool losses_read = true;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;
-  /// The depth-distortion term before its weight (mean depth spread / extent^2 over the step's
-  /// views); 0 while TrainConfig::lambda_distortion does not count.
-  double distortion_loss = 0;
   std::int64_t num_gaussians = 0;
   std::int64_t dropped = 0;  ///< Gaussians removed by the drop in this step
   DropDecision drop;         ///< the decision behind `dropped` (tensors undefined if none)

@@ -5,8 +5,7 @@
 ///
 /// Records (every field a number except `type`):
 /// - `{"type":"step","iteration","loss","rgb_loss","semantic_loss","gaussians","seconds"}`:
-///   every few iterations and at the last one; `"distortion_loss"` too while the depth-distortion
-///   loss counts (the mean depth spread / extent^2, before its weight);
+///   every few iterations and at the last one;
 /// - `{"type":"drop","iteration","removed","gaussians","low_confidence","unseen","closed_gate"}`:
 ///   one semantic-aware drop, with the counts of why Gaussians went;
 /// - `{"type":"closed_gates","iteration","removed","gaussians"}`: the removal of closed gates
@@ -37,7 +36,6 @@ struct TrainLogRecord {
   std::string type = "step";  ///< step, drop, closed_gates, recovery, max_gaussians_reached
   int iteration = 0;
   double loss = 0, rgb_loss = 0, semantic_loss = 0;  ///< step records
-  double distortion_loss = 0;  ///< step records; 0 (and not written) while the loss is off
   double seconds = 0;                                ///< training time so far (step records)
   long long gaussians = 0;                           ///< Gaussians after the event
   long long removed = 0;                             ///< drop / closed_gates records
