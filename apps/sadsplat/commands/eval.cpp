@@ -45,11 +45,6 @@ class EvalCommand : public Command {
     c->add_option("--spike-clearance", ortho_options_.spike_clearance,
                   "--ortho: as `ortho --spike-clearance`")
         ->default_val(4.0);
-    c->add_option("--roof-check", ortho_options_.roof_check, "--ortho: as `ortho --roof-check`")
-        ->default_val(0.0);
-    c->add_option("--roof-check-score", ortho_options_.roof_check_score,
-                  "--ortho: as `ortho --roof-check-score`")
-        ->default_val(0.0);
     c->add_option("--object-step", ortho_options_.object_step,
                   "--ortho: the building objects as `ortho --object-step` cuts them")
         ->default_val(1.5);

@@ -78,16 +78,6 @@ class OrthoCommand : public Command {
                   "cell the class map calls road or paved stands at the roof's height; map "
                   "units)")
         ->default_val(4.0);
-    c->add_option("--roof-check", o_.roof_check,
-                  "the converse of --raised-check: a cell of a ground class standing at least "
-                  "this share of a raised class's median height above the ground takes the "
-                  "raised class with the highest score there (a roof the class map calls paved; "
-                  "0: off; skipped with --raised-check's warning)")
-        ->default_val(0.0);
-    c->add_option("--roof-check-score", o_.roof_check_score,
-                  "--roof-check: only where that class's score (with --class-from views its "
-                  "share of the blending weight along the ray) is at least this")
-        ->default_val(0.0);
     c->add_option("--ground-window", o_.ground_window,
                   "--raised-check, --pit-depth, --spike-height: the ground is a low percentile of "
                   "the DSM in windows of this side (map units)")

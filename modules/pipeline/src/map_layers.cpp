@@ -49,14 +49,6 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
     throw Error(what, "--spike-clearance", "a distance >= 0 in map units",
                 std::to_string(o.spike_clearance));
   }
-  if (!(o.roof_check >= 0 && o.roof_check <= 1)) {
-    throw Error(what, "--roof-check", "a share of the raised class's height in [0, 1] (0: off)",
-                std::to_string(o.roof_check));
-  }
-  if (!(o.roof_check_score >= 0 && o.roof_check_score <= 1)) {
-    throw Error(what, "--roof-check-score", "a score in [0, 1]",
-                std::to_string(o.roof_check_score));
-  }
   if (o.trim_whole_under < 0) {
     throw Error(what, "--trim-whole-under", "a number of Gaussians >= 0",
                 std::to_string(o.trim_whole_under));
@@ -73,8 +65,6 @@ OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* wh
   r.pit_depth = o.pit_depth;
   r.spike_height = o.spike_height;
   r.spike_clearance = o.spike_clearance;
-  r.roof_share = o.roof_check;
-  r.roof_min_score = o.roof_check_score;
   r.ground_window = o.ground_window;
   r.min_views = o.min_views;
   r.min_spread_degrees = o.min_spread;
@@ -146,7 +136,6 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["raised_check"] = o.raised_check;
   j["pit_depth"] = o.pit_depth;
   j["spike_height"] = o.spike_height;
-  j["roof_check"] = o.roof_check;
   if (o.spike_height > 0) j["spike_clearance"] = o.spike_clearance;
   j["trim"] = trimClasses(o, classes);
   if (!j["trim"].empty()) {
@@ -154,8 +143,7 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
     j["trim_whole_under"] = o.trim_whole_under;
     j["trimmed_share"] = img.classes.empty() ? 0.0 : double(img.trimmed_cells) / img.classes.size();
   }
-  if (o.roof_check > 0) j["roof_check_score"] = o.roof_check_score;
-  if (o.raised_check <= 0 && o.pit_depth <= 0 && o.spike_height <= 0 && o.roof_check <= 0) return;
+  if (o.raised_check <= 0 && o.pit_depth <= 0 && o.spike_height <= 0) return;
   j["ground_window"] = o.ground_window;
   nlohmann::json heights = nlohmann::json::object(), raised = nlohmann::json::array();
   for (std::size_t c = 0; c < img.class_height_above_ground.size() && c < classes.size(); ++c) {
@@ -173,8 +161,6 @@ void addRenderOptions(nlohmann::json& j, const OrthoRunOptions& o, const OrthoIm
   j["pit_depth_applied"] = o.pit_depth > 0 && img.near_ground >= geo::kMinNearGround;
   j["spike_lowered_share"] = n ? double(img.lowered_spikes) / n : 0.0;
   j["spike_height_applied"] = o.spike_height > 0 && img.near_ground >= geo::kMinNearGround;
-  j["roof_raised_share"] = n ? double(img.raised_roofs) / n : 0.0;
-  j["roof_check_applied"] = o.roof_check > 0 && img.near_ground >= geo::kMinNearGround;
 }
 
 ClassObjects classObjects(const OrthoImages& img, const std::vector<int>& wanted, double step,

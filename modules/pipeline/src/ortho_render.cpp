@@ -325,45 +325,6 @@ void lowerRaisedCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
   relabelCells(trainer, grid, options, keep, tile, cells, out.ground_classes, out);
 }
 
-// OrthoRenderOptions::roof_share: the ground-class cells standing at a raised class's height given
-// the raised class with the highest score there, where it scores roof_min_score and the cell
-// stands roof_share x that class's own median height above the ground.
-void raiseRoofCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
-                    const OrthoRenderOptions& options, const at::Tensor& keep, int tile,
-                    OrthoImages& out) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (int c : out.raised_classes) lowest = std::min(lowest, out.class_height_above_ground[c]);
-  if (!std::isfinite(lowest) || out.ground_classes.empty()) return;
-  std::vector<std::uint8_t> ground(256, 0);
-  for (int c : out.ground_classes) ground[static_cast<std::size_t>(c)] = 1;
-  std::vector<std::size_t> cells;
-  for (std::size_t i = 0; i < out.classes.size(); ++i) {
-    if (out.covered[i] && ground[out.classes[i]] && std::isfinite(out.ground[i]) &&
-        out.elevation[i] - out.ground[i] >= options.roof_share * lowest) {
-      cells.push_back(i);
-    }
-  }
-  std::vector<std::uint8_t> before(cells.size());
-  std::vector<float> before_confidence(cells.size());
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    before[k] = out.classes[cells[k]];
-    before_confidence[k] = out.confidence[cells[k]];
-  }
-  relabelCells(trainer, grid, options, keep, tile, cells, out.raised_classes, out);
-  out.raised_roofs = 0;
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    const std::size_t i = cells[k];
-    const double above = out.elevation[i] - out.ground[i];
-    if (out.confidence[i] >= options.roof_min_score &&
-        above >= options.roof_share * out.class_height_above_ground[out.classes[i]]) {
-      ++out.raised_roofs;
-    } else {
-      out.classes[i] = before[k];
-      out.confidence[i] = before_confidence[k];
-    }
-  }
-}
-
 // OrthoRenderOptions::trim_classes: the objects' cells outside their Gaussians' hull given the
 // class around them (map units: the window's half side).
 constexpr double kTrimWindow = 1.0;
@@ -583,8 +544,8 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     }
     out.few_views = few.numel();
   }
-  const bool ground_checks = options.raised_share > 0 || options.pit_depth > 0 ||
-                             options.spike_height > 0 || options.roof_share > 0;
+  const bool ground_checks =
+      options.raised_share > 0 || options.pit_depth > 0 || options.spike_height > 0;
   if (ground_checks && trainer.numClasses() > 0) {
     const std::vector<std::size_t> low =
         placeClassesOnGround(grid, options, static_cast<int>(trainer.numClasses()), out);
@@ -592,8 +553,7 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
     std::string checks;
     for (const auto& [on, flag] : {std::pair{options.raised_share > 0, "--raised-check"},
                                    std::pair{options.pit_depth > 0, "--pit-depth"},
-                                   std::pair{options.spike_height > 0, "--spike-height"},
-                                   std::pair{options.roof_share > 0, "--roof-check"}}) {
+                                   std::pair{options.spike_height > 0, "--spike-height"}}) {
       if (on) checks += (checks.empty() ? "" : ", ") + std::string(flag);
     }
     if (out.near_ground < geo::kMinNearGround) {
@@ -612,13 +572,6 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
       if (progress && options.pit_depth > 0) {
         *progress << "  ortho: " << out.filled_pits << " cells of a ground class more than "
                   << options.pit_depth << " below the ground classes around them raised to them\n";
-      }
-      if (options.roof_share > 0) {
-        raiseRoofCells(trainer, grid, options, keep, tile, out);
-        if (progress) {
-          *progress << "  ortho: " << out.raised_roofs
-                    << " cells of a ground class at a raised class's height given that class\n";
-        }
       }
     }
   }

@@ -64,10 +64,6 @@ struct OrthoRunOptions {
   /// --spike-clearance M (OrthoRenderOptions::spike_clearance): 4 of 0 / 1 / 2 / 4 m kept the
   /// roofs best on those runs.
   double spike_clearance = 4;
-  /// --roof-check SHARE (OrthoRenderOptions::roof_share; 0: off) and --roof-check-score S
-  /// (roof_min_score): ground-class cells at a raised class's height take that class.
-  double roof_check = 0;
-  double roof_check_score = 0;
   double ground_window = 20;  ///< --ground-window M (OrthoRenderOptions::ground_window)
   /// --vectors: classes (names) whose objects go to OUT/vectors.gpkg as polygons (none: no file)
   std::vector<std::string> vectors;

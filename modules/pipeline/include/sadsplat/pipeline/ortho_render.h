@@ -116,14 +116,6 @@ struct OrthoRenderOptions {
   /// spike_height spares the cells within this of a raised class's cell (map units): a roof
   /// cell the class map calls road or paved stands at the roof's height.
   double spike_clearance = 0;
-  /// The converse of the raised check: a cell of a ground class standing at least roof_share x
-  /// a raised class's median height above the ground takes the raised class with the highest
-  /// score there, if that class's score (with class source kViews its share of the blending
-  /// weight) is at least roof_min_score and the cell stands at least roof_share x that class's
-  /// own median: a roof the class map calls paved. Needs the ground model, so it is skipped
-  /// where the raised check is. 0: off.
-  double roof_share = 0;
-  double roof_min_score = 0;  ///< see roof_share
   double raised_height = 2.5;                    ///< map units
   double ground_window = 20;                     ///< map units
   std::vector<gaussians::RasterCamera> cameras;  ///< the training cameras
@@ -168,7 +160,6 @@ struct OrthoImages {
   std::vector<int> ground_classes;  ///< geo::LowRaisedCells::ground
   std::int64_t filled_pits = 0;     ///< cells OrthoRenderOptions::pit_depth raised
   std::int64_t lowered_spikes = 0;  ///< cells OrthoRenderOptions::spike_height lowered
-  std::int64_t raised_roofs = 0;    ///< cells OrthoRenderOptions::roof_share gave a raised class
   double near_ground = 0;           ///< geo::LowRaisedCells::near_ground (the check's precondition)
   std::int64_t trimmed_cells = 0;   ///< cells OrthoRenderOptions::trim_classes gave another class
 };
