@@ -7,6 +7,7 @@
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/gltf_splats.h"
 #include "sadsplat/pipeline/globe_export.h"
+#include "sadsplat/pipeline/las_frame.h"
 
 namespace sadsplat {
 namespace cli {
@@ -43,7 +44,8 @@ class ConvertCommand : public Command {
       return 0;
     }
     if (io::lowerExtension(out_) == ".las") {
-      const geo::LasExportOptions options = geo::lasOptionsBeside(in_, classification_map_);
+      const geo::LasExportOptions options =
+          pipeline::lasOptionsForModel(in_, classification_map_, &std::cerr);
       std::cout << (io::cloudKind(in_) == io::CloudKind::kSemantic
                         ? geo::writeSemanticLas(out_, io::readSemanticCloud(in_), options)
                         : geo::writeGaussiansLas(out_, io::readGaussians(in_), options))

@@ -12,6 +12,7 @@
 #include "sadsplat/io/scene_cache.h"
 #include "sadsplat/io/scene_import.h"
 #include "sadsplat/pipeline/labelled_cloud.h"
+#include "sadsplat/pipeline/las_frame.h"
 #include "sadsplat/pipeline/raised_gaussians.h"
 
 namespace sadsplat {
@@ -89,7 +90,7 @@ class ExtractCommand : public Command {
     const bool las = io::lowerExtension(out_) == ".las";
     geo::LasExportOptions las_options;
     if (las) {
-      las_options = geo::lasOptionsBeside(in, classification_map_);
+      las_options = pipeline::lasOptionsForModel(in, classification_map_, &std::cerr);
       if (!classes.empty()) {
         las_options.classes = io::isSceneCache(classes) ? io::readSceneCache(classes).classes
                                                         : io::readClassesJson(classes);
