@@ -23,8 +23,8 @@ class ConvertCommand : public Command {
     c->add_option("IN", in_, "input .ply, .pcd, .splat, .spz, .sog or .compressed.ply")->required();
     c->add_option("OUT", out_,
                   "output .ply, .pcd, .splat, .spz, .sog (PlayCanvas), .las (LAS 1.4: centres, "
-                  "colour, ASPRS "
-                  "class, in the georeference's UTM zone) or .glb (glTF KHR_gaussian_splatting, "
+                  "colour, ASPRS class, in the georeference's UTM zone, else in the maps' local "
+                  "metres, z up) or .glb (glTF KHR_gaussian_splatting, "
                   "SPZ-compressed, classes as feature IDs, upright in glTF's y-up axes); "
                   "classes.json and georeference.json are read from the input's folder")
         ->required();
