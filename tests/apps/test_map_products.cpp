@@ -426,7 +426,7 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
 }
 
 // `ortho --class-from views`: the class map from the classes the training views give the
-// Gaussians (OrthoSurface::kViews); its confidence is the class's share of the blending weight,
+// Gaussians (OrthoClassSource::kViews); its confidence is the class's share of the blending weight,
 // at least 1 / classes wherever a class is given; the covered cells and the DSM are the blend's.
 TEST_F(MapProducts, OrthoClassFromViewsGivesEveryCoveredCellAClassAndAWeightShare) {
   // Without the checks that move classes or heights after the render (each its own test).

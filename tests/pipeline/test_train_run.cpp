@@ -264,7 +264,7 @@ TEST(LabelledCloud, EachGaussianTakesTheClassTheViewsRenderWhereItDraws) {
 
 // Trainer::renderCameraWith composites any per-Gaussian rows as the features are composited: the
 // model's own features give its render's features; one-hot classes give per pixel weights that
-// sum to the alpha. `ortho --class-from views` (OrthoSurface::kViews) takes the class with the
+// sum to the alpha. `ortho --class-from views` (OrthoClassSource::kViews) takes the class with the
 // most of that weight: every Gaussian of one class gives that class everywhere, at confidence 1.
 TEST(LabelledCloud, OneHotClassesRenderAsBlendingWeightsAndMakeTheViewsClassMap) {
   test::TempDir dir;
@@ -288,7 +288,7 @@ TEST(LabelledCloud, OneHotClassesRenderAsBlendingWeightsAndMakeTheViewsClassMap)
   EXPECT_THROW(trainer.renderCameraWith(cam, at::zeros({n - 1, k})), Error);
 
   pipeline::OrthoRenderOptions options;
-  options.classes = pipeline::OrthoSurface::kViews;
+  options.classes = pipeline::OrthoClassSource::kViews;
   const pipeline::OrthoGrid grid = pipeline::footprintGrid(trainer, run.scene, 0.05);
   EXPECT_THROW(pipeline::renderOrtho(trainer, grid, options), Error);  // no classes given
   options.gaussian_classes.assign(static_cast<std::size_t>(n), static_cast<std::uint32_t>(k - 1));

@@ -18,7 +18,7 @@ namespace pipeline {
 OrthoRenderOptions checkedRenderOptions(const OrthoRunOptions& o, const char* what) {
   OrthoRenderOptions r;
   r.height = parseOrthoSurface(o.height, "--height");
-  r.classes = parseOrthoSurface(o.class_from, "--class-from", true);
+  r.classes = parseOrthoClassSource(o.class_from, "--class-from");
   if (o.min_views < 0) {
     throw Error(what, "--min-views", "a number of photos >= 0", std::to_string(o.min_views));
   }
@@ -112,7 +112,7 @@ pcl::PointCloud<GaussianPoint> setGaussianClasses(OrthoRenderOptions& render,
       throw Error(what, "--trim", "class names, or auto / none alone", n + " among others");
     }
   }
-  const bool views = render.classes == OrthoSurface::kViews;
+  const bool views = render.classes == OrthoClassSource::kViews;
   if ((names.empty() && !views) || trainer.numClasses() == 0) return {};
   if (!names.empty()) {
     render.trim_classes = classIdsOf(names, scene.classes, what, "--trim");

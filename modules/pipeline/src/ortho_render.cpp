@@ -163,12 +163,17 @@ std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene) {
   return cameras;
 }
 
-OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field,
-                               bool views_allowed) {
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field) {
   if (text == "first") return OrthoSurface::kFirst;
   if (text == "blend") return OrthoSurface::kBlend;
-  if (text == "views" && views_allowed) return OrthoSurface::kViews;
-  throw Error("<ortho>", field, views_allowed ? "first, blend or views" : "first or blend", text);
+  throw Error("<ortho>", field, "first or blend", text);
+}
+
+OrthoClassSource parseOrthoClassSource(const std::string& text, const std::string& field) {
+  if (text == "views") return OrthoClassSource::kViews;
+  if (text == "blend") return OrthoClassSource::kBlend;
+  if (text == "first") return OrthoClassSource::kFirst;
+  throw Error("<ortho>", field, "first, blend or views", text);
 }
 
 namespace {
@@ -212,7 +217,7 @@ std::vector<OrthoTile> orthoTiles(const OrthoGrid& grid, int tile) {
   return tiles;
 }
 
-// OrthoRenderOptions::gaussian_classes one-hot ([N, classes]) for OrthoSurface::kViews.
+// OrthoRenderOptions::gaussian_classes one-hot ([N, classes]) for OrthoClassSource::kViews.
 at::Tensor oneHotClasses(const gaussians::Trainer& trainer, const OrthoRenderOptions& options) {
   const int k = trainer.numClasses();
   if (options.gaussian_classes.size() != static_cast<std::size_t>(trainer.numGaussians())) {
@@ -227,15 +232,16 @@ at::Tensor oneHotClasses(const gaussians::Trainer& trainer, const OrthoRenderOpt
 
 // What one tile composites for the class map (OrthoRenderOptions::classes): the trained features
 // along the whole ray (kBlend) or in front of the first surface (kFirst), or each class's
-// blending weight (kViews: the Gaussians carrying oneHotClasses).
+// blending weight (kViews: the Gaussians carrying `one_hot`, oneHotClasses made once per map).
 at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
-                         const OrthoRenderOptions& options, const at::Tensor& keep) {
+                         const OrthoRenderOptions& options, const at::Tensor& keep,
+                         const at::Tensor& one_hot) {
   switch (options.classes) {
-    case OrthoSurface::kFirst:
+    case OrthoClassSource::kFirst:
       return trainer.renderSurface(camera, 0.5, true, keep).features;
-    case OrthoSurface::kViews:
-      return trainer.renderCameraWith(camera, oneHotClasses(trainer, options), keep).features;
-    case OrthoSurface::kBlend:
+    case OrthoClassSource::kViews:
+      return trainer.renderCameraWith(camera, one_hot, keep).features;
+    case OrthoClassSource::kBlend:
       break;
   }
   return trainer.renderCamera(camera, keep).features;
@@ -243,10 +249,10 @@ at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::Ras
 
 // Per cell and class [h, w, classes], a score whose maximum is the cell's class and its
 // confidence, from classFeatures' image (`features`): the cosines of the decoded feature, or with
-// OrthoSurface::kViews each class's share of the blending weight.
+// OrthoClassSource::kViews each class's share of the blending weight.
 at::Tensor classScores(const gaussians::Trainer& trainer, const OrthoRenderOptions& options,
                        const at::Tensor& features) {
-  if (options.classes == OrthoSurface::kViews) {
+  if (options.classes == OrthoClassSource::kViews) {
     return features / features.sum(2, true).clamp_min(1e-12);
   }
   return trainer.classCosines(features);
@@ -287,6 +293,8 @@ void relabelCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
                   OrthoImages& out) {
   const int k = static_cast<int>(trainer.numClasses());
   if (cells.empty()) return;
+  const at::Tensor one_hot =
+      options.classes == OrthoClassSource::kViews ? oneHotClasses(trainer, options) : at::Tensor();
   std::vector<std::uint8_t> lower(out.classes.size(), 0);
   for (std::size_t c : cells) lower[c] = 1;
   for (const OrthoTile& t : orthoTiles(grid, tile)) {
@@ -297,7 +305,7 @@ void relabelCells(const gaussians::Trainer& trainer, const OrthoGrid& grid,
     if (!any) continue;
     const gaussians::RasterCamera camera = orthoCamera(grid, t.x_off, t.y_off, t.w, t.h);
     at::Tensor cosines =
-        classScores(trainer, options, classFeatures(trainer, camera, options, keep));
+        classScores(trainer, options, classFeatures(trainer, camera, options, keep, one_hot));
     at::Tensor others = at::ones({k}, at::kBool);
     for (int c : allowed) others[c] = false;
     cosines.index_fill_(2, others.nonzero().reshape(-1).to(cosines.device()), -1e30);
@@ -430,10 +438,10 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
   out.elevation.assign(pixels, 0.f);
   out.confidence.assign(pixels, 0.f);
   const bool first_height = options.height == OrthoSurface::kFirst;
-  const bool first_class = options.classes == OrthoSurface::kFirst;
+  const bool first_class = options.classes == OrthoClassSource::kFirst;
   // kViews: the Gaussians carry their classes one-hot in the tiles' render (its colour, alpha
   // and depth do not depend on the features), so one render gives the map and the class weights.
-  const at::Tensor one_hot = options.classes == OrthoSurface::kViews && trainer.numClasses() > 0
+  const at::Tensor one_hot = options.classes == OrthoClassSource::kViews && trainer.numClasses() > 0
                                  ? oneHotClasses(trainer, options)
                                  : at::Tensor();
   const std::vector<OrthoTile> tiles = orthoTiles(grid, tile);

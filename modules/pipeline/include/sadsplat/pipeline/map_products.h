@@ -41,7 +41,7 @@ struct OrthoRunOptions {
       gsd;  ///< metres per pixel (> 0); none = the photos' median ground sample distance
   std::optional<std::array<double, 4>> bounds;  ///< xmin, ymin, xmax, ymax in the map CRS
   std::string height = "first";      ///< --height first|blend (ortho_render.h, OrthoSurface)
-  /// --class-from views|blend|first (OrthoSurface): the views' classes gave a class map higher
+  /// --class-from views|blend|first (OrthoClassSource): the views' classes gave a class map higher
   /// than or equal to the blend's on 16 of 16 synth runs (orbits +2.2 to +4.5 points;
   /// docs/measurements/cloud_3d).
   std::string class_from = "views";

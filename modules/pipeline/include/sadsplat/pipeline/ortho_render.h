@@ -46,19 +46,26 @@ double orthoTop(const gaussians::Trainer& trainer, const geo::MapFrame& frame);
 /// \brief The orthographic camera of the grid's pixels [x_off, x_off + w) x [y_off, y_off + h).
 gaussians::RasterCamera orthoCamera(const OrthoGrid& grid, int x_off, int y_off, int w, int h);
 
-/// \brief Where along a cell's vertical ray the map takes its height or its class from.
+/// \brief Where along a cell's vertical ray the DSM takes its height from.
 enum class OrthoSurface {
   /// The first surface: where the transmittance along the ray falls below 0.5
-  /// (gaussians/surface_layer.h): its height; the class of the Gaussians in front of it.
+  /// (gaussians/surface_layer.h).
   kFirst,
   /// The blend through every Gaussian on the ray: the expected depth (a floater or an
-  /// overhanging edge pulls it towards itself); the class of the composited feature.
+  /// overhanging edge pulls it towards itself).
   kBlend,
-  /// Classes only: the class with the most blending weight along the ray, each Gaussian counted
-  /// as the class the training views give it (OrthoRenderOptions::gaussian_classes,
-  /// labelled_cloud.h), not as its feature decodes top-down. Confidence: that class's share of
-  /// the weight.
+};
+
+/// \brief What a cell's class is made of.
+enum class OrthoClassSource {
+  /// The class with the most blending weight along the ray, each Gaussian counted as the class
+  /// the training views give it (OrthoRenderOptions::gaussian_classes, labelled_cloud.h), not as
+  /// its feature decodes top-down. Confidence: that class's share of the weight.
   kViews,
+  /// The class of the feature composited through every Gaussian on the ray.
+  kBlend,
+  /// The class of the feature composited in front of the first surface (OrthoSurface::kFirst).
+  kFirst,
 };
 
 /// \brief How the map is rendered.
@@ -69,7 +76,7 @@ struct OrthoRenderOptions {
   /// The class map: the blend's class scores 1.5-5 points mIoU above the first surface's on the
   /// same runs (the features are trained as blends). kViews scores higher still but needs
   /// gaussian_classes (the CLI's default, map_products.h); here the blend needs nothing.
-  OrthoSurface classes = OrthoSurface::kBlend;
+  OrthoClassSource classes = OrthoClassSource::kBlend;
   /// A covered cell whose surface point fewer than this many of `cameras` see unoccluded is
   /// nodata (gaussians::seenUnoccluded against each camera's depth render): a surface only one
   /// photo sees has no depth from the photos (the survey's edges), one no photo sees (an alley
@@ -146,7 +153,7 @@ struct OrthoImages {
   std::vector<std::uint8_t>
       classes;                   ///< class id, 255 = none (uncovered, or a model without classes)
   std::vector<float> elevation;  ///< map height of the rendered surface (OrthoSurface)
-  /// Trainer::classCosines of the class (0 without classes); with OrthoSurface::kViews the
+  /// Trainer::classCosines of the class (0 without classes); with OrthoClassSource::kViews the
   /// class's share of the blending weight.
   std::vector<float> confidence;
   std::int64_t few_views = 0;  ///< cells with a surface made nodata by min_views
@@ -174,11 +181,13 @@ OrthoImages renderOrtho(const gaussians::Trainer& trainer, const OrthoGrid& grid
 /// \brief The scene's training cameras (OrthoRenderOptions::cameras).
 std::vector<gaussians::RasterCamera> trainingCameras(const io::Scene& scene);
 
-/// \brief "first" or "blend" (and "views" where `views_allowed`: the class map's) as an
-/// OrthoSurface.
+/// \brief "first" or "blend" as an OrthoSurface.
 /// \throws sadsplat::Error naming `field` for any other text
-OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field,
-                               bool views_allowed = false);
+OrthoSurface parseOrthoSurface(const std::string& text, const std::string& field);
+
+/// \brief "views", "blend" or "first" as an OrthoClassSource.
+/// \throws sadsplat::Error naming `field` for any other text
+OrthoClassSource parseOrthoClassSource(const std::string& text, const std::string& field);
 
 }  // namespace pipeline
 }  // namespace sadsplat
