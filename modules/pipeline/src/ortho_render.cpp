@@ -232,7 +232,8 @@ at::Tensor oneHotClasses(const gaussians::Trainer& trainer, const OrthoRenderOpt
 
 // What one tile composites for the class map (OrthoRenderOptions::classes): the trained features
 // along the whole ray (kBlend) or in front of the first surface (kFirst), or each class's
-// blending weight (kViews: the Gaussians carrying `one_hot`, oneHotClasses made once per map).
+// blending weight (kViews: the Gaussians carrying `one_hot`, oneHotClasses made once per map and
+// once per relabelling pass).
 at::Tensor classFeatures(const gaussians::Trainer& trainer, const gaussians::RasterCamera& camera,
                          const OrthoRenderOptions& options, const at::Tensor& keep,
                          const at::Tensor& one_hot) {
