@@ -111,13 +111,15 @@ std::string writeSemanticLas(const std::string& path,
   return finish(path, points, xyz, o);
 }
 
+std::string modelFolder(const std::string& model_path) {
+  if (io::isDirectory(model_path)) return model_path;
+  const std::size_t slash = model_path.find_last_of('/');
+  return slash == std::string::npos ? "." : model_path.substr(0, slash);
+}
+
 LasExportOptions lasOptionsBeside(const std::string& model_path,
                                   const std::string& classification_map) {
-  std::string dir = model_path;
-  if (!io::isDirectory(dir)) {
-    const std::size_t slash = model_path.find_last_of('/');
-    dir = slash == std::string::npos ? "." : model_path.substr(0, slash);
-  }
+  const std::string dir = modelFolder(model_path);
   LasExportOptions o;
   o.classification_map = classification_map;
   // A model's run directory (or any folder holding a model with these files beside it).

@@ -1,6 +1,5 @@
 #include "sadsplat/pipeline/las_frame.h"
 
-#include "sadsplat/common/error.h"
 #include "sadsplat/geo/map_frame.h"
 #include "sadsplat/io/filesystem.h"
 #include "sadsplat/io/scene_import.h"
@@ -15,12 +14,7 @@ geo::LasExportOptions lasOptionsForModel(const std::string& model_path,
                                          std::ostream* notes) {
   geo::LasExportOptions options = geo::lasOptionsBeside(model_path, classification_map);
   if (options.georeference) return options;
-  std::string dir = model_path;
-  if (!io::isDirectory(dir)) {
-    const std::size_t slash = model_path.find_last_of('/');
-    dir = slash == std::string::npos ? "." : model_path.substr(0, slash);
-  }
-  const io::RunDirectory run(dir);
+  const io::RunDirectory run(geo::modelFolder(model_path));
   const auto axes = [&](const std::string& why) {
     if (notes != nullptr) {
       *notes << "sadsplat: note: " << why

@@ -40,6 +40,10 @@ std::string writeSemanticLas(const std::string& path,
                              const pcl::PointCloud<pcl::PointXYZRGBL>& cloud,
                              const LasExportOptions& options);
 
+/// \brief The folder of a model file, or a run directory itself: where its classes.json,
+/// georeference.json and run.json lie.
+std::string modelFolder(const std::string& model_path);
+
 /// \brief For a model file (or run directory) MODEL: the classes.json and georeference.json next
 /// to it (a run directory has both), for `convert` / `extract`.
 LasExportOptions lasOptionsBeside(const std::string& model_path,
