@@ -783,6 +783,34 @@ TEST_F(MapProducts, EvalOrthoScoresTheClassMapAgainstTheSynthTruth) {
   EXPECT_GT(j["dsm"]["off_step_cells"].get<int>(), 0) << out;
   EXPECT_LT(j["dsm"]["off_step_cells"].get<int>(), j["dsm"]["cells"].get<int>()) << out;
   EXPECT_GT(j["dsm"]["nmad_m"].get<double>(), 0.0) << out;
+  // The confusion matrix agrees with the areas and the IoUs it is the source of: a row and its
+  // nodata cells are the true class's cells, a column the mapped class's cells.
+  const nlohmann::json& cm = j["confusion"];
+  const auto classes = cm["classes"].get<std::vector<std::string>>();
+  ASSERT_EQ(cm["cells"].size(), classes.size()) << out;
+  const double cell_m2 = 0.25 * 0.25;
+  std::int64_t all = 0;
+  for (std::size_t t = 0; t < classes.size(); ++t) {
+    std::int64_t row = 0, column = 0;
+    for (std::size_t p = 0; p < classes.size(); ++p) {
+      row += cm["cells"][t][p].get<std::int64_t>();
+      column += cm["cells"][p][t].get<std::int64_t>();
+    }
+    all += row + cm["nodata_cells"][t].get<std::int64_t>();
+    const nlohmann::json& a = j["area"][classes[t]];
+    EXPECT_DOUBLE_EQ((row + cm["nodata_cells"][t].get<std::int64_t>()) * cell_m2,
+                     a["truth_m2"].get<double>())
+        << classes[t];
+    EXPECT_DOUBLE_EQ(row * cell_m2, a["truth_covered_m2"].get<double>()) << classes[t];
+    EXPECT_DOUBLE_EQ(column * cell_m2, a["predicted_m2"].get<double>()) << classes[t];
+    const std::int64_t tp = cm["cells"][t][t].get<std::int64_t>();
+    if (row + column > 0) {
+      EXPECT_NEAR(double(tp) / double(row + column - tp),
+                  j["per_class_iou"][classes[t]].get<double>(), 1e-12)
+          << classes[t];
+    }
+  }
+  EXPECT_EQ(all, j["cells"].get<std::int64_t>());
   // The class map near the grid's centre: three discs, the largest the widest.
   ASSERT_EQ(j["miou_within"].size(), 3u) << out;
   EXPECT_DOUBLE_EQ(j["miou_within"][0]["radius_m"].get<double>(), 50.0);

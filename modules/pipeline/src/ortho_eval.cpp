@@ -179,6 +179,18 @@ std::string evalOrthoRun(const std::string& run_dir, const std::string& truth_js
   }
   j["per_class_iou"] = per_class;
   j["area"] = area;
+  // Where each true class went, in cells: rows the true class, columns the mapped class (the
+  // scene's class order, as `classes`), and per true class its cells the map leaves nodata.
+  nlohmann::json matrix = nlohmann::json::array(), nodata = nlohmann::json::array(),
+                 names = nlohmann::json::array();
+  for (int t = 0; t < C; ++t) {
+    names.push_back(run.scene.classes[t].name);
+    nlohmann::json row = nlohmann::json::array();
+    for (int p = 0; p < C; ++p) row.push_back(confusion.at(t, p));
+    matrix.push_back(row);
+    nodata.push_back(truth_cells[t] - truth_covered[t]);
+  }
+  j["confusion"] = {{"classes", names}, {"cells", matrix}, {"nodata_cells", nodata}};
   // DSM error (the rendered elevation against the true top surface's height) over covered cells
   // of the labelled area, all and per true class: roofs, ground, vegetation apart; also away
   // from the truth's height steps (walls), where a fraction of a cell costs metres.
