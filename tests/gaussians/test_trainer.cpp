@@ -429,57 +429,6 @@ TEST_P(TrainerOnDevice, FloatersArePrunedAtTheEndOnlyWhenAsked) {
   EXPECT_EQ(pruned.numGaussians(), plain.numGaussians() - last.removed_floaters);
 }
 
-// The surface prune removes, at its iteration, exactly the Gaussians whose gap to the rendered
-// surface (the cloud's check, renderedDepthResiduals) exceeds the limit, and those no training
-// view draws; off by default, and the training goes on consistently after it.
-TEST_P(TrainerOnDevice, SurfacePruneRemovesTheGaussiansOffTheRenderedSurface) {
-  TrainConfig c = small(12);
-  Trainer plain(scene_, c);
-  gaussians::StepStats last;
-  for (int i = 0; i < 8; ++i) {
-    last = plain.step();
-    EXPECT_EQ(last.removed_off_surface, 0);
-  }
-  std::vector<gaussians::RasterCamera> training;
-  for (const io::View& v : scene_.views) {
-    if (v.train) training.push_back(gaussians::RasterCamera::fromPinhole(v.camera));
-  }
-  const at::Tensor gaps =
-      plain.renderedDepthResiduals(training, gaussians::SurfaceDepth::kMedianWhereSeen).cpu();
-  const at::Tensor finite = gaps.masked_select(at::isfinite(gaps));
-  ASSERT_GT(finite.numel(), 10);
-  const double limit = finite.median().item<double>();
-  ASSERT_GT(limit, 0);
-  const std::int64_t expected = (gaps > limit).sum().item<std::int64_t>();
-  ASSERT_GT(expected, 0);
-  ASSERT_LT(expected, plain.numGaussians());
-
-  c.surface_prune_gap = limit;
-  c.surface_prune_at = 8;
-  Trainer pruned(scene_, c);
-  for (int i = 0; i < 7; ++i) EXPECT_EQ(pruned.step().removed_off_surface, 0);
-  const std::int64_t before = pruned.numGaussians();
-  last = pruned.step();
-  // The same training up to the prune (CPU: bit for bit; CUDA: to rounding, so near the limit a
-  // Gaussian may fall on the other side).
-  const double slack = GetParam() == "cpu" ? 0 : 0.02 * expected + 1;
-  EXPECT_NEAR(last.removed_off_surface, expected, slack);
-  EXPECT_EQ(pruned.numGaussians(), before - last.removed_off_surface);
-  pruned.checkConsistency();
-  for (int i = 0; i < 4; ++i) EXPECT_EQ(pruned.step().removed_off_surface, 0);
-  pruned.checkConsistency();
-  EXPECT_EQ(pruned.iteration(), 12);
-}
-
-// -1 resolves to 2/7 of the iterations before the end (5000 of 7000), as scale_limit_from does.
-TEST(TrainSchedule, SurfacePruneIterationResolvesFromTheIterations) {
-  TrainConfig c;
-  c.iterations = 7000;
-  EXPECT_EQ(gaussians::resolveDerivedKeys(c).surface_prune_at, 5000);
-  c.surface_prune_at = 1234;
-  EXPECT_EQ(gaussians::resolveDerivedKeys(c).surface_prune_at, 1234);
-}
-
 TEST_P(TrainerOnDevice, ClosedGatesArePrunedByDensificationAndAtTheEnd) {
   TrainConfig c = small(30);
   c.densify_from = 5;

@@ -76,7 +76,6 @@ ResolvedSchedule resolveSchedule(const TrainConfig& config, const ScheduleReques
 TrainConfig resolveDerivedKeys(TrainConfig c) {
   c.densify_until = densifyUntilResolved(c);
   if (c.scale_limit_from < 0) c.scale_limit_from = c.iterations - c.iterations / 7;
-  if (c.surface_prune_at < 0) c.surface_prune_at = c.iterations - 2 * (c.iterations / 7);
   return c;
 }
 
@@ -97,8 +96,7 @@ TrainConfig forGlobalBatch(const TrainConfig& config, int views) {
   for (int* count :
        {&c.iterations, &c.sh_increase_interval, &c.densify_from, &c.densify_until,
         &c.densify_interval, &c.opacity_reset_interval, &c.checkpoint_interval, &c.drop_interval,
-        &c.recovery_iterations, &c.lambda_l0_from, &c.lambda_l0_ramp, &c.scale_limit_from,
-        &c.surface_prune_at}) {
+        &c.recovery_iterations, &c.lambda_l0_from, &c.lambda_l0_ramp, &c.scale_limit_from}) {
     *count = steps(*count);
   }
   const double lr = std::sqrt(static_cast<double>(views));

@@ -170,13 +170,6 @@ const std::vector<TrainOption> kOptions = {
      "--prune-floaters"},
     {"floater_min_views", &C::floater_min_views, "see prune_floaters", nullptr, 0, kInf},
     {"floater_max_scale", &C::floater_max_scale, "see prune_floaters", nullptr, 0, kInf},
-    {"surface_prune_gap", &C::surface_prune_gap,
-     "at surface_prune_at remove the Gaussians farther than this (scene units) from the surface "
-     "the training views render where they draw them, and those no view draws (0: off)",
-     "--surface-prune", 0, kInf},
-    {"surface_prune_at", &C::surface_prune_at,
-     "the iteration of the surface prune (-1: iterations - 2 x iterations / 7, 5000 of 7000)",
-     "--surface-prune-at", -1, kInf},
     {"drop", &C::drop, "the semantic-aware drop", "--drop"},
     {"p_base", &C::p_base, "base drop rate P_base (paper: 1.0)", "--p-base", 0, kInf},
     {"drop_interval", &C::drop_interval, "iterations between drops (paper: 500)", nullptr, 1, kInf},

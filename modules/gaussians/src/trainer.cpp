@@ -129,26 +129,6 @@ struct Trainer::State {
     return settings;
   }
 
-  // TrainConfig::surface_prune_gap: removes the Gaussians farther than the gap from the median
-  // depth the training views render where they draw them (the cloud's surface check,
-  // Trainer::renderedDepthResiduals), and those no view draws; returns how many. Every rank
-  // computes the same gaps from the same model and all training cameras, so their rows agree.
-  std::int64_t pruneOffSurface() {
-    c10::AutoGradMode no_grad(false);
-    const GaussianParams g = evaluationGaussians();
-    const std::vector<RasterCamera> cameras = views.trainingCameras();
-    const at::Tensor gaps = gapsFromCameraSums(g.means.size(0), at::kCPU, cameras.size(),
-                                               [&](std::size_t k) {
-                                                 return surfaceGapSums(g, cameras[k], 0.5);
-                                               });
-    const at::Tensor keep = (gaps <= config.surface_prune_gap).to(device);
-    const std::int64_t removed = params.rows() - keep.sum().item<std::int64_t>();
-    // A model with no Gaussian on its own surface (nothing drawn yet) is left as it is.
-    if (removed == 0 || removed == params.rows()) return 0;
-    resize(keep, {});
-    return removed;
-  }
-
   // The mean squared error of the drop guard's probe views, rendered as evaluation renders them
   // (deterministic gates, no features). Every rank renders the same views of the same model; the
   // mean over the ranks makes their guards agree to the bit, so their drop events stay alike.
@@ -313,9 +293,6 @@ void Trainer::State::afterUpdate(int done, bool gated, StepStats& stats) {
   if (done == drop.recoveryStart()) {
     std::tie(stats.recovery_closed_gates, stats.recovery_pruned) =
         drop.settleGates(params, views, resizer());
-  }
-  if (c.surface_prune_gap > 0 && done == c.surface_prune_at && done < c.iterations) {
-    stats.removed_off_surface = pruneOffSurface();
   }
   if (done == c.iterations) {
     stats.removed_closed_gates = drop.removeClosedGates(params, done, resizer());

@@ -111,9 +111,6 @@ void TrainingReport::log(const gaussians::StepStats& s, double seconds, bool las
   }
   if (s.removed_closed_gates > 0)
     log_->append(eventRecord("closed_gates", s, s.removed_closed_gates));
-  if (s.removed_off_surface > 0) {
-    log_->append(eventRecord("off_surface", s, s.removed_off_surface));
-  }
   if (s.recovery_started) {
     io::TrainLogRecord r = eventRecord("recovery", s, s.recovery_closed_gates + s.recovery_pruned);
     r.closed_gate = s.recovery_closed_gates;
@@ -169,13 +166,6 @@ void TrainingReport::events(const gaussians::StepStats& stats,
         << stats.recovery_closed_gates << " Gaussians with a closed gate and "
         << stats.recovery_pruned << " least contributing ones, " << stats.num_gaussians << " left; "
         << config.recovery_iterations << " iterations without gates, L0 and drops follow\n";
-  }
-  if (stats.removed_off_surface > 0) {
-    out << "\n[surface prune] iteration " << it << ": removed " << stats.removed_off_surface
-        << " Gaussians farther than " << config.surface_prune_gap
-        << " from the surface the training views render where they draw them (or drawn by "
-           "none), "
-        << stats.num_gaussians << " left\n";
   }
   if (stats.removed_floaters > 0) {
     std::string rule;

@@ -33,8 +33,8 @@ struct ScheduleRequest {
   int batch_ranks = 0;
 };
 
-/// \brief A schedule resolved: the configuration the trainer runs (densify_until,
-/// scale_limit_from and surface_prune_at are never -1 in it) and one line per rule that changed keys.
+/// \brief A schedule resolved: the configuration the trainer runs (densify_until and
+/// scale_limit_from are never -1 in it) and one line per rule that changed keys.
 struct ResolvedSchedule {
   TrainConfig config;
   std::vector<std::string> notes;
@@ -46,8 +46,7 @@ struct ResolvedSchedule {
 ResolvedSchedule resolveSchedule(const TrainConfig& config, const ScheduleRequest& request = {});
 
 /// \brief The keys whose -1 means "from the number of iterations", resolved: densify_until
-/// (densifyUntilResolved), scale_limit_from (iterations - iterations / 7) and surface_prune_at
-/// (iterations - 2 x iterations / 7). Resolving twice
+/// (densifyUntilResolved) and scale_limit_from (iterations - iterations / 7). Resolving twice
 /// changes nothing; the trainer applies it to any configuration it is given.
 TrainConfig resolveDerivedKeys(TrainConfig config);
 

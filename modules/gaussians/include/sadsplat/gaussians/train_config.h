@@ -136,14 +136,6 @@ struct DensificationOptions {
   int scale_limit_from = -1;
   int floater_min_views = 2;
   double floater_max_scale = 0.1;
-  /// Not 3DGS: at iteration surface_prune_at, remove every Gaussian whose mean gap to the
-  /// surface the training views render where it is drawn (their median depth, where the
-  /// transmittance falls below 0.5; gaussians/surface_layer.h, the check of `extract
-  /// --on-surface`) exceeds surface_prune_gap scene units, and those no training view draws;
-  /// the remaining iterations adapt the rest. 0 = off.
-  double surface_prune_gap = 0.0;
-  /// -1 (default): iterations - 2 x iterations / 7 (5000 of 7000).
-  int surface_prune_at = -1;
 };
 
 /// \brief The semantic-aware drop (paper, "Gaussian Point Drop"); the trainer only carries these,

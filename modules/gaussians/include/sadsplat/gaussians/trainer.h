@@ -41,9 +41,6 @@ struct StepStats {
   std::int64_t removed_closed_gates = 0;
   /// After the last iteration, with TrainConfig::prune_floaters: the floaters removed.
   std::int64_t removed_floaters = 0;
-  /// At TrainConfig::surface_prune_at, with surface_prune_gap > 0: the Gaussians removed for
-  /// their gap to the rendered surface (or because no training view draws them).
-  std::int64_t removed_off_surface = 0;
   /// Whether the recovery phase (TrainConfig::recovery_iterations) starts after this step; if so
   /// the Gaussians removed then for a closed gate, and for their small contribution.
   bool recovery_started = false;
