@@ -367,7 +367,9 @@ TEST_F(MapProducts, OrthoPitDepthRaisesOnlyGroundClassCellsInPits) {
     EXPECT_TRUE(ground.count(cls.bytes[i])) << int(cls.bytes[i]);
   }
   EXPECT_NEAR(j["pit_filled_share"].get<double>(), double(changed) / a.size(), 1e-12);
-  if (!j["pit_depth_applied"].get<bool>()) EXPECT_EQ(changed, 0u);
+  if (!j["pit_depth_applied"].get<bool>()) {
+    EXPECT_EQ(changed, 0u);
+  }
   std::string out;
   EXPECT_EQ(test::runCommand(
                 kCli + " ortho " + run() + " --pit-depth -1 --out " + dir_->file("bad_pits"), &out),
@@ -411,7 +413,9 @@ TEST_F(MapProducts, OrthoSpikeHeightLowersOnlyGroundClassCellsStandingHigh) {
   }
   EXPECT_NEAR(j["spike_lowered_share"].get<double>(), double(changed) / a.size(), 1e-12);
   EXPECT_LE(changed_spared, changed);
-  if (!j["spike_height_applied"].get<bool>()) EXPECT_EQ(changed, 0u);
+  if (!j["spike_height_applied"].get<bool>()) {
+    EXPECT_EQ(changed, 0u);
+  }
   for (const char* bad :
        {"--spike-height -1", "--spike-clearance -1", "--trim none --trim-whole-under -1"}) {
     std::string out;
@@ -938,6 +942,19 @@ TEST_F(MapProducts, EvalThreeDScoresTheCloudAgainstTheWorldsSurfaces) {
   EXPECT_LE(j["distance_median_all_m"].get<double>(), j["distance_p90_all_m"].get<double>());
   EXPECT_LE(j["distance_median_m"].get<double>(), j["distance_p90_m"].get<double>());
   EXPECT_TRUE(j["point_iou"].contains("building")) << j.dump();
+  // Over the map's area only: a part of the cloud, in the labelled world's square.
+  ASSERT_TRUE(j.contains("over_map")) << j.dump();
+  const nlohmann::json& over = j["over_map"];
+  ASSERT_EQ(over["bounds"].size(), 4u) << over.dump();
+  EXPECT_LT(over["bounds"][0].get<double>(), over["bounds"][2].get<double>());
+  EXPECT_LT(over["bounds"][1].get<double>(), over["bounds"][3].get<double>());
+  EXPECT_GT(over["gaussians"].get<int>(), 0) << over.dump();
+  EXPECT_LE(over["gaussians"].get<int>(), j["gaussians"].get<int>());
+  EXPECT_LE(over["opaque"].get<int>(), j["opaque"].get<int>());
+  for (const char* key : {"share_within_0.5_m", "share_beyond_1.0_m", "point_miou"}) {
+    EXPECT_GE(over[key].get<double>(), 0.0) << key;
+    EXPECT_LE(over[key].get<double>(), 1.0) << key;
+  }
   // Buildings as objects: the world's standing buildings are the truth (a city has dozens).
   ASSERT_TRUE(j.contains("objects")) << j.dump();
   EXPECT_GT(j["objects"]["true"].get<int>(), 10) << j.dump();

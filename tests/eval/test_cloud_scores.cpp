@@ -92,5 +92,33 @@ TEST(CloudScores, AClassAbsentFromTruthAndModelIsNotAveraged) {
   EXPECT_ANY_THROW(eval::scoreCloud(points, handMadeTruth, {}, o));
 }
 
+// Over a map's area: the points whose centre lies over the rectangle (edges included), heights
+// ignored; scored, a far-off floater beyond the area no longer counts.
+TEST(CloudScores, PointsOverTheMapsAreaLeaveOutWhatLiesBeyond) {
+  const std::vector<eval::CloudPoint> points = {{{-1, 0, 0}, 0, 1.f},
+                                                {{1, 1, 3.1f}, 2, 1.f},
+                                                {{2, -2, 0}, 1, 1.f},    // on the corner
+                                                {{2.01f, 0, 0}, 1, 1.f},  // just beyond x1
+                                                {{0, 0, 50}, 1, 1.f},   // high above: over it
+                                                {{-40, 30, 12}, 0, 1.f}};  // far away, floating
+  const std::vector<eval::CloudPoint> over = eval::pointsOver(points, -2, -2, 2, 2);
+  ASSERT_EQ(over.size(), 4u);
+  EXPECT_EQ(over[0].xyz[0], -1.f);
+  EXPECT_EQ(over[1].xyz[2], 3.1f);
+  EXPECT_EQ(over[2].xyz[0], 2.f);
+  EXPECT_EQ(over[3].xyz[2], 50.f);
+  eval::CloudScoreOptions o;
+  o.num_classes = 3;
+  const eval::CloudScores all = eval::scoreCloud(points, handMadeTruth, {}, o);
+  const eval::CloudScores inside = eval::scoreCloud(over, handMadeTruth, {}, o);
+  // Within 0.5 m: 4 of 6 everywhere (the floaters at 50 m and 12 m not), 3 of 4 over the area.
+  EXPECT_NEAR(all.share_near, 4.0 / 6, 1e-9);
+  EXPECT_NEAR(inside.share_near, 3.0 / 4, 1e-9);
+  EXPECT_EQ(inside.opaque, 4u);
+  EXPECT_TRUE(eval::pointsOver(points, 5, 5, 6, 6).empty());
+  EXPECT_ANY_THROW(eval::pointsOver(points, 1, 0, 0, 1));
+  EXPECT_ANY_THROW(eval::pointsOver(points, 0, 1, 1, 0));
+}
+
 }  // namespace
 }  // namespace sadsplat

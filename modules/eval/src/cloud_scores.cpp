@@ -41,6 +41,20 @@ double quantile(std::vector<float> v, double q) { return quantileInPlace(v, q); 
 
 }  // namespace
 
+std::vector<CloudPoint> pointsOver(const std::vector<CloudPoint>& points, double x0, double y0,
+                                   double x1, double y1) {
+  if (!(x1 >= x0) || !(y1 >= y0)) {
+    throw Error("<cloud scores>", "area", "x0 <= x1 and y0 <= y1",
+                std::to_string(x0) + ".." + std::to_string(x1) + " x " + std::to_string(y0) +
+                    ".." + std::to_string(y1));
+  }
+  std::vector<CloudPoint> over;
+  for (const CloudPoint& p : points) {
+    if (p.xyz[0] >= x0 && p.xyz[0] <= x1 && p.xyz[1] >= y0 && p.xyz[1] <= y1) over.push_back(p);
+  }
+  return over;
+}
+
 CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruthSurface& truth,
                        const std::vector<SurfaceSample>& surface, const CloudScoreOptions& o) {
   const int n = o.num_classes;

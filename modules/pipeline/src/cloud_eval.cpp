@@ -129,6 +129,19 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
     confusion.push_back(row);
   }
   j["confusion"] = confusion;  // rows: the nearest true surface's class; columns: the Gaussian's
+  // The same distances over the map's area only (the labelled world's square, as `eval --ortho`
+  // scores it): the far terrain oblique photos see beyond it left out.
+  const double x1 = top.x0 + top.width * top.gsd, y0 = top.y0 - top.height * top.gsd;
+  const std::vector<eval::CloudPoint> over_map = eval::pointsOver(points, top.x0, y0, x1, top.y0);
+  const eval::CloudScores over = eval::scoreCloud(over_map, truth, surface, options);
+  j["over_map"] = {{"bounds", {top.x0, y0, x1, top.y0}},
+                   {"gaussians", over_map.size()},
+                   {"opaque", over.opaque},
+                   {"point_miou", over.miou},
+                   {"distance_median_m", over.median_metres},
+                   {"distance_p90_m", over.p90_metres},
+                   {"share_within_0.5_m", over.share_near},
+                   {"share_beyond_1.0_m", over.share_far}};
   // Objects: the buildings as examples/building_footprints extracts them (opaque Gaussians of
   // the class, Euclidean clusters), against the world's standing buildings.
   int building = -1;

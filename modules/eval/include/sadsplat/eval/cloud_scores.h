@@ -65,6 +65,12 @@ struct CloudScores {
   double completeness_all = 0;       ///< over all scored samples
 };
 
+/// \brief The points whose centre lies over the rectangle [x0, x1] x [y0, y1] (horizontal
+/// coordinates, edges included): the cloud over a map's area, without what lies beyond it.
+/// \throws sadsplat::Error when x1 < x0 or y1 < y0
+std::vector<CloudPoint> pointsOver(const std::vector<CloudPoint>& points, double x0, double y0,
+                                   double x1, double y1);
+
 /// \brief Scores `points` against `truth` and `surface` (see the file comment).
 CloudScores scoreCloud(const std::vector<CloudPoint>& points, const NearestTruthSurface& truth,
                        const std::vector<SurfaceSample>& surface, const CloudScoreOptions& options);
