@@ -43,6 +43,16 @@ std::vector<eval::CloudPoint> cloudPoints(const pcl::PointCloud<GaussianPoint>& 
   return points;
 }
 
+// What every part of the cloud scored apart (over the map's area, on the surface) reports.
+nlohmann::json partScores(std::size_t gaussians, const eval::CloudScores& k) {
+  return {{"gaussians", gaussians},
+          {"point_miou", k.miou},
+          {"opaque", k.opaque},
+          {"share_within_0.5_m", k.share_near},
+          {"share_beyond_1.0_m", k.share_far},
+          {"distance_p90_m", k.p90_metres}};
+}
+
 }  // namespace
 
 std::string evalCloudRun(const std::string& run_dir, const std::string& scene_override) {
@@ -133,15 +143,11 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
   // scores it): the far terrain oblique photos see beyond it left out.
   const double x1 = top.x0 + top.width * top.gsd, y0 = top.y0 - top.height * top.gsd;
   const std::vector<eval::CloudPoint> over_map = eval::pointsOver(points, top.x0, y0, x1, top.y0);
-  const eval::CloudScores over = eval::scoreCloud(over_map, truth, surface, options);
-  j["over_map"] = {{"bounds", {top.x0, y0, x1, top.y0}},
-                   {"gaussians", over_map.size()},
-                   {"opaque", over.opaque},
-                   {"point_miou", over.miou},
-                   {"distance_median_m", over.median_metres},
-                   {"distance_p90_m", over.p90_metres},
-                   {"share_within_0.5_m", over.share_near},
-                   {"share_beyond_1.0_m", over.share_far}};
+  // No surface samples: its completeness is not reported.
+  const eval::CloudScores over = eval::scoreCloud(over_map, truth, {}, options);
+  j["over_map"] = partScores(over_map.size(), over);
+  j["over_map"]["bounds"] = {top.x0, y0, x1, top.y0};
+  j["over_map"]["distance_median_m"] = over.median_metres;
   // Objects: the buildings as examples/building_footprints extracts them (opaque Gaussians of
   // the class, Euclidean clusters), against the world's standing buildings.
   int building = -1;
@@ -181,14 +187,9 @@ std::string evalCloudRun(const std::string& run_dir, const std::string& scene_ov
       if (gaps[i] <= limit) kept.push_back(points[i]), kept_checked.push_back(checked_points[i]);
     }
     const eval::CloudScores k = eval::scoreCloud(kept, truth, surface, options);
-    on_surface.push_back({{"max_gap_m", limit},
-                          {"gaussians", kept.size()},
-                          {"point_miou", k.miou},
-                          {"opaque", k.opaque},
-                          {"share_within_0.5_m", k.share_near},
-                          {"share_beyond_1.0_m", k.share_far},
-                          {"distance_p90_m", k.p90_metres},
-                          {"completeness_all", k.completeness_all}});
+    on_surface.push_back(partScores(kept.size(), k));
+    on_surface.back()["max_gap_m"] = limit;
+    on_surface.back()["completeness_all"] = k.completeness_all;
     if (building >= 0) {
       on_surface.back()["objects_f1"] = buildingObjects(kept, object_options).f1;
       on_surface.back()["objects_f1_raised_check"] =
